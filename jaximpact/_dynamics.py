@@ -1,0 +1,272 @@
+"""Nondimensional equations of motion of one contact.
+
+Every law is integrated in its own natural units: length `x*`, time `t*` and force
+`m v0^2 / x*`, so that the solver sees an O(1) problem whatever the stiffness, mass and
+impact speed (shared/notes, section 3). The state starts at `X = 0`, `V = 1`.
+A dynamics object knows its state layout; the impact solve only calls the methods below.
+"""
+
+import abc
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+from jaxtyping import Array
+
+from ._powers import contact_pow
+
+
+class AbstractDynamics(eqx.Module):
+    """Equations of motion of one contact in nondimensional form.
+
+    `compressing` is a boolean (traced) that selects the phase: the compression phase
+    (`v > 0`) or the restitution phase (`v < 0`); laws with a dry force differ between them.
+    """
+
+    x_star: eqx.AbstractVar[Array]  # length scale, m
+    t_star: eqx.AbstractVar[Array]  # time scale, s
+    gamma: eqx.AbstractVar[Array]  # gravity g x* / v0^2, pushing into the surface
+    has_dry: eqx.AbstractVar[bool]  # a dry force can hold the body at rest (static)
+    split: eqx.AbstractVar[bool]  # the force jumps at maximum compression (static)
+
+    @abc.abstractmethod
+    def y0(self) -> Array:
+        """State at first touch: `X = 0`, `V = 1`."""
+
+    @abc.abstractmethod
+    def rhs(self, y: Array, compressing) -> Array:
+        """`dy/dtau`."""
+
+    @abc.abstractmethod
+    def position(self, y: Array) -> Array:
+        """`X = x / x*`."""
+
+    @abc.abstractmethod
+    def velocity(self, y: Array) -> Array:
+        """`V = v / v0`."""
+
+    @abc.abstractmethod
+    def force(self, y: Array, compressing) -> Array:
+        """Contact force in units of `m v0^2 / x*`, positive pushing the body out."""
+
+    @abc.abstractmethod
+    def force_gap(self, y: Array, compressing) -> Array:
+        """Positive while the contact pushes; crosses zero transversally where it stops
+        pushing (the `"force"` separation criterion)."""
+
+    def force_rate(self, y: Array, compressing) -> Array:
+        """`dF/dtau` along the motion (zero at a force peak)."""
+        return jax.jvp(lambda z: self.force(z, compressing), (y,), (self.rhs(y, compressing),))[1]
+
+    @property
+    def force_scale(self) -> Array:
+        """`m v0^2 / x*` in N, given through the scales: `x* / t*^2` times the mass."""
+        return self.mass * self.x_star / self.t_star**2
+
+    mass: eqx.AbstractVar[Array]
+
+
+class PowerDynamics(AbstractDynamics):
+    """`F = c x^n + b x^p v + P_phase`, in the Lienard variable `W`.
+
+    With `X = x/x*`, `x* = (m v0^2/c)^(1/(n+1))`, `t* = x*/v0`, `beta = b x*^(p+1)/(m v0)`:
+    `X' = W - beta X^(p+1)/(p+1)`, `W' = -X^n - P_phase + gamma`, and `V = X'`.
+    The damping term is absorbed into `W` (since `x^p x' = d/dt x^(p+1)/(p+1)`), so no
+    `x^(p-1)` appears in the Jacobian: AD derivatives converge for the `x^0.5` laws
+    (shared/notes, section 2.4).
+    """
+
+    n: Array | float
+    p: Array | float
+    beta: Array
+    dry_in: Array  # dry force in compression, units of m v0^2/x*
+    dry_out: Array  # dry force in restitution
+    gamma: Array
+    x_star: Array
+    t_star: Array
+    mass: Array
+    # where the force criterion ends contact: at the first zero of x or of the "reduced"
+    # force, which is F itself ("force", dry laws), or F / x^p = x^(n-p) + beta V (a number:
+    # n - p); "x": the force only vanishes at x = 0 (Hunt-Crossley)
+    gap: str | float = eqx.field(static=True)
+    has_dry: bool = eqx.field(static=True, default=False)
+    split: bool = eqx.field(static=True, default=False)
+
+    def y0(self):
+        zero = jnp.zeros_like(self.beta)
+        return jnp.stack([zero, zero + 1.0])
+
+    def _damping_potential(self, x):
+        return self.beta * contact_pow(x, self.p + 1) / (self.p + 1)
+
+    def position(self, y):
+        return y[0]
+
+    def velocity(self, y):
+        return y[1] - self._damping_potential(y[0])
+
+    def _dry(self, compressing):
+        return jnp.where(compressing, self.dry_in, self.dry_out)
+
+    def rhs(self, y, compressing):
+        x = y[0]
+        return jnp.stack(
+            [self.velocity(y), -contact_pow(x, self.n) - self._dry(compressing) + self.gamma]
+        )
+
+    def force(self, y, compressing):
+        x, v = y[0], self.velocity(y)
+        elastic = contact_pow(x, self.n)
+        damping = self.beta * contact_pow(x, self.p) * v
+        return elastic + damping + self._dry(compressing)
+
+    def force_gap(self, y, compressing):
+        x = y[0]
+        if self.gap == "x":
+            return x
+        if self.gap == "force":
+            reduced = self.force(y, compressing)
+        else:
+            reduced = contact_pow(x, self.gap) + self.beta * self.velocity(y)
+        return jnp.minimum(x, reduced)
+
+
+class MaxwellDynamics(AbstractDynamics):
+    """Spring `c` in series with dashpot `b`; the force is a state (eqs. 10-11).
+
+    With `t* = sqrt(m/c)`, `x* = v0 t*` and `Phi = F/(c x*)`:
+    `X' = V`, `V' = -Phi + gamma`, `Phi' = V - mu Phi`, `mu = sqrt(m c)/b`.
+    """
+
+    mu: Array
+    gamma: Array
+    x_star: Array
+    t_star: Array
+    mass: Array
+    has_dry: bool = eqx.field(static=True, default=False)
+    split: bool = eqx.field(static=True, default=False)
+
+    def y0(self):
+        zero = jnp.zeros_like(self.mu)
+        return jnp.stack([zero, zero + 1.0, zero])
+
+    def position(self, y):
+        return y[0]
+
+    def velocity(self, y):
+        return y[1]
+
+    def rhs(self, y, compressing):
+        return jnp.stack([y[1], -y[2] + self.gamma, y[1] - self.mu * y[2]])
+
+    def force(self, y, compressing):
+        return y[2]
+
+    def force_gap(self, y, compressing):
+        return y[2]
+
+
+class ScaledDynamics(AbstractDynamics):
+    """A user's force law `f(x, v, params)`, rescaled: `X'' = -f(x* X, v0 V)/(m v0^2/x*) + gamma`.
+
+    The scale `x*` solves `x* f(x*, v0) = m v0^2` (work of the contact force over `x*`
+    equals the kinetic energy), found by bisection; the force criterion uses `f` itself
+    while `X > 0` and `X` below, so a law vanishing like `x^1.5` still ends at `X = 0`.
+    """
+
+    fn: object = eqx.field(static=True)
+    params: dict
+    v0: Array
+    gamma: Array
+    x_star: Array
+    t_star: Array
+    mass: Array
+    has_dry: bool = eqx.field(static=True, default=False)
+    split: bool = eqx.field(static=True, default=False)
+
+    def y0(self):
+        zero = jnp.zeros_like(self.v0)
+        return jnp.stack([zero, zero + 1.0])
+
+    def position(self, y):
+        return y[0]
+
+    def velocity(self, y):
+        return y[1]
+
+    def force(self, y, compressing):
+        return self.fn(self.x_star * y[0], self.v0 * y[1], self.params) / self.force_scale
+
+    def rhs(self, y, compressing):
+        return jnp.stack([y[1], -self.force(y, compressing) + self.gamma])
+
+    def force_gap(self, y, compressing):
+        return jnp.where(y[0] > 0, self.force(y, compressing), y[0])
+
+
+def power_dynamics(
+    c, n, b, p, dry_in, dry_out, *, m, v0, g, gap, split=False, can_stick=False
+) -> PowerDynamics:
+    """Build `PowerDynamics` from dimensional coefficients (SI units); `split`: the dry
+    force differs between compression and restitution; `can_stick`: it can hold the body."""
+    x_star = (m * v0**2 / c) ** (1.0 / (n + 1.0))
+    force_scale = m * v0**2 / x_star
+    return PowerDynamics(
+        n=n,
+        p=p,
+        beta=jnp.asarray(b * x_star ** (p + 1.0) / (m * v0), dtype=float),
+        dry_in=jnp.asarray(dry_in / force_scale, dtype=float),
+        dry_out=jnp.asarray(dry_out / force_scale, dtype=float),
+        gamma=jnp.asarray(g * x_star / v0**2, dtype=float),
+        x_star=jnp.asarray(x_star, dtype=float),
+        t_star=jnp.asarray(x_star / v0, dtype=float),
+        mass=jnp.asarray(m, dtype=float),
+        gap=gap,
+        has_dry=can_stick,
+        split=split,
+    )
+
+
+def maxwell_dynamics(c, b, *, m, v0, g) -> MaxwellDynamics:
+    """Build `MaxwellDynamics` from the spring `c` (N/m) and dashpot `b` (N s/m)."""
+    t_star = jnp.sqrt(m / c)
+    x_star = v0 * t_star
+    return MaxwellDynamics(
+        mu=jnp.asarray(jnp.sqrt(m * c) / b, dtype=float),
+        gamma=jnp.asarray(g * x_star / v0**2, dtype=float),
+        x_star=jnp.asarray(x_star, dtype=float),
+        t_star=jnp.asarray(t_star, dtype=float),
+        mass=jnp.asarray(m, dtype=float),
+    )
+
+
+def _energy_length(fn, params, m, v0):
+    """`x*` with `x* f(x*, v0) = m v0^2`, by bisection on `log10 x*` in [-30, 10]."""
+    target = jnp.log(m * v0**2)
+
+    def excess(log10_x):
+        x = 10.0**log10_x
+        return jnp.log(jnp.maximum(x * fn(x, v0, params), 1e-300)) - target
+
+    def step(_, bounds):
+        lo, hi = bounds
+        mid = 0.5 * (lo + hi)
+        above = excess(mid) > 0
+        return jnp.where(above, lo, mid), jnp.where(above, mid, hi)
+
+    lo, hi = jax.lax.fori_loop(0, 80, step, (jnp.asarray(-30.0), jnp.asarray(10.0)))
+    return jax.lax.stop_gradient(10.0 ** (0.5 * (lo + hi)))
+
+
+def scaled_dynamics(fn, params, *, m, v0, g) -> ScaledDynamics:
+    """Build `ScaledDynamics` for a user's law `fn(x, v, params)` (SI units)."""
+    x_star = _energy_length(fn, jax.lax.stop_gradient(params), m, v0)
+    return ScaledDynamics(
+        fn=fn,
+        params=params,
+        v0=jnp.asarray(v0, dtype=float),
+        gamma=jnp.asarray(g * x_star / v0**2, dtype=float),
+        x_star=x_star,
+        t_star=x_star / v0,
+        mass=jnp.asarray(m, dtype=float),
+    )

@@ -1,0 +1,385 @@
+"""Contact force laws: the seed paper's ten, the Hunt-Crossley family, and the user's own.
+
+Sign convention: `x` is the penetration (m, > 0 inside the surface), `v = dx/dt` (m/s), and a
+law returns the force on the body (N), positive when it pushes the body out. Most laws are
+one family, `F = c x^n + b x^p v + P d(v)`; the table `LAWS` maps each name to its
+coefficients in that family. Equation numbers refer to Polukoshko, Viba, Kononova and
+Sokolova, "Rigid body impact models partially considering deformation", Proc. Estonian
+Acad. Sci. Eng. 13 (2007) (shared/seeds).
+"""
+
+import abc
+import dataclasses
+from collections.abc import Callable
+
+import equinox as eqx
+import jax.numpy as jnp
+from jaxtyping import Array
+
+from . import _hysteresis_damping
+from ._checks import check_nonnegative, check_positive, check_values
+from ._dynamics import (
+    AbstractDynamics,
+    maxwell_dynamics,
+    power_dynamics,
+    scaled_dynamics,
+)
+from ._powers import contact_pow
+
+
+@dataclasses.dataclass(frozen=True)
+class LawSpec:
+    """One row of the law table.
+
+    `coefficients(params, v0)` returns the family coefficients
+    `(c, n, b, p, P_compression, P_restitution)` in SI units; `None` for laws outside the
+    family (Maxwell). `split`: the force jumps at maximum compression (a dry force), so the
+    contact is integrated as two smooth phases; `dry`: that force can hold the body at rest.
+    `gap` says where the force criterion ends contact: `"force"` (a dry force makes `F`
+    itself cross zero), `"x"` (the force only vanishes at `x = 0`), or the exponent `n - p`
+    of the reduced force `F / x^p`.
+    """
+
+    name: str
+    equation: str
+    formula: str
+    parameters: tuple[str, ...]
+    units: dict[str, str]
+    reference: str
+    coefficients: Callable | None
+    gap: str | float = "force"
+    split: bool = False
+    dry: bool = False
+    defaults: dict[str, float] = dataclasses.field(default_factory=dict)
+
+
+_PAPER = "Polukoshko et al. 2007"
+_UNITS = {
+    "c": "N/m^n",
+    "b": "N s/m^(p+1)",
+    "b1": "N s/m^(p+1)",
+    "P": "N",
+    "a": "s/m",
+    "n": "-",
+    "e_nominal": "-",
+}
+
+
+def _family(c, n, b, p, p_in=0.0, p_out=0.0):
+    zero = jnp.zeros_like(jnp.asarray(c, dtype=float))
+    return c, n, b + zero, p, p_in + zero, p_out + zero
+
+
+_SPECS = [
+    LawSpec(
+        "kelvin_voigt",
+        "1",
+        "c x + b v",
+        ("c", "b"),
+        _UNITS,
+        f"{_PAPER}, eq. 1",
+        lambda q, v0: _family(q["c"], 1, q["b"], 0),
+        gap=1,
+    ),
+    LawSpec(
+        "kelvin_voigt_modified",
+        "6",
+        "c x + b1 x v",
+        ("c", "b1"),
+        _UNITS,
+        f"{_PAPER}, eq. 6",
+        lambda q, v0: _family(q["c"], 1, q["b1"], 1),
+        gap=0,
+    ),
+    LawSpec(
+        "bingham",
+        "7",
+        "c x + b v + P sgn(v)",
+        ("c", "b", "P"),
+        _UNITS,
+        f"{_PAPER}, eq. 7",
+        lambda q, v0: _family(q["c"], 1, q["b"], 0, q["P"], -q["P"]),
+        split=True,
+        dry=True,
+    ),
+    LawSpec(
+        "bingham_modified",
+        "8",
+        "c x + b1 x v + P sgn(v)",
+        ("c", "b1", "P"),
+        _UNITS,
+        f"{_PAPER}, eq. 8",
+        lambda q, v0: _family(q["c"], 1, q["b1"], 1, q["P"], -q["P"]),
+        split=True,
+        dry=True,
+    ),
+    LawSpec(
+        "bingham_compression",
+        "9",
+        "c x + P while v > 0, c x after",
+        ("c", "P"),
+        _UNITS,
+        f"{_PAPER}, eq. 9",
+        lambda q, v0: _family(q["c"], 1, 0.0, 0, q["P"], 0.0),
+        gap=1,
+        split=True,
+    ),
+    LawSpec(
+        "maxwell",
+        "10-11",
+        "spring c in series with dashpot b: dF/dt = c (v - F/b)",
+        ("c", "b"),
+        {"c": "N/m", "b": "N s/m"},
+        f"{_PAPER}, eqs. 10-11",
+        None,
+    ),
+    LawSpec(
+        "hertz_viscous",
+        "12",
+        "c x^1.5 + b v",
+        ("c", "b"),
+        _UNITS,
+        f"{_PAPER}, eq. 12",
+        lambda q, v0: _family(q["c"], 1.5, q["b"], 0),
+        gap=1.5,
+    ),
+    LawSpec(
+        "hertz_modified",
+        "13",
+        "c x^1.5 + b x v",
+        ("c", "b"),
+        _UNITS,
+        f"{_PAPER}, eq. 13",
+        lambda q, v0: _family(q["c"], 1.5, q["b"], 1),
+        gap=0.5,
+    ),
+    LawSpec(
+        "hertz_rate",
+        "14",
+        "c x^1.5 + b1 x^0.5 v",
+        ("c", "b1"),
+        _UNITS,
+        f"{_PAPER}, eq. 14 (the paper's proposal; Kuwabara & Kono 1987)",
+        lambda q, v0: _family(q["c"], 1.5, q["b1"], 0.5),
+        gap=1,
+    ),
+    LawSpec(
+        "hunt_crossley",
+        "15-16",
+        "c x^n (1 + 1.5 a v)",
+        ("c", "a", "n"),
+        _UNITS,
+        f"{_PAPER}, eqs. 15-16; Hunt & Crossley, J. Appl. Mech. 42 (1975) 440",
+        lambda q, v0: _family(q["c"], q["n"], 1.5 * q["a"] * q["c"], q["n"]),
+        gap="x",
+        defaults={"n": 1.5},
+    ),
+]
+
+
+def _nominal_spec(name, formula, citation):
+    def coefficients(q, v0):
+        damping = formula(q["e_nominal"], v0)
+        return _family(q["c"], q["n"], damping * q["c"], q["n"])
+
+    return LawSpec(
+        name,
+        "-",
+        f"c x^n (1 + D v), {formula.__doc__.split(':')[-1].strip().strip('`.')}",
+        ("c", "e_nominal", "n"),
+        _UNITS,
+        f"{citation}: {formula.__doc__.split(':')[0].strip()}",
+        coefficients,
+        gap="x",
+        defaults={"n": 1.5},
+    )
+
+
+_SPECS += [_nominal_spec(name, *row) for name, row in _hysteresis_damping.FORMULAS.items()]
+
+LAWS: dict[str, LawSpec] = {spec.name: spec for spec in _SPECS}
+LAW_NAMES: tuple[str, ...] = tuple(LAWS)
+
+
+class AbstractLaw(eqx.Module):
+    """A contact force law. Its array fields are its parameters (what a fit updates)."""
+
+    @abc.abstractmethod
+    def dynamics(self, *, m, v0, g) -> AbstractDynamics:
+        """The nondimensional equations of one contact (mass m in kg, speed v0 in m/s,
+        gravity g in m/s^2 along the inward normal)."""
+
+    @property
+    @abc.abstractmethod
+    def parameters(self) -> dict[str, Array]:
+        """The law's parameters by name."""
+
+    @abc.abstractmethod
+    def replace(self, **params) -> "AbstractLaw":
+        """The same law with some parameters changed."""
+
+    def __getattr__(self, item):
+        params = self.__dict__.get("params")
+        if params is not None and item in params:
+            return params[item]
+        raise AttributeError(item)
+
+
+class Law(AbstractLaw):
+    """A law of the table `LAWS`, built by `jaximpact.law(name, **params)`.
+
+    **Example**: `jaximpact.law("hertz_rate", c=2e6, b1=800.0).force(1e-3, 1.0)`.
+    """
+
+    name: str = eqx.field(static=True)
+    params: dict[str, Array]
+
+    @property
+    def spec(self) -> LawSpec:
+        return LAWS[self.name]
+
+    @property
+    def parameters(self):
+        return dict(self.params)
+
+    def replace(self, **params):
+        unknown = sorted(set(params) - set(self.params))
+        if unknown:
+            raise ValueError(
+                f"law {self.name!r} has no parameter {', '.join(unknown)}; "
+                f"it has {', '.join(self.params)}"
+            )
+        return law(self.name, **{**self.params, **params})
+
+    def dynamics(self, *, m, v0, g):
+        if self.name == "maxwell":
+            return maxwell_dynamics(self.params["c"], self.params["b"], m=m, v0=v0, g=g)
+        c, n, b, p, p_in, p_out = self.spec.coefficients(self.params, v0)
+        return power_dynamics(
+            c,
+            n,
+            b,
+            p,
+            p_in,
+            p_out,
+            m=m,
+            v0=v0,
+            g=g,
+            gap=self.spec.gap,
+            split=self.spec.split,
+            can_stick=self.spec.dry,
+        )
+
+    def force(self, x, v, *, v0=None, compressing=None):
+        """Contact force (N) at penetration `x` (m) and velocity `v` (m/s).
+
+        The dry force's sign follows `compressing` (default: `v > 0`); the Hunt-Crossley
+        variants need the impact speed `v0`. Not defined for Maxwell, whose force is a state.
+        """
+        if self.name == "maxwell":
+            raise ValueError(
+                "the Maxwell force is a state, not a function of (x, v): "
+                "read it from impact(..., ts=...).F"
+            )
+        if v0 is None and self.name in _hysteresis_damping.FORMULAS:
+            raise ValueError(f"law {self.name!r} needs the impact speed: pass v0=...")
+        c, n, b, p, p_in, p_out = self.spec.coefficients(self.params, v0)
+        x, v = jnp.asarray(x, dtype=float), jnp.asarray(v, dtype=float)
+        compressing = v > 0 if compressing is None else compressing
+        dry = jnp.where(compressing, p_in, p_out)
+        return c * contact_pow(x, n) + b * contact_pow(x, p) * v + dry
+
+
+class CustomLaw(AbstractLaw):
+    """A user's law `F = fn(x, v, params)` in SI units (N), built by `custom_law`."""
+
+    fn: Callable = eqx.field(static=True)
+    params: dict[str, Array]
+    name: str = eqx.field(static=True, default="custom")
+
+    @property
+    def parameters(self):
+        return dict(self.params)
+
+    def replace(self, **params):
+        unknown = sorted(set(params) - set(self.params))
+        if unknown:
+            raise ValueError(
+                f"this custom law has no parameter {', '.join(unknown)}; "
+                f"it has {', '.join(self.params)}"
+            )
+        return CustomLaw(self.fn, {**self.params, **_as_arrays(params)}, self.name)
+
+    def dynamics(self, *, m, v0, g):
+        return scaled_dynamics(self.fn, self.params, m=m, v0=v0, g=g)
+
+    def force(self, x, v, **_):
+        """Contact force (N) at penetration `x` (m) and velocity `v` (m/s)."""
+        return self.fn(jnp.asarray(x, dtype=float), jnp.asarray(v, dtype=float), self.params)
+
+
+def _as_arrays(params):
+    return {k: jnp.asarray(v, dtype=float) for k, v in params.items()}
+
+
+def _check_law_parameters(name, params):
+    for key, value in params.items():
+        if key == "c":
+            check_positive(f"{name}: stiffness c", value, _UNITS["c"])
+        elif key == "n":
+            check_positive(f"{name}: exponent n", value)
+        elif key == "e_nominal":
+            check_values(
+                value,
+                lambda a: (a <= 0) | (a > 1),
+                f"{name}: e_nominal must lie in (0, 1], got {value}",
+            )
+        else:
+            check_nonnegative(f"{name}: {key}", value, _UNITS.get(key, ""))
+
+
+def law(name: str, **params) -> Law:
+    """Build the law `name` of `LAW_NAMES` with its parameters (SI units).
+
+    Parameter names are the seed paper's: `c` stiffness, `b` or `b1` damping, `P` dry force,
+    `a` Hunt-Crossley damping, `n` exponent, `e_nominal` the restitution a published
+    Hunt-Crossley damping formula is asked for. `jaximpact laws` lists them all.
+
+    **Example**: `law("kelvin_voigt", c=2e6, b=400.0)`.
+    """
+    if name not in LAWS:
+        raise ValueError(f"unknown law {name!r}; choose one of: {', '.join(LAW_NAMES)}")
+    spec = LAWS[name]
+    unknown = sorted(set(params) - set(spec.parameters))
+    if unknown:
+        raise ValueError(
+            f"law {name!r} has no parameter {', '.join(unknown)}; "
+            f"it takes {', '.join(spec.parameters)}"
+        )
+    given = {**spec.defaults, **params}
+    missing = [k for k in spec.parameters if k not in given]
+    if missing:
+        raise ValueError(
+            f"law {name!r} needs {', '.join(missing)}; it takes {', '.join(spec.parameters)}"
+            + (f" (defaults: {spec.defaults})" if spec.defaults else "")
+        )
+    given = {k: given[k] for k in spec.parameters}
+    _check_law_parameters(name, given)
+    return Law(name, _as_arrays(given))
+
+
+def custom_law(fn: Callable, **params) -> CustomLaw:
+    """Wrap a user's force law `fn(x, v, params) -> F` (SI units, N, positive pushing out).
+
+    `fn` must be a pure JAX function of the penetration `x` (m), the velocity `v` (m/s)
+    and the dict `params`; it is called with `x` slightly below 0 by the solver's last
+    step, so guard fractional powers with `jaximpact.safe_pow`.
+
+    **Example**:
+    `custom_law(lambda x, v, p: p["k"] * x + p["d"] * safe_pow(x, 0.5) * v, k=2e6, d=800.0)`.
+    """
+    if not callable(fn):
+        raise ValueError("custom_law needs a function f(x, v, params) as its first argument")
+    if not params:
+        raise ValueError("custom_law needs the law's parameters as keywords, e.g. k=2e6")
+    return CustomLaw(fn, _as_arrays(params))

@@ -1,0 +1,20 @@
+"""How an impact ended."""
+
+import enum
+
+
+class Status(enum.IntEnum):
+    """How an impact ended; `ImpactResult.status` holds these as small integers.
+
+    - `separated`: the body left the surface (by the chosen separation criterion).
+    - `stuck`: a dry force `P` held the body at rest inside the surface (e = 0).
+    - `captured`: the body never left, e.g. over-damped Kelvin-Voigt under the penetration
+      criterion, or a body resting on the surface under gravity (e = 0; T is the time at
+      which the integration gave up, see `impact`).
+    - `out_of_steps`: the solver used `max_steps` before the contact ended.
+    """
+
+    separated = 0
+    stuck = 1
+    captured = 2
+    out_of_steps = 3
