@@ -3,29 +3,19 @@
 import importlib.metadata
 
 from . import closed_forms as closed_forms
-from ._impact import ImpactResult as ImpactResult
-from ._impact import impact as impact
+from ._calibrate import Fit as Fit, calibrate as calibrate
+from ._impact import ImpactResult as ImpactResult, impact as impact
 from ._laws import (
     LAW_NAMES as LAW_NAMES,
-)
-from ._laws import (
     LAWS as LAWS,
-)
-from ._laws import (
     AbstractLaw as AbstractLaw,
-)
-from ._laws import (
     CustomLaw as CustomLaw,
-)
-from ._laws import (
     Law as Law,
-)
-from ._laws import (
     custom_law as custom_law,
-)
-from ._laws import (
     law as law,
 )
+from ._model_choice import compare_laws as compare_laws, starting_law as starting_law
+from ._plotting import plot_impact as plot_impact
 from ._powers import safe_pow as safe_pow
 from ._status import Status as Status
 

@@ -9,8 +9,7 @@ looks at the tracers it is given and picks the cheapest one that works.
 
 import diffrax as dfx
 import jax
-from jax._src.interpreters import ad as _ad
-from jax._src.interpreters import batching as _batching
+from jax._src.interpreters import ad as _ad, batching as _batching
 
 
 def _tracer_kinds(leaf, kinds: set):

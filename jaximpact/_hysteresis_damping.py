@@ -63,15 +63,15 @@ def gharib_hurmuzlu(e, v0):
     return (1.0 / e - 1.0) / v0
 
 
-# law name -> (formula, short citation)
+# law name -> formula (its docstring holds the reference)
 FORMULAS = {
-    "lankarani_nikravesh": (lankarani_nikravesh, "Lankarani & Nikravesh 1990"),
-    "flores": (flores, "Flores et al. 2011"),
-    "gonthier": (gonthier, "Gonthier et al. 2004"),
-    "hu_guo": (hu_guo, "Hu & Guo 2015"),
-    "herbert_mcwhannell": (herbert_mcwhannell, "Herbert & McWhannell 1977"),
-    "lee_wang": (lee_wang, "Lee & Wang 1983"),
-    "zhiying_qishao": (zhiying_qishao, "Zhiying & Qishao 2006"),
-    "gharib_hurmuzlu": (gharib_hurmuzlu, "Gharib & Hurmuzlu 2012"),
-    "hunt_crossley_nominal": (hunt_crossley, "Hunt & Crossley 1975"),
+    "lankarani_nikravesh": lankarani_nikravesh,
+    "flores": flores,
+    "gonthier": gonthier,
+    "hu_guo": hu_guo,
+    "herbert_mcwhannell": herbert_mcwhannell,
+    "lee_wang": lee_wang,
+    "zhiying_qishao": zhiying_qishao,
+    "gharib_hurmuzlu": gharib_hurmuzlu,
+    "hunt_crossley_nominal": hunt_crossley,
 }

@@ -257,6 +257,48 @@ def _histories(dynamics, phases, plan, tau_grid, v0, g):
     return dict(ts=tau_grid * t_star, x=x, v=v, F=force)
 
 
+class ImpactOptions(eqx.Module):
+    """Everything static about an impact solve (see `impact` for the meanings)."""
+
+    separation: str = eqx.field(static=True)
+    closed_form: bool = eqx.field(static=True)
+    solver: dfx.AbstractSolver = eqx.field(static=True)
+    rtol: float = eqx.field(static=True)
+    atol: float = eqx.field(static=True)
+    max_steps: int = eqx.field(static=True)
+    tau_max: float = eqx.field(static=True)
+    rest_tol: float = eqx.field(static=True)
+    adjoint: dfx.AbstractAdjoint = eqx.field(static=True)
+    peaks: bool = eqx.field(static=True)
+
+
+@eqx.filter_jit
+def solve_impact(law, m, v0, g, ts, options: ImpactOptions) -> ImpactResult:
+    """The compiled part of `impact`, cached per law structure and options; no input
+    checks (callers inside the library that have validated their inputs use it)."""
+    dynamics = law.dynamics(m=m, v0=v0, g=g)
+    if options.closed_form:
+        closed = _closed_forms.closed_form_for(law, options.separation)
+        fields = closed(law, m=m, v0=v0, rest_tol=options.rest_tol)
+        return ImpactResult(**fields, path="closed_form")
+    tau_grid = None if ts is None else ts / dynamics.t_star
+    plan = _phase_plan(dynamics, options.peaks or tau_grid is not None)
+    phases = _integrate(
+        dynamics,
+        plan=plan,
+        separation=options.separation,
+        tau_grid=tau_grid,
+        solver=options.solver,
+        rtol=options.rtol,
+        atol=options.atol,
+        max_steps=options.max_steps,
+        tau_max=options.tau_max,
+        rest_tol=options.rest_tol,
+        adjoint=options.adjoint,
+    )
+    return _assemble_integrated(dynamics, phases, plan, m=m, v0=v0, g=g, tau_grid=tau_grid)
+
+
 def impact(
     law: AbstractLaw,
     *,
@@ -326,31 +368,23 @@ def impact(
             f"no closed form for law {getattr(law, 'name', 'custom')!r} with "
             f"separation={separation!r}, g={float(g)} and ts={'given' if ts is not None else None}"
         )
-    dynamics = law.dynamics(m=m, v0=v0, g=g)
-    if closed is not None and method != "integrate":
-        fields = closed(law, m=m, v0=v0, rest_tol=rest_tol)
-        result = ImpactResult(**fields, path="closed_form")
-    else:
-        tau_grid = None if ts is None else jnp.asarray(ts, dtype=float) / dynamics.t_star
-        if tau_grid is not None and tau_grid.ndim != 1:
+    if ts is not None:
+        ts = jnp.asarray(ts, dtype=float)
+        if ts.ndim != 1:
             raise ValueError("ts must be a 1-D array of times in seconds")
-        if adjoint is None:
-            adjoint = auto_adjoint(law, m, v0, g, ts)
-        plan = _phase_plan(dynamics, peaks or tau_grid is not None)
-        phases = _integrate(
-            dynamics,
-            plan=plan,
-            separation=separation,
-            tau_grid=tau_grid,
-            solver=dfx.Tsit5() if solver is None else solver,
-            rtol=rtol,
-            atol=rtol if atol is None else atol,
-            max_steps=max_steps,
-            tau_max=tau_max,
-            rest_tol=rest_tol,
-            adjoint=adjoint,
-        )
-        result = _assemble_integrated(dynamics, phases, plan, m=m, v0=v0, g=g, tau_grid=tau_grid)
+    options = ImpactOptions(
+        separation=separation,
+        closed_form=closed is not None and method != "integrate",
+        solver=dfx.Tsit5() if solver is None else solver,
+        rtol=rtol,
+        atol=rtol if atol is None else atol,
+        max_steps=max_steps,
+        tau_max=tau_max,
+        rest_tol=rest_tol,
+        adjoint=auto_adjoint(law, m, v0, g, ts) if adjoint is None else adjoint,
+        peaks=peaks,
+    )
+    result = solve_impact(law, m, v0, g, ts, options)
     if throw:
         result = eqx.error_if(
             result,

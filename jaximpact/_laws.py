@@ -177,7 +177,7 @@ _SPECS = [
 ]
 
 
-def _nominal_spec(name, formula, citation):
+def _nominal_spec(name, formula):
     def coefficients(q, v0):
         damping = formula(q["e_nominal"], v0)
         return _family(q["c"], q["n"], damping * q["c"], q["n"])
@@ -188,14 +188,14 @@ def _nominal_spec(name, formula, citation):
         f"c x^n (1 + D v), {formula.__doc__.split(':')[-1].strip().strip('`.')}",
         ("c", "e_nominal", "n"),
         _UNITS,
-        f"{citation}: {formula.__doc__.split(':')[0].strip()}",
+        formula.__doc__.split(":")[0].strip(),
         coefficients,
         gap="x",
         defaults={"n": 1.5},
     )
 
 
-_SPECS += [_nominal_spec(name, *row) for name, row in _hysteresis_damping.FORMULAS.items()]
+_SPECS += [_nominal_spec(name, formula) for name, formula in _hysteresis_damping.FORMULAS.items()]
 
 LAWS: dict[str, LawSpec] = {spec.name: spec for spec in _SPECS}
 LAW_NAMES: tuple[str, ...] = tuple(LAWS)

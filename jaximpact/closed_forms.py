@@ -2,13 +2,7 @@
 
 from ._closed_forms import (
     hunt_crossley_restitution as hunt_crossley_restitution,
-)
-from ._closed_forms import (
     kelvin_voigt as kelvin_voigt,
-)
-from ._closed_forms import (
     maxwell as maxwell,
-)
-from ._closed_forms import (
     power_spring as power_spring,
 )

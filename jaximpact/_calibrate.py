@@ -1,0 +1,466 @@
+"""Fitting a law's parameters to measured restitution and contact duration."""
+
+import functools
+
+import diffrax as dfx
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optax
+import optimistix as optx
+from jaxtyping import Array
+
+from ._forward_jacobian import value_and_jacobian, with_forward_jacobian
+from ._impact import ImpactOptions, impact, solve_impact
+from ._laws import AbstractLaw, Law
+from ._status import Status
+
+# the damping parameter of each law whose restitution depends on one dimensionless group
+DAMPING = {
+    "kelvin_voigt": "b",
+    "kelvin_voigt_modified": "b1",
+    "hertz_viscous": "b",
+    "hertz_modified": "b",
+    "hertz_rate": "b1",
+    "hunt_crossley": "a",
+    "maxwell": "b",
+}
+OPTIMIZERS = ("lbfgs", "lm")
+
+
+class Fit(eqx.Module):
+    """A calibrated law and how well it reproduces the measurements.
+
+    - `law`, `params`: the fitted law and its parameters (SI units).
+    - `e`, `T`: predicted restitution and contact duration (s) at every row's `v0`.
+    - `residuals`: weighted residuals, `(e_fit - e)/sigma_e` then `(T_fit - T)/sigma_T`
+      (without sigmas: `e_fit - e` and `(T_fit - T)/T`); 0 for a row without `T`.
+    - `loss`: half the sum of squared residuals; `history`: the loss at each iteration.
+    - `converged`: the optimiser stopped at a minimum and every residual is below
+      `target_tol` (a target the law cannot reach gives `False`, with the best fit).
+    - `iterations`; `stderr`: standard errors of the free parameters (from the Jacobian,
+      only when sigmas are given), `None` otherwise.
+    """
+
+    law: AbstractLaw
+    params: dict[str, Array]
+    v0: Array
+    e: Array
+    T: Array
+    e_target: Array
+    T_target: Array
+    residuals: Array
+    loss: Array
+    converged: Array
+    iterations: Array
+    history: Array
+    stderr: dict[str, Array] | None
+    free: tuple[str, ...] = eqx.field(static=True)
+    optimizer: str = eqx.field(static=True)
+
+
+def _as_rows(name, value, rows, allow_missing=False):
+    if value is None:
+        return None
+    if isinstance(value, (list, tuple)):
+        if allow_missing:
+            value = [np.nan if item is None else item for item in value]
+        value = jnp.asarray(value, dtype=float)
+    value = jnp.atleast_1d(jnp.asarray(value, dtype=float))
+    if value.ndim != 1:
+        raise ValueError(f"{name} must be a number or a 1-D array, got shape {value.shape}")
+    if rows is not None and value.shape[0] not in (1, rows):
+        raise ValueError(
+            f"{name} has {value.shape[0]} values but v0 has {rows}: give one per impact speed"
+        )
+    return jnp.broadcast_to(value, (rows,)) if rows is not None else value
+
+
+def _check_targets(m, v0, e, T, sigma_e, sigma_T):
+    """One-line ValueErrors for impossible targets (only for concrete inputs)."""
+    concrete = not any(isinstance(a, jax.core.Tracer) for a in (m, v0, e, T, sigma_e, sigma_T))
+    if not concrete:
+        return
+    if not np.all(np.asarray(m) > 0) or not np.all(np.isfinite(np.asarray(m))):
+        raise ValueError(f"mass m must be a finite number > 0 kg, got {np.asarray(m)}")
+    if np.any(~np.isfinite(np.asarray(v0))) or np.any(np.asarray(v0) <= 0):
+        raise ValueError("every impact speed v0 must be a finite number > 0 m/s")
+    if e is not None:
+        ea = np.asarray(e)
+        if np.any(np.isnan(ea)):
+            raise ValueError("e contains NaN; every row needs a measured restitution")
+        if np.any((ea <= 0) | (ea > 1)):
+            raise ValueError(f"restitution e must lie in (0, 1], got {ea[(ea <= 0) | (ea > 1)]}")
+    if T is not None:
+        Ta = np.asarray(T)
+        if np.all(np.isnan(Ta)):
+            raise ValueError("T has no value; leave T=None to fit e alone")
+        if np.any(Ta[~np.isnan(Ta)] <= 0) or np.any(np.isinf(Ta)):
+            raise ValueError("contact durations T must be finite and > 0 s (None: no T)")
+    for name, sigma in (("sigma_e", sigma_e), ("sigma_T", sigma_T)):
+        if sigma is not None and (
+            np.any(~np.isfinite(np.asarray(sigma))) or np.any(np.asarray(sigma) <= 0)
+        ):
+            raise ValueError(f"{name} must be finite and > 0")
+    if e is None and T is None:
+        raise ValueError("give e, T or both to calibrate against")
+
+
+# ----------------------------------------------------------------------------- transforms
+
+
+def _to_unbounded(name, value):
+    if name == "e_nominal":
+        return jnp.log(value) - jnp.log1p(-jnp.minimum(value, 1 - 1e-12))
+    return jnp.log(value)
+
+
+def _from_unbounded(name, theta):
+    if name == "e_nominal":
+        return jax.nn.sigmoid(theta)
+    return jnp.exp(theta)
+
+
+def _law_with(law, free, theta):
+    """`law` with its free parameters set from `theta` (physical by construction, so no
+    value checks, which would put host callbacks in the compiled fit)."""
+    params = dict(law.params)
+    params.update({k: _from_unbounded(k, theta[i]) for i, k in enumerate(free)})
+    return eqx.tree_at(lambda item: item.params, law, params)
+
+
+# ------------------------------------------------------------------- initial values
+
+
+@functools.cache
+def _restitution_table(name: str, separation: str, n: float):
+    """`e` and `tau = T/t*` against the dimensionless damping group on a log grid, from
+    impacts at unit scales (`c = m = v0 = 1`, so `x* = t* = 1`). Computed once per law."""
+    groups = np.logspace(-4, 2.5, 53)
+    damping = DAMPING[name]
+
+    def one(group):
+        value = group / 1.5 if name == "hunt_crossley" else group
+        params = {"c": 1.0, damping: value}
+        if name == "hunt_crossley":
+            params["n"] = n
+        result = impact(
+            Law(name, {k: jnp.asarray(v, float) for k, v in params.items()}),
+            m=1.0,
+            v0=1.0,
+            separation=separation,
+            peaks=False,
+            rtol=1e-8,
+        )
+        return result.e, result.T, result.status
+
+    e, tau, status = jax.jit(jax.vmap(one))(jnp.asarray(groups))
+    ok = np.asarray(status) == Status.separated
+    return groups[ok], np.asarray(e)[ok], np.asarray(tau)[ok]
+
+
+def _initial_law(law, free, *, m, v0, e, T, separation):
+    """Start from one dimensionless damping group: `e` sets it (through a table of the
+    law's nondimensional impact), `T` then sets the time scale and so the stiffness."""
+    name = getattr(law, "name", None)
+    damping = DAMPING.get(name)
+    if damping is None or damping not in free or e is None:
+        return law
+    if isinstance(law.params.get("n", 0.0), jax.core.Tracer):
+        return law
+    n = float(law.params.get("n", 1.5)) if name == "hunt_crossley" else 1.5
+    groups, e_table, tau_table = _restitution_table(name, separation, n)
+    row = jnp.argsort(v0)[v0.shape[0] // 2]
+    v_row, e_row = v0[row], e[row]
+    log_group = jnp.interp(-e_row, -e_table, np.log(groups))
+    group = jnp.exp(log_group)
+    tau = jnp.interp(log_group, np.log(groups), tau_table)
+    if name == "maxwell":
+        c = law.params["c"]
+        if T is not None and "c" in free:
+            c = jnp.where(jnp.isfinite(T[row]), m * (tau / T[row]) ** 2, c)
+        return law.replace(**({"c": c} if "c" in free else {}), b=group * jnp.sqrt(m * c))
+    _, n_law, _, p, _, _ = law.spec.coefficients(law.params, v_row)
+    c = law.params["c"]
+    if T is not None and "c" in free:
+        x_star = v_row * T[row] / tau
+        c = jnp.where(jnp.isfinite(T[row]), m * v_row**2 / x_star ** (n_law + 1.0), c)
+    x_star = (m * v_row**2 / c) ** (1.0 / (n_law + 1.0))
+    b = group * m * v_row / x_star ** (p + 1.0)
+    value = b / (1.5 * c) if name == "hunt_crossley" else b
+    return law.replace(**({"c": c} if "c" in free else {}), **{damping: value})
+
+
+# ------------------------------------------------------------------------------ the fit
+
+
+def _default_free(law, has_T):
+    name = getattr(law, "name", None)
+    params = list(law.parameters)
+    damping = DAMPING.get(name) or next(
+        (k for k in ("b", "b1", "a", "e_nominal", "P") if k in params), None
+    )
+    free = [damping] if damping else []
+    if has_T and "c" in params:
+        free = ["c"] + free
+    return tuple(free) or tuple(params[:1])
+
+
+def _residual_function(law, free, *, m, separation, g, rtol, has_e, has_T):
+    """Weighted residuals and predictions; differentiated in forward mode only (through
+    `with_forward_jacobian`), hence the explicit `ForwardMode` adjoint."""
+    options = ImpactOptions(
+        separation=separation,
+        closed_form=False,
+        solver=dfx.Tsit5(),
+        rtol=rtol,
+        atol=rtol,
+        max_steps=4096,
+        tau_max=1e4,
+        rest_tol=1e-9,
+        adjoint=dfx.ForwardMode(),
+        peaks=False,
+    )
+
+    def residuals(theta, data):
+        v0, e, T, s_e, s_T = data
+        fitted = _law_with(law, free, theta)
+        result = jax.vmap(lambda v: solve_impact(fitted, m, v, g, None, options))(v0)
+        parts = []
+        predictions = (result.e, result.T, result.status)
+        if has_e:
+            parts.append((result.e - e) / s_e)
+        if has_T:
+            known = jnp.isfinite(T)
+            T_safe = jnp.where(known, T, 1.0)
+            parts.append(jnp.where(known, (result.T - T_safe) / s_T, 0.0))
+        return jnp.concatenate(parts), predictions
+
+    return residuals
+
+
+def _run_lbfgs(loss, theta0, data, optimizer, max_iter, gtol):
+    linesearch = optimizer is None
+    opt = optax.lbfgs() if linesearch else optax.with_extra_args_support(optimizer)
+    value_and_grad = (
+        optax.value_and_grad_from_state(loss) if linesearch else jax.value_and_grad(loss)
+    )
+    history0 = jnp.zeros(max_iter + 1)
+
+    def step(carry):
+        theta, state, k, history, _ = carry
+        if linesearch:
+            value, grad = value_and_grad(theta, data, state=state)
+        else:
+            value, grad = value_and_grad(theta, data)
+        updates, state = opt.update(
+            grad, state, theta, value=value, grad=grad, value_fn=lambda t: loss(t, data)
+        )
+        theta = optax.apply_updates(theta, updates)
+        grad_norm = optax.tree_utils.tree_l2_norm(grad)
+        return theta, state, k + 1, history.at[k].set(value), grad_norm
+
+    def keep_going(carry):
+        _, _, k, history, grad_norm = carry
+        value = history[jnp.maximum(k - 1, 0)]
+        return (k == 0) | ((k < max_iter) & (grad_norm > gtol) & (value > 1e-30))
+
+    carry = (theta0, opt.init(theta0), jnp.asarray(0), history0, jnp.asarray(jnp.inf))
+    theta, _, k, history, grad_norm = jax.lax.while_loop(keep_going, step, carry)
+    stopped = (grad_norm <= gtol) | (history[jnp.maximum(k - 1, 0)] <= 1e-30)
+    return theta, k, history, stopped
+
+
+def _run_lm(residuals, theta0, data, max_iter, tol):
+    solution = optx.least_squares(
+        residuals,
+        optx.LevenbergMarquardt(rtol=tol, atol=tol),
+        theta0,
+        args=data,
+        max_steps=max_iter,
+        throw=False,
+    )
+    stopped = solution.result == optx.RESULTS.successful
+    return solution.value, solution.stats["num_steps"], stopped
+
+
+def calibrate(
+    law: AbstractLaw,
+    *,
+    m,
+    v0,
+    e=None,
+    T=None,
+    sigma_e=None,
+    sigma_T=None,
+    free=None,
+    separation: str = "force",
+    g=0.0,
+    optimizer="lbfgs",
+    init: str = "auto",
+    max_iter: int = 100,
+    tol: float = 1e-12,
+    target_tol: float | None = None,
+    rtol: float = 1e-10,
+) -> Fit:
+    """Fit `law`'s parameters to a measured restitution `e` and/or contact duration `T` (s).
+
+    `v0` (m/s), `e` and `T` may be arrays, one row per impact speed; a row without `T` is
+    `None` in a list (or NaN in an array). `m` is the (effective) mass in kg. `free` names
+    the parameters to fit (default: the stiffness `c`, if some `T` is given, and the
+    damping); the others keep the values in `law`. Parameters are fitted in a transformed
+    space that keeps them physical (logarithms; a logit for `e_nominal`).
+
+    - `optimizer`: `"lm"` (optimistix Levenberg-Marquardt, the default: fewest iterations
+      on these small least-squares problems), `"lbfgs"` (optax L-BFGS with a zoom line
+      search), or any optax `GradientTransformation`.
+    - `init`: `"auto"` starts from the law's nondimensional restitution table (one damping
+      group sets `e`, then `T` sets the stiffness) so most fits need a few iterations;
+      `"given"` starts from the values in `law`.
+    - `target_tol`: the largest residual a converged fit may leave (default 1e-6 without
+      sigmas, 3 with them, i.e. three standard deviations).
+    - `rtol`: tolerance of each impact solve.
+    Works under `jax.vmap` over the targets (one fit per body); see `calibrate_batch`.
+
+    **Example**:
+    `calibrate(law("hertz_rate", c=1e6, b1=100.0), m=1.0, v0=2.5, e=0.85, T=7.8e-3)`.
+    """
+    if not isinstance(law, AbstractLaw):
+        raise TypeError("calibrate needs a law from jaximpact.law(...) or custom_law(...)")
+    if optimizer not in OPTIMIZERS and not isinstance(optimizer, optax.GradientTransformation):
+        raise ValueError(
+            f"optimizer must be one of {OPTIMIZERS} or an optax GradientTransformation"
+        )
+    if init not in ("auto", "given"):
+        raise ValueError(f"init must be 'auto' or 'given', got {init!r}")
+    v0 = _as_rows("v0", v0, None)
+    rows = v0.shape[0]
+    e = _as_rows("e", e, rows)
+    T = _as_rows("T", T, rows, allow_missing=True)
+    sigma_e = _as_rows("sigma_e", sigma_e, rows)
+    sigma_T = _as_rows("sigma_T", sigma_T, rows)
+    _check_targets(m, v0, e, T, sigma_e, sigma_T)
+    m = jnp.asarray(m, dtype=float)
+    has_sigma = sigma_e is not None or sigma_T is not None
+    free = _default_free(law, T is not None) if free is None else tuple(free)
+    unknown = [k for k in free if k not in law.parameters]
+    if unknown:
+        raise ValueError(
+            f"cannot fit {', '.join(unknown)}: the law's parameters are {', '.join(law.parameters)}"
+        )
+    if not free:
+        raise ValueError("free names no parameter to fit")
+    if init == "auto":
+        law = _initial_law(law, free, m=m, v0=v0, e=e, T=T, separation=separation)
+
+    ones = jnp.ones(rows)
+    s_e = ones if sigma_e is None else sigma_e
+    if sigma_T is not None:
+        s_T = sigma_T
+    else:
+        s_T = ones if T is None else jnp.where(jnp.isfinite(T), T, 1.0)
+    data = (v0, ones if e is None else e, ones if T is None else T, s_e, s_T)
+    target_tol = (3.0 if has_sigma else 1e-6) if target_tol is None else target_tol
+    options = _Options(
+        free=free,
+        separation=separation,
+        optimizer=optimizer,
+        max_iter=max_iter,
+        tol=tol,
+        rtol=rtol,
+        has_e=e is not None,
+        has_T=T is not None,
+        has_sigma=has_sigma,
+    )
+    return _fit(law, data, m, jnp.asarray(g, dtype=float), jnp.asarray(target_tol), options)
+
+
+class _Options(eqx.Module):
+    free: tuple = eqx.field(static=True)
+    separation: str = eqx.field(static=True)
+    optimizer: object = eqx.field(static=True)
+    max_iter: int = eqx.field(static=True)
+    tol: float = eqx.field(static=True)
+    rtol: float = eqx.field(static=True)
+    has_e: bool = eqx.field(static=True)
+    has_T: bool = eqx.field(static=True)
+    has_sigma: bool = eqx.field(static=True)
+
+
+@eqx.filter_jit
+def _fit(law, data, m, g, target_tol, options):
+    """The compiled part of `calibrate`: optimise, then evaluate the fit."""
+    free, optimizer = options.free, options.optimizer
+    v0, e, T = data[0], data[1], data[2]
+    rows = v0.shape[0]
+    raw = _residual_function(
+        law,
+        free,
+        m=m,
+        separation=options.separation,
+        g=g,
+        rtol=options.rtol,
+        has_e=options.has_e,
+        has_T=options.has_T,
+    )
+    # one traced copy of the residuals and of their Jacobian, shared by every call site
+    raw = jax.jit(raw)
+    jacobian_fn = jax.jit(lambda theta, data: value_and_jacobian(raw, theta, data))
+    residuals = with_forward_jacobian(lambda theta, data: raw(theta, data)[0], jacobian_fn)
+
+    def loss(theta, data):
+        r = residuals(theta, data)
+        return 0.5 * jnp.sum(r**2)
+
+    theta0 = jnp.stack([_to_unbounded(k, law.parameters[k]) for k in free])
+    if optimizer == "lm":
+        theta, iterations, stopped = _run_lm(residuals, theta0, data, options.max_iter, options.tol)
+        history = None
+    else:
+        theta, iterations, history, stopped = _run_lbfgs(
+            loss,
+            theta0,
+            data,
+            None if optimizer == "lbfgs" else optimizer,
+            options.max_iter,
+            gtol=options.tol,
+        )
+    if options.has_sigma:
+        (r, (e_fit, T_fit, status)), jacobian = jacobian_fn(theta, data)
+    else:
+        r, (e_fit, T_fit, status) = raw(theta, data)
+    final_loss = 0.5 * jnp.sum(r**2)
+    if history is None:
+        history = jnp.stack([loss(theta0, data), final_loss])
+    else:
+        filled = jnp.arange(history.shape[0]) < iterations
+        history = jnp.where(filled, history, final_loss)
+    fitted = _law_with(law, free, theta)
+    converged = jnp.all(jnp.abs(r) <= target_tol) & jnp.all(status == Status.separated)
+    stderr = None
+    if options.has_sigma:
+        covariance = jnp.linalg.pinv(jacobian.T @ jacobian)
+        params = jnp.stack([fitted.parameters[k] for k in free])
+        scale = jnp.where(
+            jnp.asarray([k == "e_nominal" for k in free]), params * (1 - params), params
+        )
+        se = scale * jnp.sqrt(jnp.abs(jnp.diag(covariance)))
+        stderr = {k: se[i] for i, k in enumerate(free)}
+    return Fit(
+        law=fitted,
+        params=fitted.parameters,
+        v0=v0,
+        e=e_fit,
+        T=T_fit,
+        e_target=e if options.has_e else jnp.full(rows, jnp.nan),
+        T_target=T if options.has_T else jnp.full(rows, jnp.nan),
+        residuals=r,
+        loss=final_loss,
+        converged=(converged & stopped) | (final_loss <= 1e-30),
+        iterations=jnp.asarray(iterations),
+        history=history,
+        stderr=stderr,
+        free=free,
+        optimizer=optimizer if isinstance(optimizer, str) else type(optimizer).__name__,
+    )

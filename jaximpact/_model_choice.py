@@ -1,0 +1,160 @@
+"""Which law do the measurements support? Fit them all and rank them."""
+
+import dataclasses
+import math
+
+import jax.numpy as jnp
+import numpy as np
+from jax.scipy.special import gammaln
+
+from ._calibrate import DAMPING, Fit, calibrate
+from ._laws import LAWS, law
+from ._progress import Progress
+
+PAPER_LAWS = tuple(name for name, spec in LAWS.items() if spec.equation != "-")
+
+
+def _undamped_tau(n: float) -> float:
+    """Contact time of `F = c x^n` in units of `t* = x*/v0`, `x* = (m v0^2/c)^(1/(n+1))`."""
+    k = 1.0 / (n + 1.0)
+    beta = math.exp(float(gammaln(k) + gammaln(0.5) - gammaln(k + 0.5)))
+    return 2.0 * ((n + 1.0) / 2.0) ** k * beta / (n + 1.0)
+
+
+def starting_law(name: str, *, m: float, v0: float, e: float, T: float | None):
+    """A law `name` whose parameters roughly reproduce `e` and `T` at speed `v0`: the
+    undamped contact time sets `c`, an equivalent linear damping ratio sets the rest
+    (`calibrate` then refines them)."""
+    spec = LAWS[name]
+    n = 1.5 if "hertz" in name or spec.gap == "x" else 1.0
+    T = 1e-3 if T is None or not np.isfinite(T) else T
+    x_star = v0 * T / _undamped_tau(n)
+    c = m * v0**2 / x_star ** (n + 1.0)
+    log_e = math.log(min(max(e, 1e-6), 0.999999))
+    zeta = -log_e / math.sqrt(math.pi**2 + log_e**2)
+    b_linear = 2.0 * zeta * math.sqrt(m * m * v0**2 / x_star**2)  # 2 zeta sqrt(m c_linear)
+    params = {"c": c}
+    for key in spec.parameters:
+        if key in ("b", "b1"):
+            p = (
+                1.0
+                if name in ("kelvin_voigt_modified", "bingham_modified", "hertz_modified")
+                else 0.0
+            )
+            p = 0.5 if name == "hertz_rate" else p
+            params[key] = b_linear / x_star**p
+        elif key == "a":
+            params[key] = max(1.0 - e, 1e-3) / v0
+        elif key == "P":
+            x_max = e * x_star
+            params[key] = (
+                0.5
+                * m
+                * v0**2
+                * max(1.0 - e**2, 1e-3)
+                / x_max
+                / (2.0 if name != "bingham_compression" else 1.0)
+            )
+        elif key == "e_nominal":
+            params[key] = min(max(e, 0.05), 0.999)
+        elif key == "n":
+            params[key] = 1.5
+    if name == "maxwell":
+        params = {
+            "c": m * (math.pi / T) ** 2,
+            "b": math.sqrt(m * m * (math.pi / T) ** 2) / max(zeta, 1e-3),
+        }
+    return law(name, **params)
+
+
+@dataclasses.dataclass
+class Ranking:
+    """One law's fit in a comparison: the `Fit`, its weighted sum of squares `chi2`, the
+    number of free parameters `k`, and AIC/BIC (with sigmas only, else `None`)."""
+
+    name: str
+    fit: Fit
+    chi2: float
+    k: int
+    aic: float | None
+    bic: float | None
+
+
+def compare_laws(
+    *,
+    m,
+    v0,
+    e,
+    T=None,
+    sigma_e=None,
+    sigma_T=None,
+    laws=PAPER_LAWS,
+    separation="force",
+    progress=True,
+    **calibrate_options,
+) -> list[Ranking]:
+    """Fit every law of `laws` to the same measurements and rank them, best first.
+
+    Ranked by AIC (`chi2 + 2k`, Gaussian errors) when sigmas are given, else by the sum of
+    squared residuals. Laws with more free parameters than data are skipped.
+
+    **Example**: `compare_laws(m=0.0027, v0=[1, 2, 3], e=[0.9, 0.87, 0.85])[0].name`.
+    """
+    v0_rows = np.atleast_1d(np.asarray(v0, dtype=float))
+    e_rows = np.broadcast_to(np.atleast_1d(np.asarray(e, dtype=float)), v0_rows.shape)
+    T_rows = None
+    if T is not None:
+        T_rows = np.broadcast_to(
+            np.atleast_1d(
+                np.asarray([np.nan if t is None else t for t in np.atleast_1d(T)], dtype=float)
+            ),
+            v0_rows.shape,
+        )
+    middle = int(np.argsort(v0_rows)[len(v0_rows) // 2])
+    n_data = len(e_rows) + (0 if T_rows is None else int(np.sum(np.isfinite(T_rows))))
+    has_sigma = sigma_e is not None or sigma_T is not None
+    rankings = []
+    with Progress(len(laws), "fitting laws", enabled=progress) as bar:
+        for name in laws:
+            start = starting_law(
+                name,
+                m=float(m),
+                v0=float(v0_rows[middle]),
+                e=float(e_rows[middle]),
+                T=None if T_rows is None else float(T_rows[middle]),
+            )
+            free = _free_for(name, has_T=T_rows is not None, n_data=n_data)
+            if len(free) > n_data:
+                bar.update(f"{name} (skipped)")
+                continue
+            fit = calibrate(
+                start,
+                m=m,
+                v0=v0_rows,
+                e=e_rows,
+                T=T_rows,
+                sigma_e=sigma_e,
+                sigma_T=sigma_T,
+                free=free,
+                separation=separation,
+                **calibrate_options,
+            )
+            chi2 = float(jnp.sum(fit.residuals**2))
+            k = len(free)
+            aic = chi2 + 2 * k if has_sigma else None
+            bic = chi2 + k * math.log(n_data) if has_sigma else None
+            rankings.append(Ranking(name, fit, chi2, k, aic, bic))
+            bar.update(name)
+    key = (lambda r: r.aic) if has_sigma else (lambda r: r.chi2)
+    return sorted(rankings, key=key)
+
+
+def _free_for(name, *, has_T, n_data):
+    params = LAWS[name].parameters
+    damping = DAMPING.get(name) or next(
+        k for k in ("b", "b1", "a", "e_nominal", "P") if k in params
+    )
+    free = (["c"] if has_T or n_data > 1 else []) + [damping]
+    if "P" in params and "P" not in free and n_data > len(free):
+        free.append("P")
+    return tuple(free)
