@@ -1,7 +1,5 @@
 """Fitting a law's parameters to measured restitution and contact duration."""
 
-import functools
-
 import diffrax as dfx
 import equinox as eqx
 import jax
@@ -12,20 +10,11 @@ import optimistix as optx
 from jaxtyping import Array
 
 from ._forward_jacobian import value_and_jacobian, with_forward_jacobian
-from ._impact import ImpactOptions, impact, solve_impact
-from ._laws import AbstractLaw, Law
+from ._impact import ImpactOptions, solve_impact
+from ._laws import AbstractLaw
+from ._restitution_tables import DAMPING, restitution_table
 from ._status import Status
 
-# the damping parameter of each law whose restitution depends on one dimensionless group
-DAMPING = {
-    "kelvin_voigt": "b",
-    "kelvin_voigt_modified": "b1",
-    "hertz_viscous": "b",
-    "hertz_modified": "b",
-    "hertz_rate": "b1",
-    "hunt_crossley": "a",
-    "maxwell": "b",
-}
 OPTIMIZERS = ("lbfgs", "lm")
 
 
@@ -133,33 +122,6 @@ def _law_with(law, free, theta):
 # ------------------------------------------------------------------- initial values
 
 
-@functools.cache
-def _restitution_table(name: str, separation: str, n: float):
-    """`e` and `tau = T/t*` against the dimensionless damping group on a log grid, from
-    impacts at unit scales (`c = m = v0 = 1`, so `x* = t* = 1`). Computed once per law."""
-    groups = np.logspace(-4, 2.5, 53)
-    damping = DAMPING[name]
-
-    def one(group):
-        value = group / 1.5 if name == "hunt_crossley" else group
-        params = {"c": 1.0, damping: value}
-        if name == "hunt_crossley":
-            params["n"] = n
-        result = impact(
-            Law(name, {k: jnp.asarray(v, float) for k, v in params.items()}),
-            m=1.0,
-            v0=1.0,
-            separation=separation,
-            peaks=False,
-            rtol=1e-8,
-        )
-        return result.e, result.T, result.status
-
-    e, tau, status = jax.jit(jax.vmap(one))(jnp.asarray(groups))
-    ok = np.asarray(status) == Status.separated
-    return groups[ok], np.asarray(e)[ok], np.asarray(tau)[ok]
-
-
 def _initial_law(law, free, *, m, v0, e, T, separation):
     """Start from one dimensionless damping group: `e` sets it (through a table of the
     law's nondimensional impact), `T` then sets the time scale and so the stiffness."""
@@ -170,12 +132,17 @@ def _initial_law(law, free, *, m, v0, e, T, separation):
     if isinstance(law.params.get("n", 0.0), jax.core.Tracer):
         return law
     n = float(law.params.get("n", 1.5)) if name == "hunt_crossley" else 1.5
-    groups, e_table, tau_table = _restitution_table(name, separation, n)
+    groups, e_table, tau_table = restitution_table(name, separation, n)
+    # 1 - e is nearly proportional to the group at light damping: interpolate logarithms
+    loss_table = np.log(np.maximum(1.0 - e_table, 1e-300))
+    order = np.argsort(loss_table)  # e rises or falls with the group, depending on the law
+    groups, loss_table, tau_table = groups[order], loss_table[order], tau_table[order]
     row = jnp.argsort(v0)[v0.shape[0] // 2]
     v_row, e_row = v0[row], e[row]
-    log_group = jnp.interp(-e_row, -e_table, np.log(groups))
+    loss_row = jnp.log(jnp.maximum(1.0 - e_row, 1e-300))
+    log_group = jnp.interp(loss_row, loss_table, np.log(groups))
     group = jnp.exp(log_group)
-    tau = jnp.interp(log_group, np.log(groups), tau_table)
+    tau = jnp.interp(loss_row, loss_table, tau_table)
     if name == "maxwell":
         c = law.params["c"]
         if T is not None and "c" in free:
@@ -312,9 +279,8 @@ def calibrate(
     damping); the others keep the values in `law`. Parameters are fitted in a transformed
     space that keeps them physical (logarithms; a logit for `e_nominal`).
 
-    - `optimizer`: `"lm"` (optimistix Levenberg-Marquardt, the default: fewest iterations
-      on these small least-squares problems), `"lbfgs"` (optax L-BFGS with a zoom line
-      search), or any optax `GradientTransformation`.
+    - `optimizer`: `"lbfgs"` (the default: optax L-BFGS with a zoom line search), `"lm"`
+      (optimistix Levenberg-Marquardt), or any optax `GradientTransformation`.
     - `init`: `"auto"` starts from the law's nondimensional restitution table (one damping
       group sets `e`, then `T` sets the stiffness) so most fits need a few iterations;
       `"given"` starts from the values in `law`.

@@ -272,6 +272,9 @@ def cache_dir() -> Path | None:
 def configure_jax():
     """float64, and a persistent compilation cache unless JAX already has one set
     (`JAX_COMPILATION_CACHE_DIR`) or `JAXIMPACT_CACHE_DIR` is empty."""
+    # XLA's CPU compiler logs harmless "algebraic simplifier ... circular" notes at error
+    # level for diffrax's loops; keep them off the user's terminal unless asked for
+    os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "3")
     import jax
 
     jax.config.update("jax_enable_x64", True)

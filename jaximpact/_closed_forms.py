@@ -9,6 +9,7 @@ All in SI units; every function is differentiable and NaN-free, including at cri
 damping (`b^2 = 4 m c`), where the under- and over-damped formulas meet.
 """
 
+import jax
 import jax.numpy as jnp
 import optimistix as optx
 from jax.scipy.special import gammaln
@@ -183,6 +184,8 @@ def hunt_crossley_restitution(alpha):
     (optimistix, differentiated implicitly); `e -> 1 - 2 alpha/3` as `alpha -> 0`.
     """
     alpha = jnp.asarray(alpha, dtype=float)
+    if alpha.ndim:
+        return jax.vmap(hunt_crossley_restitution)(alpha.ravel()).reshape(alpha.shape)
 
     def residual(e, a):
         return e**2 * _phi_over_square(-a * e) - _phi_over_square(a)

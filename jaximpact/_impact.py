@@ -199,7 +199,8 @@ def _assemble_integrated(dynamics, phases, plan, *, m, v0, g, tau_grid):
         else jnp.asarray(False)
     )
     rested = phases["second"][last] | stuck_at_max | jnp.any(phases["rest"])
-    separated = phases["first"][last] & ~rested
+    # a force that vanishes while the body is not moving out (creeping to rest) is a capture
+    separated = phases["first"][last] & ~rested & (dynamics.velocity(phases["y"][last]) < 0)
     out_of_steps = jnp.any(phases["out_of_steps"])
     held = Status.stuck if dynamics.has_dry else Status.captured
     status = jnp.where(

@@ -4,8 +4,7 @@ Sign convention: `x` is the penetration (m, > 0 inside the surface), `v = dx/dt`
 law returns the force on the body (N), positive when it pushes the body out. Most laws are
 one family, `F = c x^n + b x^p v + P d(v)`; the table `LAWS` maps each name to its
 coefficients in that family. Equation numbers refer to Polukoshko, Viba, Kononova and
-Sokolova, "Rigid body impact models partially considering deformation", Proc. Estonian
-Acad. Sci. Eng. 13 (2007) (shared/seeds).
+Sokolova, "Rigid body impact models partially considering deformation" (2007; shared/seeds).
 """
 
 import abc
