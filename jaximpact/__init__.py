@@ -3,7 +3,16 @@
 import importlib.metadata
 
 from . import closed_forms as closed_forms
+from ._batch import impact_batch as impact_batch, run_batch as run_batch, write_table as write_table
+from ._bounce import BounceResult as BounceResult, bounce as bounce
 from ._calibrate import Fit as Fit, calibrate as calibrate
+from ._design import (
+    bumper_design as bumper_design,
+    drop_design as drop_design,
+    propagate_uncertainty as propagate_uncertainty,
+    sensitivity_map as sensitivity_map,
+)
+from ._fit_bounces import BounceFit as BounceFit, fit_bounces as fit_bounces
 from ._impact import ImpactResult as ImpactResult, impact as impact
 from ._laws import (
     LAW_NAMES as LAW_NAMES,
@@ -14,6 +23,7 @@ from ._laws import (
     custom_law as custom_law,
     law as law,
 )
+from ._maps import plot_map as plot_map, restitution_map as restitution_map
 from ._model_choice import compare_laws as compare_laws, starting_law as starting_law
 from ._plotting import plot_impact as plot_impact
 from ._powers import safe_pow as safe_pow

@@ -208,6 +208,9 @@ def _residual_function(law, free, *, m, separation, g, rtol, has_e, has_T):
 
 
 def _run_lbfgs(loss, theta0, data, optimizer, max_iter, gtol):
+    """Iterate until the gradient norm is below `gtol`, the loss is zero, or the steps have
+    stalled (two in a row shorter than `gtol (1 + |theta|)`: the loss is at the noise floor
+    of the impact solves, which weighted residuals can put far above `gtol`)."""
     linesearch = optimizer is None
     opt = optax.lbfgs() if linesearch else optax.with_extra_args_support(optimizer)
     value_and_grad = (
@@ -216,7 +219,7 @@ def _run_lbfgs(loss, theta0, data, optimizer, max_iter, gtol):
     history0 = jnp.zeros(max_iter + 1)
 
     def step(carry):
-        theta, state, k, history, _ = carry
+        theta, state, k, history, _, stalled = carry
         if linesearch:
             value, grad = value_and_grad(theta, data, state=state)
         else:
@@ -224,18 +227,22 @@ def _run_lbfgs(loss, theta0, data, optimizer, max_iter, gtol):
         updates, state = opt.update(
             grad, state, theta, value=value, grad=grad, value_fn=lambda t: loss(t, data)
         )
-        theta = optax.apply_updates(theta, updates)
-        grad_norm = optax.tree_utils.tree_l2_norm(grad)
-        return theta, state, k + 1, history.at[k].set(value), grad_norm
+        new_theta = optax.apply_updates(theta, updates)
+        grad_norm = jnp.linalg.norm(grad)
+        small = jnp.linalg.norm(new_theta - theta) <= gtol * (1.0 + jnp.linalg.norm(theta))
+        stalled = jnp.where(small, stalled + 1, 0)
+        return new_theta, state, k + 1, history.at[k].set(value), grad_norm, stalled
 
     def keep_going(carry):
-        _, _, k, history, grad_norm = carry
+        _, _, k, history, grad_norm, stalled = carry
         value = history[jnp.maximum(k - 1, 0)]
-        return (k == 0) | ((k < max_iter) & (grad_norm > gtol) & (value > 1e-30))
+        return (k == 0) | ((k < max_iter) & (grad_norm > gtol) & (value > 1e-30) & (stalled < 2))
 
-    carry = (theta0, opt.init(theta0), jnp.asarray(0), history0, jnp.asarray(jnp.inf))
-    theta, _, k, history, grad_norm = jax.lax.while_loop(keep_going, step, carry)
-    stopped = (grad_norm <= gtol) | (history[jnp.maximum(k - 1, 0)] <= 1e-30)
+    zero = jnp.asarray(0)
+    carry = (theta0, opt.init(theta0), zero, history0, jnp.asarray(jnp.inf), zero)
+    theta, _, k, history, grad_norm, stalled = jax.lax.while_loop(keep_going, step, carry)
+    value = history[jnp.maximum(k - 1, 0)]
+    stopped = (grad_norm <= gtol) | (value <= 1e-30) | (stalled >= 2)
     return theta, k, history, stopped
 
 
@@ -287,7 +294,12 @@ def calibrate(
     - `target_tol`: the largest residual a converged fit may leave (default 1e-6 without
       sigmas, 3 with them, i.e. three standard deviations).
     - `rtol`: tolerance of each impact solve.
-    Works under `jax.vmap` over the targets (one fit per body); see `calibrate_batch`.
+    A batch of fits (one body per element: its own mass, speeds and targets) is `jax.vmap`
+    over a lambda, `jax.jit(jax.vmap(lambda m, e, T: calibrate(start, m=m, v0=v0, e=e, T=T)))`,
+    which returns one `Fit` whose fields carry a leading batch axis; a batch runs until its
+    slowest member has converged (benchmarks/calibrate.md times 10 000 such fits). Targets
+    are refused (ValueError: e outside (0, 1], T <= 0, NaN, rows of different lengths) only
+    when they are concrete, so check a batch's targets before mapping over them.
 
     **Example**:
     `calibrate(law("hertz_rate", c=1e6, b1=100.0), m=1.0, v0=2.5, e=0.85, T=7.8e-3)`.

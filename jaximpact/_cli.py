@@ -513,6 +513,8 @@ def _simulate_text(law, data) -> str:
 COMMANDS: list[tuple[str, Callable | str]] = [
     ("laws", _add_laws),
     ("simulate", _add_simulate),
+    ("fit", "jaximpact._cli_fit:add_fit"),
+    ("calibrate", "jaximpact._cli_calibrate:add_calibrate"),
 ]
 
 

@@ -55,7 +55,7 @@ def _cos_continued(r, t):
     return jnp.where(small, series, exact)
 
 
-def kelvin_voigt(c, b, m, v0, separation="force", *, rest_tol=1e-9):
+def kelvin_voigt(c, b, m, v0, separation="force", *, rest_tol=1e-7):
     """Exact impact of `m x'' = -c x - b x'`, `x(0) = 0`, `x'(0) = v0`.
 
     With `s = b/(2m)` and `r = c/m - s^2` (`r < 0` over-damped):
@@ -88,7 +88,11 @@ def kelvin_voigt(c, b, m, v0, separation="force", *, rest_tol=1e-9):
     else:
         returns = r > 0
         t_star = jnp.sqrt(m / c)
-        rest = _rest_time(s * t_star, r * t_star**2, rest_tol, 2.0 * s * t_star, t_max / t_star)
+        # the rest time exists for over-damped values only: feed a harmless over-damped
+        # problem to the others, so no NaN reaches a gradient through the discarded branch
+        s_nd = jnp.where(returns, 2.0, s * t_star)
+        r_nd = jnp.where(returns, -3.0, r * t_star**2)
+        rest = _rest_time(s_nd, r_nd, rest_tol, 2.0 * s_nd, jnp.where(returns, 1.0, t_max / t_star))
         T = jnp.where(returns, jnp.pi / jnp.sqrt(r_pos), rest * t_star)
         status = jnp.where(returns, Status.separated, Status.captured)
     e = jnp.where(status == Status.separated, jnp.exp(-s * T), 0.0)
@@ -98,14 +102,16 @@ def kelvin_voigt(c, b, m, v0, separation="force", *, rest_tol=1e-9):
 def _rest_time(s, r, rest_tol, beta, tau_start):
     """Nondimensional time at which an over-damped `X'' + beta X' + X = 0` (`X(0) = 0`,
     `X'(0) = 1`, `s = beta/2`, `r = 1 - s^2 < 0`) reaches `|V| + |X + beta V| = rest_tol`
-    (Newton on its logarithm, from the slow mode's estimate). Finite for any input."""
-    q = jnp.sqrt(jnp.where(r < 0, -r, 1.0))
-    slow = jnp.where(r < 0, -s + q, -1.0)  # decay rate of the slow mode, < 0
+    (Newton on its logarithm, from the slow mode's estimate). The modes are written as
+    single exponentials, `X = (exp(l1 tau) - exp(l2 tau))/(l1 - l2)`, which cannot overflow.
+    Call it with over-damped values only (`impact` substitutes safe ones elsewhere)."""
+    q = jnp.sqrt(-r)
+    slow, fast = -s + q, -s - q
     start = jnp.maximum(jnp.log(rest_tol) / slow, tau_start)
 
     def excess(tau, _):
-        x = jnp.exp(-s * tau) * _sin_ratio(r, tau)
-        v = jnp.exp(-s * tau) * (_cos_continued(r, tau) - s * _sin_ratio(r, tau))
+        x = (jnp.exp(slow * tau) - jnp.exp(fast * tau)) / (slow - fast)
+        v = (slow * jnp.exp(slow * tau) - fast * jnp.exp(fast * tau)) / (slow - fast)
         return jnp.log(jnp.abs(v) + jnp.abs(x + beta * v)) - jnp.log(rest_tol)
 
     solution = optx.root_find(

@@ -128,7 +128,9 @@ class PowerDynamics(AbstractDynamics):
             reduced = self.force(y, compressing)
         else:
             reduced = contact_pow(x, self.gap) + self.beta * self.velocity(y)
-        return jnp.minimum(x, reduced)
+        # at a tie (no damping: x^(n-p) + beta V = x) take the force, whose derivative in
+        # the damping is the right one (jnp.minimum would split it between the branches)
+        return jnp.where(x < reduced, x, reduced)
 
 
 class MaxwellDynamics(AbstractDynamics):

@@ -179,7 +179,8 @@ def _integrate(
         )
         if tau_grid is not None:
             record["grid"] = sol.ys[1]
-        return (y_end, tau_end, alive & (skip | fired) & ~out_of_steps), record
+        at_rest = sol.event_mask[2]
+        return (y_end, tau_end, alive & (skip | fired) & ~at_rest & ~out_of_steps), record
 
     carry = (dynamics.y0(), jnp.zeros_like(tau_max), jnp.asarray(True))
     if len(plan) == 1:
@@ -314,7 +315,7 @@ def impact(
     atol: float | None = None,
     max_steps: int = 4096,
     tau_max: float = 1e4,
-    rest_tol: float = 1e-9,
+    rest_tol: float = 1e-7,
     adjoint: dfx.AbstractAdjoint | None = None,
     peaks: bool = True,
     throw: bool = False,

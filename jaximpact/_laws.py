@@ -322,19 +322,23 @@ def _as_arrays(params):
 
 
 def _check_law_parameters(name, params):
+    """The parameters, each passed through its value check (eager `ValueError`, or
+    `eqx.error_if` under `jit`, whose result must be used)."""
+    checked = {}
     for key, value in params.items():
         if key == "c":
-            check_positive(f"{name}: stiffness c", value, _UNITS["c"])
+            checked[key] = check_positive(f"{name}: stiffness c", value, _UNITS["c"])
         elif key == "n":
-            check_positive(f"{name}: exponent n", value)
+            checked[key] = check_positive(f"{name}: exponent n", value)
         elif key == "e_nominal":
-            check_values(
+            checked[key] = check_values(
                 value,
                 lambda a: (a <= 0) | (a > 1),
                 f"{name}: e_nominal must lie in (0, 1], got {value}",
             )
         else:
-            check_nonnegative(f"{name}: {key}", value, _UNITS.get(key, ""))
+            checked[key] = check_nonnegative(f"{name}: {key}", value, _UNITS.get(key, ""))
+    return checked
 
 
 def law(name: str, **params) -> Law:
@@ -363,8 +367,7 @@ def law(name: str, **params) -> Law:
             + (f" (defaults: {spec.defaults})" if spec.defaults else "")
         )
     given = {k: given[k] for k in spec.parameters}
-    _check_law_parameters(name, given)
-    return Law(name, _as_arrays(given))
+    return Law(name, _as_arrays(_check_law_parameters(name, given)))
 
 
 def custom_law(fn: Callable, **params) -> CustomLaw:

@@ -1,0 +1,134 @@
+"""Helpers shared by the benchmark scripts: timing, machine description, markdown tables.
+
+Timing follows brax's rule: compile time is reported apart from run time, and every clock
+stops after `jax.block_until_ready`. The machine is small and shared, so each timing is the
+median over several rounds (each round long enough to swamp the clock's resolution), and
+every report carries the load average and the CPU seen while it ran.
+"""
+
+import os
+import platform
+import statistics
+import subprocess
+import time
+
+
+def block(tree):
+    """`jax.block_until_ready` for JAX outputs, nothing for plain Python values."""
+    import jax
+
+    return jax.block_until_ready(tree)
+
+
+def time_call(fn, *args, rounds=7, min_round_s=0.05, max_total_s=20.0):
+    """Median and minimum seconds per call of `fn(*args)` (already compiled/warm).
+
+    Each round repeats the call until it has run `min_round_s`; a call slower than that is
+    one round by itself, and the number of rounds shrinks (down to 3) so that the whole
+    measurement stays near `max_total_s`.
+    """
+    start = time.perf_counter()
+    block(fn(*args))
+    once = time.perf_counter() - start
+    calls = max(1, int(min_round_s / max(once, 1e-7)))
+    rounds = max(3, min(rounds, int(max_total_s / max(once * calls, 1e-9))))
+    per_call = []
+    for _ in range(rounds):
+        start = time.perf_counter()
+        for _ in range(calls):
+            out = fn(*args)
+        block(out)
+        per_call.append((time.perf_counter() - start) / calls)
+    return statistics.median(per_call), min(per_call)
+
+
+def first_call(fn, *args):
+    """Seconds taken by the first call (tracing and compilation included) and its output."""
+    start = time.perf_counter()
+    out = block(fn(*args))
+    return time.perf_counter() - start, out
+
+
+def load_average() -> str:
+    one, five, fifteen = os.getloadavg()
+    return f"{one:.2f}, {five:.2f}, {fifteen:.2f}"
+
+
+def machine() -> dict:
+    """Versions, CPU and load, for the header of a report."""
+    import diffrax
+    import jax
+    import scipy
+
+    try:
+        lscpu = subprocess.run(["lscpu"], capture_output=True, text=True, check=False).stdout
+        lscpu = "\n".join(lscpu.splitlines()[:15])
+    except OSError:
+        lscpu = platform.processor()
+    try:
+        root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+        commit = subprocess.run(
+            ["git", "-C", root, "rev-parse", "--short", "HEAD"],
+            capture_output=True,
+            text=True,
+            check=False,
+        ).stdout.strip()
+        dirty = subprocess.run(
+            ["git", "-C", root, "status", "--short", "jaximpact"],
+            capture_output=True,
+            text=True,
+            check=False,
+        ).stdout.strip()
+    except OSError:
+        commit, dirty = "?", ""
+    return dict(
+        python=platform.python_version(),
+        jax=jax.__version__,
+        diffrax=diffrax.__version__,
+        scipy=scipy.__version__,
+        backend=jax.default_backend(),
+        lscpu=lscpu,
+        commit=commit + (" (jaximpact/ modified in the working tree)" if dirty else ""),
+        date=time.strftime("%Y-%m-%d %H:%M:%S %Z"),
+    )
+
+
+def machine_markdown(info: dict, loads: list[str]) -> str:
+    lines = [
+        f"- Run {info['date']}, commit {info['commit']}; python {info['python']}, "
+        f"jax {info['jax']} ({info['backend']}), diffrax {info['diffrax']}, "
+        f"scipy {info['scipy']}.",
+        "- Load average (1, 5, 15 min) seen during the run: " + "; ".join(loads) + ".",
+        "- `lscpu | head -15`:",
+        "",
+        "```",
+        info["lscpu"],
+        "```",
+    ]
+    return "\n".join(lines)
+
+
+def fmt(value, digits=2) -> str:
+    """A number for a table: `-` for None, scientific for small or large values."""
+    if value is None:
+        return "-"
+    if isinstance(value, str):
+        return value
+    if value != value:  # NaN
+        return "NaN"
+    if value == 0:
+        return "0"
+    if abs(value) < 1e-2 or abs(value) >= 1e5:
+        return f"{value:.{digits - 1}e}"
+    return f"{value:.{digits + 1}g}"
+
+
+def us(seconds) -> str:
+    """Seconds as microseconds for a table."""
+    return "-" if seconds is None else f"{seconds * 1e6:.{3}g}"
+
+
+def table(header: list[str], rows: list[list]) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
+    return "\n".join(lines)

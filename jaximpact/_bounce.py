@@ -1,0 +1,495 @@
+"""A ball dropped on a floor: free flights in closed form, one impact solve per contact.
+
+The seed paper's system (17) (Polukoshko et al. 2007, section 7) integrates the whole motion,
+flight and contact, with explicit Euler at a fixed step (`jaximpact._euler`). Here the free
+flight is a parabola (or, with quadratic air drag, its closed form: `jaximpact._flight`), never
+integrated, and each contact is one event-terminated impact solve with gravity inside it (the
+same solve as `jaximpact.impact(..., g=g)`). The contacts run in a `lax.scan` of static
+length `max_impacts`; contacts after the end are masked, so the whole drop is one compiled
+program, differentiable in both modes (shared/notes/diffrax-impact-notes.md, section 6).
+"""
+
+import enum
+
+import diffrax as dfx
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jaxtyping import Array
+
+from ._adjoint import auto_adjoint
+from ._checks import check_nonnegative, check_positive, check_values
+from ._flight import Flight
+from ._impact import (
+    SEPARATIONS,
+    ImpactOptions,
+    _assemble_integrated,
+    _integrate,
+    _phase_plan,
+)
+from ._laws import AbstractLaw
+from ._status import Status
+
+
+class BounceStatus(enum.IntEnum):
+    """How a bounce sequence ended; `BounceResult.status` holds these as small integers.
+
+    - `t_end`: the ball was still bouncing at `t_end` (its next landing comes later).
+    - `at_rest`: the ball came to rest on the floor before `t_end`: a contact did not
+      separate (gravity held the ball in the surface: the contact's status is `captured`, or
+      `stuck` for a dry force), or a flight was shorter than `min_flight` (a restitution that
+      stays finite at low speed gives infinitely many bounces in finite time; the sequence
+      is cut there and the ball counted at rest from that landing on).
+    - `max_impacts`: `max_impacts` contacts were used up before `t_end`; the results are
+      right as far as they go.
+    - `failed`: a contact solve ran out of steps (`max_steps`); results from that contact
+      on are not to be trusted.
+    """
+
+    t_end = 0
+    at_rest = 1
+    max_impacts = 2
+    failed = 3
+
+
+_RUNNING = -1
+
+
+class BounceOptions(eqx.Module):
+    """Everything static about a bounce sequence."""
+
+    impact: ImpactOptions
+    max_impacts: int = eqx.field(static=True)
+
+
+def _contact(law, m, v_in, g, ts_local, options: ImpactOptions):
+    """One contact at impact speed `v_in` with gravity `g`: the `ImpactResult`, the
+    penetration at separation (m; > 0 when the force criterion ends contact inside the
+    surface), and, with `ts_local` (s from first touch), the histories on that grid."""
+    dynamics = law.dynamics(m=m, v0=v_in, g=g)
+    tau_grid = None if ts_local is None else ts_local / dynamics.t_star
+    plan = _phase_plan(dynamics, options.peaks or tau_grid is not None)
+    phases = _integrate(
+        dynamics,
+        plan=plan,
+        separation=options.separation,
+        tau_grid=tau_grid,
+        solver=options.solver,
+        rtol=options.rtol,
+        atol=options.atol,
+        max_steps=options.max_steps,
+        tau_max=options.tau_max,
+        rest_tol=options.rest_tol,
+        adjoint=options.adjoint,
+    )
+    result = _assemble_integrated(dynamics, phases, plan, m=m, v0=v_in, g=g, tau_grid=tau_grid)
+    x_end = dynamics.position(phases["y"][-1]) * dynamics.x_star
+    return result, x_end
+
+
+def _chain(law, m, g, drag, start, t_end, min_flight, ts, options: BounceOptions):
+    """The scan over contacts. `start = (t0, y0, u0)`: the first flight's state (s, m, m/s,
+    upward velocity). Returns the per-contact records (unmasked: a record whose `valid` is
+    False comes from a dummy solve at unit speed and must not be used), the first flight,
+    and the final carry."""
+    flight0 = Flight.from_state(*start, g=g, drag=drag)
+    zero = jnp.zeros_like(flight0.t_apex)
+
+    def body(carry, k):
+        t_apex, y_apex, t_release, active, code, t_rest, y_rest = carry
+        t_land, v_in = Flight(t_apex, y_apex, g, drag).landing()
+        too_late = t_land > t_end
+        too_short = ((k > 0) & (t_land - t_release < min_flight)) | (v_in <= 0)
+        hit = active & ~too_late & ~too_short
+        v_safe = jnp.where(hit, v_in, 1.0)
+        local = None if ts is None else ts - jnp.where(hit, t_land, 0.0)
+        contact, x_end = _contact(law, m, v_safe, g, local, options.impact)
+        separated = contact.status == Status.separated
+        t_out = t_land + contact.T
+        after = Flight.from_state(t_out, -x_end, -contact.v_out, g=g, drag=drag)
+        go_on = hit & separated
+        rests = active & ~too_late & too_short
+        held = hit & ~separated
+        failed = contact.status == Status.out_of_steps
+        code = jnp.where(active & too_late, BounceStatus.t_end, code)
+        code = jnp.where(rests, BounceStatus.at_rest, code)
+        code = jnp.where(held, jnp.where(failed, BounceStatus.failed, BounceStatus.at_rest), code)
+        t_rest = jnp.where(rests, t_land, jnp.where(held & ~failed, t_out, t_rest))
+        y_rest = jnp.where(held & ~failed, -x_end, y_rest)
+        carry = (
+            jnp.where(go_on, after.t_apex, t_apex),
+            jnp.where(go_on, after.y_apex, y_apex),
+            jnp.where(go_on, t_out, t_release),
+            go_on,
+            code,
+            t_rest,
+            y_rest,
+        )
+        record = dict(
+            valid=hit,
+            separated=separated,
+            t_land=t_land,
+            v_in=v_in,
+            e=contact.e,
+            T=contact.T,
+            v_out=-contact.v_out,
+            x_end=x_end,
+            t_out=t_out,
+            t_apex=after.t_apex,
+            y_apex=after.y_apex,
+            status=contact.status,
+            num_steps=contact.num_steps,
+            x_max=contact.x_max,
+            F_max=contact.F_max,
+        )
+        if ts is not None:
+            record.update(x=contact.x, v=contact.v, F=contact.F)
+        return carry, record
+
+    carry0 = (
+        flight0.t_apex,
+        flight0.y_apex,
+        zero + start[0],
+        jnp.asarray(True),
+        jnp.asarray(_RUNNING),
+        zero + jnp.nan,
+        zero,
+    )
+    carry, records = jax.lax.scan(body, carry0, jnp.arange(options.max_impacts))
+    return records, flight0, carry
+
+
+class BounceResult(eqx.Module):
+    """A ball dropped on a floor (SI units; `height` above the floor, velocities upward
+    positive where signed).
+
+    Arrays of length `max_impacts`, one entry per contact, padded with NaN after the last
+    (`num_impacts` of them are real; `mask` says which):
+
+    - `impact_times`, `release_times` (s): first touch and separation (NaN for a contact
+      that did not separate).
+    - `impact_speeds` (m/s, downward), `rebound_speeds` (m/s, upward, `e * impact_speeds`).
+    - `e`, `T` (s): restitution and duration of each contact (gravity included).
+    - `F_max` (N), `x_max` (m): peak contact force and maximum penetration (`None` under
+      `peaks=False`).
+    - `release_heights` (m): height at separation, `-x` there (negative: under the force
+      criterion a damped contact ends while the surface is still pressed in).
+    - `apex_times` (s), `apex_heights` (m): the top of the flight after each contact.
+    - `contact_status`: each contact's `jaximpact.Status`.
+
+    Scalars: `num_impacts`; `status` (a `BounceStatus`); `t_rest` (s): when the ball came
+    to rest (NaN unless `status == at_rest`); `drop_apex_time`, `drop_apex_height`: the apex
+    of the first flight (`0, h0` for a ball released at rest).
+
+    `height(ts)`, `velocity(ts)` and `force(ts)` (N, on the ball, upward) evaluate the motion
+    at any instants `ts` (s): closed-form flight between contacts, each contact's own
+    solution inside it (re-integrated once, with output at `ts`), and rest on the floor after
+    `t_rest`; NaN after the end of what was computed (the next landing after `t_end`, or
+    after the last of `max_impacts` contacts). Before `t = 0` they continue the first flight
+    backwards. At rest: after a contact that gravity held (status `captured`), the contact's
+    solve stops where the ball first halts inside the surface; the decaying oscillation about
+    the static deflection that follows is not integrated, and the height is held at that
+    depth (within one static deflection of the floor), the velocity at 0 and the force at
+    `m g`; after a flight shorter than `min_flight`, at 0.
+    """
+
+    impact_times: Array
+    release_times: Array
+    impact_speeds: Array
+    rebound_speeds: Array
+    e: Array
+    T: Array
+    release_heights: Array
+    apex_times: Array
+    apex_heights: Array
+    contact_status: Array
+    num_impacts: Array
+    status: Array
+    t_rest: Array
+    drop_apex_time: Array
+    drop_apex_height: Array
+    num_steps: Array
+    F_max: Array | None
+    x_max: Array | None
+    # what the histories need to re-run the contacts
+    law: AbstractLaw
+    m: Array
+    g: Array
+    drag: Array | None
+    start: tuple
+    t_end: Array
+    min_flight: Array
+    options: BounceOptions
+
+    @property
+    def mask(self) -> Array:
+        """True for the entries of the per-contact arrays that are real contacts."""
+        return jnp.arange(self.e.shape[-1]) < self.num_impacts[..., None]
+
+    @property
+    def status_name(self) -> str:
+        """The status as a word (for one drop, not a batch)."""
+        return BounceStatus(int(self.status)).name
+
+    def trajectory(self, ts) -> tuple[Array, Array, Array]:
+        """`(height, velocity, force)` at the times `ts` (s): m, m/s upward, N upward."""
+        ts = jnp.asarray(ts, dtype=float)
+        if ts.ndim != 1:
+            raise ValueError("ts must be a 1-D array of times in seconds")
+        return _histories(self, ts)
+
+    def height(self, ts) -> Array:
+        """Height of the ball's lowest point above the undeformed floor (m) at `ts` (s);
+        inside a contact `-x`, minus the penetration."""
+        return self.trajectory(ts)[0]
+
+    def velocity(self, ts) -> Array:
+        """Upward velocity (m/s) at `ts` (s)."""
+        return self.trajectory(ts)[1]
+
+    def force(self, ts) -> Array:
+        """Contact force on the ball (N, upward) at `ts` (s); `m g` once at rest."""
+        return self.trajectory(ts)[2]
+
+
+@eqx.filter_jit
+def _histories(result: BounceResult, ts):
+    records, flight0, carry = _chain(
+        result.law,
+        result.m,
+        result.g,
+        result.drag,
+        result.start,
+        result.t_end,
+        result.min_flight,
+        ts,
+        result.options,
+    )
+    return trajectory_from_records(records, flight0, carry, ts, result.m, result.g, result.drag)
+
+
+def trajectory_from_records(records, flight0, carry, ts, m, g, drag):
+    """Height, upward velocity and contact force at `ts` from the chain's records (which
+    must carry the contact histories on `ts`)."""
+    valid, separated = records["valid"], records["separated"]
+    t_land = jnp.where(valid, records["t_land"], jnp.inf)
+    t_out = jnp.where(valid, records["t_out"], jnp.inf)
+    n = ts.shape[0]
+    k = jnp.searchsorted(t_land, ts, side="right") - 1  # the last contact begun, -1: none
+    kk = jnp.maximum(k, 0)
+    columns = jnp.arange(n)
+    started = k >= 0
+    in_contact = started & (ts <= t_out[kk])
+    # the flight after contact k (or the first flight), and where it ends
+    t_apex = jnp.concatenate([flight0.t_apex[None], records["t_apex"]])[k + 1]
+    y_apex = jnp.concatenate([flight0.y_apex[None], records["y_apex"]])[k + 1]
+    t_next = jnp.concatenate([t_land, jnp.asarray([jnp.inf])])[k + 1]
+    final_apex, final_height = carry[0], carry[1]
+    code, t_rest, y_rest = carry[4], carry[5], carry[6]
+    next_landing = Flight(final_apex, final_height, g, drag).landing()[0]
+    last_flight = ~jnp.isfinite(t_next)
+    resting = code == BounceStatus.at_rest
+    flight_end = jnp.where(last_flight, jnp.where(resting, t_rest, next_landing), t_next)
+    in_flight = (~started | separated[kk]) & ~in_contact & (ts <= flight_end)
+    at_rest = resting & ~in_contact & ~in_flight & (ts >= t_rest)
+    y_flight, u_flight = Flight(t_apex, y_apex, g, drag).state(ts)
+    y_rest_now = jnp.where(jnp.isfinite(y_rest), y_rest, 0.0)
+    height = jnp.where(in_contact, -records["x"][kk, columns], jnp.nan)
+    velocity = jnp.where(in_contact, -records["v"][kk, columns], jnp.nan)
+    force = jnp.where(in_contact, records["F"][kk, columns], jnp.nan)
+    height = jnp.where(in_flight, y_flight, jnp.where(at_rest, y_rest_now, height))
+    velocity = jnp.where(in_flight, u_flight, jnp.where(at_rest, 0.0, velocity))
+    force = jnp.where(in_flight, 0.0, jnp.where(at_rest, m * g, force))
+    return height, velocity, force
+
+
+@eqx.filter_jit
+def _solve_bounce(law, m, g, drag, start, t_end, min_flight, options: BounceOptions):
+    records, flight0, carry = _chain(law, m, g, drag, start, t_end, min_flight, None, options)
+    valid = records["valid"]
+    num = jnp.sum(valid)
+    code, t_rest = carry[4], carry[5]
+    # still bouncing after the last contact: was there time for another one?
+    next_landing = Flight(carry[0], carry[1], g, drag).landing()[0]
+    long_enough = (next_landing - carry[2]) >= min_flight
+    ran_out = (code == _RUNNING) & (next_landing <= t_end) & long_enough
+    code = jnp.where(
+        code == _RUNNING,
+        jnp.where(
+            ran_out,
+            BounceStatus.max_impacts,
+            jnp.where(next_landing > t_end, BounceStatus.t_end, BounceStatus.at_rest),
+        ),
+        code,
+    )
+    t_rest = jnp.where((code == BounceStatus.at_rest) & ~jnp.isfinite(t_rest), next_landing, t_rest)
+
+    def pad(value, where=valid):
+        return None if value is None else jnp.where(where, value, jnp.nan)
+
+    separated = valid & records["separated"]
+    return BounceResult(
+        impact_times=pad(records["t_land"]),
+        release_times=pad(records["t_out"], separated),
+        impact_speeds=pad(records["v_in"]),
+        rebound_speeds=pad(records["v_out"], separated),
+        e=pad(records["e"]),
+        T=pad(records["T"]),
+        release_heights=pad(-records["x_end"], separated),
+        apex_times=pad(records["t_apex"], separated),
+        apex_heights=pad(records["y_apex"], separated),
+        contact_status=jnp.where(valid, records["status"], -1),
+        num_impacts=num,
+        status=code.astype(jnp.int32),
+        t_rest=t_rest,
+        drop_apex_time=flight0.t_apex,
+        drop_apex_height=flight0.y_apex,
+        num_steps=jnp.sum(jnp.where(valid, records["num_steps"], 0)),
+        F_max=pad(records["F_max"]),
+        x_max=pad(records["x_max"]),
+        law=law,
+        m=m,
+        g=g,
+        drag=drag,
+        start=start,
+        t_end=t_end,
+        min_flight=min_flight,
+        options=options,
+    )
+
+
+def bounce_options(
+    *,
+    separation="force",
+    max_impacts=64,
+    solver=None,
+    rtol=1e-10,
+    atol=None,
+    max_steps=4096,
+    tau_max=1e4,
+    rest_tol=1e-9,
+    adjoint=None,
+    peaks=True,
+) -> BounceOptions:
+    """The static options of a bounce (see `bounce`); `adjoint` defaults to diffrax's
+    `RecursiveCheckpointAdjoint`."""
+    if separation not in SEPARATIONS:
+        raise ValueError(f"separation must be one of {SEPARATIONS}, got {separation!r}")
+    if not isinstance(max_impacts, (int, np.integer)) or max_impacts < 1:
+        raise ValueError(f"max_impacts must be an integer >= 1, got {max_impacts!r}")
+    return BounceOptions(
+        impact=ImpactOptions(
+            separation=separation,
+            closed_form=False,
+            solver=dfx.Tsit5() if solver is None else solver,
+            rtol=rtol,
+            atol=rtol if atol is None else atol,
+            max_steps=max_steps,
+            tau_max=tau_max,
+            rest_tol=rest_tol,
+            adjoint=dfx.RecursiveCheckpointAdjoint() if adjoint is None else adjoint,
+            peaks=peaks,
+        ),
+        max_impacts=int(max_impacts),
+    )
+
+
+def bounce(
+    law: AbstractLaw,
+    *,
+    m,
+    h0,
+    t_end,
+    v_drop=0.0,
+    g=9.81,
+    separation: str = "force",
+    drag=None,
+    max_impacts: int = 64,
+    min_flight=1e-6,
+    solver: dfx.AbstractSolver | None = None,
+    rtol: float = 1e-10,
+    atol: float | None = None,
+    max_steps: int = 4096,
+    tau_max: float = 1e4,
+    rest_tol: float = 1e-9,
+    adjoint: dfx.AbstractAdjoint | None = None,
+    peaks: bool = True,
+    throw: bool = False,
+) -> BounceResult:
+    """A ball of mass `m` (kg) released at height `h0` (m) above a floor at `t = 0`, with
+    downward speed `v_drop` (m/s; 0: dropped from rest), bouncing until `t_end` (s).
+
+    The seed paper's system (17) (Polukoshko et al. 2007, section 7): `m y'' = -m g + N`,
+    with the contact force `N` of `law` while the ball presses into the floor. Each free
+    flight is solved in closed form (a parabola; with `drag`, the closed form of
+    `u' = -g - k u |u|`), each contact by one event-terminated impact solve of
+    `m x'' = -F(x, x') + m g` from first touch to separation (the solve of `jaximpact.impact`
+    with gravity). A contact that ends with the surface still pressed in (force criterion)
+    starts its flight at that depth.
+
+    - `separation`: `"force"` (the floor stops pushing) or `"penetration"` (x back to 0),
+      as in `impact`.
+    - `drag`: `k = rho C_d A / (2 m)` (1/m), or None for no air drag.
+    - `max_impacts`: static bound on the number of contacts (the length of the compiled
+      scan); running out of it before `t_end` gives `status == max_impacts`.
+    - `min_flight` (s): a flight shorter than this ends the sequence with the ball at rest
+      (with a speed-independent restitution the bounces accumulate in finite time).
+    - `solver`, `rtol`, `atol`, `max_steps`, `tau_max`, `rest_tol`, `peaks`: each contact's
+      solve, as in `impact`; `adjoint`: default picks the cheapest diffrax adjoint for the
+      transformation in use (`ForwardMode` under `jax.jacfwd`).
+    - `throw`: raise if the sequence failed or ran out of `max_impacts`.
+    Differentiable (forward and reverse mode) in the law's parameters, `m`, `h0`, `v_drop`,
+    `g` and `drag`; works under `jax.vmap`.
+
+    **Example**:
+    ```python
+    b = bounce(law("hertz_rate", c=1e6, b1=1350.0), m=1.0, h0=0.6, t_end=3.0)
+    b.impact_times[:4], b.e[:4], b.height(jnp.linspace(0.0, 3.0, 500))
+    ```
+    """
+    if not isinstance(law, AbstractLaw):
+        raise TypeError(
+            f"bounce needs a law from jaximpact.law(...) or jaximpact.custom_law(...), "
+            f"got {type(law).__name__}"
+        )
+    m = jnp.asarray(check_positive("mass m", m, "kg"), dtype=float)
+    h0 = jnp.asarray(check_nonnegative("drop height h0", h0, "m"), dtype=float)
+    t_end = jnp.asarray(check_positive("t_end", t_end, "s"), dtype=float)
+    g = jnp.asarray(check_positive("gravity g", g, "m/s^2"), dtype=float)
+    v_drop = jnp.asarray(check_values(v_drop, lambda a: False, "v_drop must be finite"), float)
+    min_flight = jnp.asarray(check_nonnegative("min_flight", min_flight, "s"), dtype=float)
+    if drag is not None:
+        drag = jnp.asarray(check_positive("air drag coefficient drag", drag, "1/m"), dtype=float)
+        concrete = not any(isinstance(a, jax.core.Tracer) for a in (drag, v_drop, g))
+        if concrete and float(v_drop) > 0 and float(v_drop) ** 2 * float(drag) >= float(g):
+            raise ValueError(
+                f"v_drop = {float(v_drop)} m/s is not below the terminal speed "
+                f"sqrt(g / drag) = {float(jnp.sqrt(g / drag)):.4g} m/s"
+            )
+    for name, value in (("m", m), ("h0", h0), ("t_end", t_end), ("g", g), ("v_drop", v_drop)):
+        if jnp.ndim(value):
+            raise ValueError(f"bounce takes a scalar {name}; use jax.vmap for a batch")
+    if adjoint is None:
+        adjoint = auto_adjoint(law, m, h0, v_drop, g, drag, t_end)
+    options = bounce_options(
+        separation=separation,
+        max_impacts=max_impacts,
+        solver=solver,
+        rtol=rtol,
+        atol=atol,
+        max_steps=max_steps,
+        tau_max=tau_max,
+        rest_tol=rest_tol,
+        adjoint=adjoint,
+        peaks=peaks,
+    )
+    start = (jnp.zeros(()), h0, -v_drop)
+    result = _solve_bounce(law, m, g, drag, start, t_end, min_flight, options)
+    if throw:
+        result = eqx.error_if(
+            result,
+            (result.status == BounceStatus.failed) | (result.status == BounceStatus.max_impacts),
+            "the bounce sequence failed (a contact ran out of steps) or used up max_impacts",
+        )
+    return result

@@ -1,0 +1,669 @@
+"""`jaximpact calibrate`: fit a law's parameters to measured restitution and contact duration.
+
+One impact from the flags (`--v0`, `--e`, `--T`), or one row per impact speed from
+`--data FILE.csv` (columns `v0,e[,T,sigma_e,sigma_T]`, an empty cell a missing value).
+`--law all` fits every law of the seed paper and ranks them (`jaximpact.compare_laws`).
+Without start values (`--param`), each law starts from `jaximpact.starting_law` and then from
+its nondimensional restitution table (`calibrate(..., init="auto")`).
+"""
+
+import csv
+import math
+import sys
+import threading
+from pathlib import Path
+
+from ._cli import (
+    CLIError,
+    _concrete_units,
+    add_law_arguments,
+    add_output_arguments,
+    check_plot_path,
+    command_parser,
+    emit,
+    format_number,
+    format_quantity,
+    new_figure,
+    parse_params,
+    save_figure,
+)
+from ._progress import Progress
+
+COLUMNS = ("v0", "e", "T", "sigma_e", "sigma_T")
+ALL = "all"
+
+
+def add_calibrate(subparsers):
+    parser = command_parser(
+        subparsers,
+        "calibrate",
+        help="fit a law's parameters to measured e (and T) at one or several impact speeds",
+        description="Fit the parameters of the force law --law (stiffness c, damping b, b1 or "
+        "a, dry force P ...) to a measured coefficient of restitution e and, if known, contact "
+        "duration T of a body of mass --mass (kg): one impact at --v0 (m/s), or one row per "
+        "impact speed from --data FILE.csv with columns v0,e[,T,sigma_e,sigma_T] (an empty "
+        "cell is a missing value: a row may have e without T). --free names the parameters "
+        "to fit (default: c when T is given, and the damping); --param gives start values "
+        "(and the values of the parameters kept fixed); without them the start comes from "
+        "the law's nondimensional restitution table. With sigmas the residuals are weighted "
+        "and the standard errors of the parameters are printed. --law all fits every law of "
+        "the seed paper and ranks them (by AIC with sigmas, else by the sum of squared "
+        "residuals). The first fit of a law compiles it (10-30 s); later runs reuse JAX's "
+        "persistent compilation cache.",
+        example="jaximpact calibrate --law hertz_rate --mass 1 --v0 2.5 --e 0.85 --T 7.8e-3\n"
+        "jaximpact calibrate --law kelvin_voigt --v0 2.5 --e 0.7 --T 2e-3 --free c,b --json\n"
+        "jaximpact calibrate --law hertz_rate --mass 0.0027 --data drops.csv --plot fit.png\n"
+        "jaximpact calibrate --law all --mass 0.0027 --data drops.csv",
+    )
+    add_law_arguments(parser)
+    for action in parser._actions:
+        if action.dest == "law":
+            action.help += f", or '{ALL}' to fit every law of the seed paper and rank them"
+        elif action.dest == "param":
+            action.help = (
+                "start value of a parameter (or value of a fixed one), SI units, e.g. "
+                "--param c=1e6 b1=100 (default: jaximpact.starting_law, then the law's "
+                "restitution table where it has one)"
+            )
+    parser.add_argument(
+        "--mass", type=float, default=1.0, metavar="KG", help="(effective) mass, kg (default 1)"
+    )
+    parser.add_argument("--v0", type=float, metavar="M/S", help="impact speed, m/s (> 0)")
+    parser.add_argument("--e", type=float, metavar="E", help="measured restitution, in (0, 1]")
+    parser.add_argument("--T", type=float, metavar="S", help="measured contact duration, s")
+    parser.add_argument(
+        "--sigma-e", dest="sigma_e", type=float, metavar="SE", help="standard deviation of e"
+    )
+    parser.add_argument(
+        "--sigma-T", dest="sigma_T", type=float, metavar="ST", help="standard deviation of T, s"
+    )
+    parser.add_argument(
+        "--data",
+        type=Path,
+        metavar="FILE.csv",
+        help="measurements, one impact speed per row: a header with v0,e and optionally "
+        "T,sigma_e,sigma_T (SI units); instead of --v0/--e/--T",
+    )
+    parser.add_argument(
+        "--free",
+        action="extend",
+        nargs="+",
+        metavar="NAME",
+        help="parameters to fit, e.g. --free c,b1 (default: c if T is given, and the damping)",
+    )
+    parser.add_argument(
+        "--separation",
+        choices=("force", "penetration"),
+        default="force",
+        help="end of contact: force back to zero (default) or penetration back to zero",
+    )
+    parser.add_argument(
+        "--gravity",
+        type=float,
+        default=0.0,
+        metavar="M/S^2",
+        help="gravity along the inward normal during contact, m/s^2 (default 0)",
+    )
+    parser.add_argument(
+        "--optimizer",
+        choices=("lbfgs", "lm"),
+        default="lbfgs",
+        help="optax L-BFGS (default) or optimistix Levenberg-Marquardt",
+    )
+    parser.add_argument(
+        "--init",
+        choices=("auto", "given"),
+        help="start from the restitution table (auto) or from the --param values (given); "
+        "default: given if --param names a fitted parameter, else auto",
+    )
+    parser.add_argument(
+        "--max-iter", type=int, default=100, metavar="N", help="iteration limit (default 100)"
+    )
+    add_output_arguments(parser)
+    parser.set_defaults(handler=run_calibrate)
+
+
+# --------------------------------------------------------------------------- the data
+
+
+def _cell(text, line, column):
+    text = text.strip()
+    if not text:
+        return math.nan
+    try:
+        return float(text)
+    except ValueError:
+        raise CLIError(f"line {line}, column {column}: {text!r} is not a number") from None
+
+
+def read_data(path: Path) -> dict:
+    """`{column: [float, ...]}` from a CSV with a header naming some of `COLUMNS`; empty
+    cells are NaN; blank lines and lines starting with `#` are skipped."""
+    try:
+        text = path.read_text()
+    except OSError as error:
+        raise CLIError(f"cannot read --data {path}: {error.strerror or error}") from None
+    lines = [
+        (number, line)
+        for number, line in enumerate(text.splitlines(), start=1)
+        if line.strip() and not line.lstrip().startswith("#")
+    ]
+    if not lines:
+        raise CLIError(f"--data {path} is empty")
+    header = [name.strip() for name in next(csv.reader([lines[0][1]]))]
+    unknown = [name for name in header if name not in COLUMNS]
+    if unknown:
+        raise CLIError(
+            f"--data {path}: unknown column {', '.join(map(repr, unknown))}; "
+            f"the columns are v0,e[,T,sigma_e,sigma_T]"
+        )
+    if len(set(header)) != len(header):
+        raise CLIError(f"--data {path}: a column is named twice in the header")
+    for needed in ("v0", "e"):
+        if needed not in header:
+            raise CLIError(f"--data {path}: no column {needed!r} (need v0,e[,T,sigma_e,sigma_T])")
+    columns = {name: [] for name in header}
+    for number, line in lines[1:]:
+        cells = next(csv.reader([line]))
+        if len(cells) != len(header):
+            raise CLIError(
+                f"--data {path}, line {number}: {len(cells)} cells for {len(header)} columns"
+            )
+        for name, cell in zip(header, cells, strict=True):
+            columns[name].append(_cell(cell, number, name))
+        for name in ("v0", "e"):
+            if math.isnan(columns[name][-1]):
+                what = "impact speed" if name == "v0" else "restitution (T may be left empty)"
+                raise CLIError(
+                    f"--data {path}, line {number}: no {name}; every row needs its {what}"
+                )
+    if not columns["v0"]:
+        raise CLIError(f"--data {path} has a header but no rows")
+    return columns
+
+
+def measurements(args) -> dict:
+    """The rows to fit: `v0`, `e` (lists), `T`, `sigma_e`, `sigma_T` (lists or None; T
+    NaN where a row has none, sigma_T 1 there)."""
+    import numpy as np
+
+    from ._calibrate import _check_targets
+
+    flags = [f"--{k}" for k in ("v0", "e", "T") if getattr(args, k) is not None]
+    flags += [
+        f"--{k.replace('_', '-')}" for k in ("sigma_e", "sigma_T") if getattr(args, k) is not None
+    ]
+    if args.data is not None:
+        if flags:
+            raise CLIError(f"give either --data or {', '.join(flags)}, not both")
+        columns = read_data(args.data)
+    else:
+        if args.v0 is None or args.e is None:
+            raise CLIError("give --v0 and --e (and --T if measured), or --data FILE.csv")
+        columns = {k: [getattr(args, k)] for k in COLUMNS if getattr(args, k, None) is not None}
+    rows = len(columns["v0"])
+    T = columns.get("T")
+    if T is not None and all(math.isnan(t) for t in T):
+        T = None
+    sigma_e, sigma_T = columns.get("sigma_e"), columns.get("sigma_T")
+    if sigma_e is not None and any(math.isnan(s) for s in sigma_e):
+        raise CLIError("sigma_e is missing on some rows: give it on every row or on none")
+    if sigma_T is not None:
+        if T is None:
+            raise CLIError("sigma_T is given without any T")
+        if any(math.isnan(s) and not math.isnan(t) for s, t in zip(sigma_T, T, strict=True)):
+            raise CLIError("sigma_T is missing on a row with a T: give both or neither")
+        sigma_T = [1.0 if math.isnan(t) else s for s, t in zip(sigma_T, T, strict=True)]
+    if T is not None and (sigma_e is None) != (sigma_T is None):
+        raise CLIError(
+            "the residuals are weighted by the sigmas: give sigma_e and sigma_T together "
+            "(or neither) when T is measured"
+        )
+    if sigma_e is None and sigma_T is not None:
+        raise CLIError("give sigma_e with sigma_T")
+    _check_targets(
+        args.mass,
+        np.asarray(columns["v0"]),
+        np.asarray(columns["e"]),
+        None if T is None else np.asarray(T),
+        None if sigma_e is None else np.asarray(sigma_e),
+        None if sigma_T is None else np.asarray(sigma_T),
+    )  # the library's own messages, before the start values need sane numbers
+    return dict(v0=columns["v0"], e=columns["e"], T=T, sigma_e=sigma_e, sigma_T=sigma_T, rows=rows)
+
+
+def _middle(data):
+    """The row whose speed is the median (where the start values are computed)."""
+    order = sorted(range(data["rows"]), key=lambda i: data["v0"][i])
+    return order[data["rows"] // 2]
+
+
+# --------------------------------------------------------------------- progress bar
+
+
+class _Ticker:
+    """A `Progress` bar redrawn every 0.2 s while the work runs (a first fit compiles for
+    tens of seconds without other sign of life), shown only once it has taken `delay` s."""
+
+    def __init__(self, total, what, enabled, delay=0.5):
+        self.bar = Progress(total, what, enabled=False)
+        self.enabled, self.delay, self.label = enabled, delay, ""
+        self._lock, self._stop = threading.Lock(), threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+
+    def __enter__(self):
+        if self.enabled:
+            self._thread.start()
+        return self
+
+    def _run(self):
+        if self._stop.wait(self.delay):
+            return
+        with self._lock:
+            self.bar.enabled = True
+        while True:
+            with self._lock:
+                self.bar._draw(self.label)
+            if self._stop.wait(0.2):
+                return
+
+    def update(self, label=""):
+        with self._lock:
+            self.label = label
+            self.bar.done += 1
+
+    def __exit__(self, *exc):
+        self._stop.set()
+        if self._thread.is_alive():
+            self._thread.join()
+        if self.bar.enabled:
+            self.bar._draw(self.label)
+            self.bar.__exit__(*exc)
+        return False
+
+
+def _progress_enabled():
+    return sys.stderr.isatty()
+
+
+# ------------------------------------------------------------------------- running
+
+
+def run_calibrate(args):
+    check_plot_path(args.plot)
+    if not (math.isfinite(args.mass) and args.mass > 0):
+        raise CLIError(f"--mass must be a finite number > 0 kg, got {args.mass:g}")
+    if args.max_iter < 1:
+        raise CLIError("--max-iter must be at least 1")
+    data = measurements(args)
+    if args.law == ALL:
+        if args.free or args.param:
+            raise CLIError(
+                "--law all chooses each law's free parameters and start itself: "
+                "drop --free and --param"
+            )
+        return _run_all(args, data)
+    return _run_one(args, data)
+
+
+def _free_names(args):
+    if not args.free:
+        return None
+    names = [name.strip() for item in args.free for name in item.split(",") if name.strip()]
+    if not names:
+        raise CLIError("--free names no parameter, e.g. --free c,b1")
+    if len(set(names)) != len(names):
+        raise CLIError("--free names a parameter twice")
+    return tuple(names)
+
+
+def _fit_kwargs(args, data):
+    return dict(
+        m=args.mass,
+        v0=data["v0"],
+        e=data["e"],
+        T=data["T"],
+        sigma_e=data["sigma_e"],
+        sigma_T=data["sigma_T"],
+        separation=args.separation,
+        g=args.gravity,
+        optimizer=args.optimizer,
+        max_iter=args.max_iter,
+    )
+
+
+def _run_one(args, data):
+    import jax
+
+    from ._calibrate import _default_free, calibrate
+    from ._laws import LAW_NAMES, LAWS
+    from ._model_choice import starting_law
+
+    if args.law not in LAWS:
+        raise CLIError(f"unknown law {args.law!r}; choose one of: {', '.join(LAW_NAMES)}, or {ALL}")
+    given = parse_params(args.param)
+    row = _middle(data)
+    T_row = None if data["T"] is None else data["T"][row]
+    start = starting_law(
+        args.law,
+        m=args.mass,
+        v0=data["v0"][row],
+        e=data["e"][row],
+        T=None if T_row is None or math.isnan(T_row) else T_row,
+    )
+    if given:
+        start = start.replace(**given)
+    free = _free_names(args)
+    fitted_names = free or _default_free(start, data["T"] is not None)
+    init = args.init or ("given" if set(given) & set(fitted_names) else "auto")
+    with _Ticker(1, f"calibrating {args.law}", _progress_enabled()) as bar:
+        fit = calibrate(start, free=free, init=init, **_fit_kwargs(args, data))
+        jax.block_until_ready(fit)
+        bar.update("done")
+    result = _fit_record(args.law, fit, data)
+    result.update(
+        m=args.mass,
+        separation=args.separation,
+        g=args.gravity,
+        optimizer=args.optimizer,
+        init=init,
+        start={k: float(v) for k, v in start.parameters.items()},
+    )
+    if args.plot is not None:
+        _plot(args, data, [(args.law, fit)])
+        result["plot"] = str(args.plot)
+    emit(args, result, lambda: _one_text(result, data))
+    return 0
+
+
+def _fit_record(name, fit, data):
+    import numpy as np
+
+    from ._laws import LAWS
+
+    rows = []
+    for i in range(data["rows"]):
+        T = None if data["T"] is None else data["T"][i]
+        rows.append(
+            dict(
+                v0=data["v0"][i],
+                e=data["e"][i],
+                e_fit=float(fit.e[i]),
+                T=None if T is None or math.isnan(T) else T,
+                T_fit=float(fit.T[i]),
+                sigma_e=None if data["sigma_e"] is None else data["sigma_e"][i],
+                sigma_T=None
+                if data["sigma_T"] is None or T is None or math.isnan(T)
+                else data["sigma_T"][i],
+            )
+        )
+    residuals = np.asarray(fit.residuals)
+    order = list(fit.law.parameters)
+    if name in LAWS:  # the law's own order (a compiled fit returns its dict sorted)
+        order = [k for k in LAWS[name].parameters if k in fit.params]
+    return dict(
+        law=name,
+        params={k: float(fit.params[k]) for k in order},
+        free=list(fit.free),
+        stderr=None if fit.stderr is None else {k: float(v) for k, v in fit.stderr.items()},
+        converged=bool(fit.converged),
+        iterations=int(fit.iterations),
+        loss=float(fit.loss),
+        max_residual=float(np.max(np.abs(residuals))) if residuals.size else 0.0,
+        rows=rows,
+    )
+
+
+def _run_all(args, data):
+    from ._model_choice import PAPER_LAWS, compare_laws
+
+    laws = tuple(MODEL_CHOICE_LAWS or PAPER_LAWS)
+    has_sigma = data["sigma_e"] is not None
+    kwargs = _fit_kwargs(args, data)
+    rankings, failed = [], {}
+    with _Ticker(len(laws), "fitting laws", _progress_enabled()) as bar:
+        for name in laws:
+            bar.label = name
+            try:
+                rankings += compare_laws(laws=(name,), progress=False, **kwargs)
+            except Exception as error:  # one law's failure must not hide the others' fits
+                failed[name] = f"{type(error).__name__}: {str(error).splitlines()[0]}"
+            bar.update(name)
+    if not rankings:
+        raise CLIError(
+            "no law could be fitted: "
+            + ("; ".join(f"{k}: {v}" for k, v in failed.items()) or "more parameters than data")
+        )
+    rankings.sort(key=(lambda r: r.aic) if has_sigma else (lambda r: r.chi2))
+    ranked = []
+    for rank, item in enumerate(rankings, start=1):
+        record = _fit_record(item.name, item.fit, data)
+        record.update(rank=rank, k=item.k, chi2=item.chi2, aic=item.aic, bic=item.bic)
+        ranked.append(record)
+    n_data = len(data["e"]) + (
+        0 if data["T"] is None else sum(not math.isnan(t) for t in data["T"])
+    )
+    result = dict(
+        m=args.mass,
+        separation=args.separation,
+        g=args.gravity,
+        optimizer=args.optimizer,
+        criterion="aic" if has_sigma else "chi2",
+        n_data=n_data,
+        skipped=[
+            name for name in laws if name not in {r.name for r in rankings} and name not in failed
+        ],
+        failed=failed,
+        best=ranked[0]["law"],
+        ranking=ranked,
+    )
+    if args.plot is not None:
+        _plot(args, data, [(r.name, r.fit) for r in rankings[:3]])
+        result["plot"] = str(args.plot)
+    emit(args, result, lambda: _all_text(result, data))
+    return 0
+
+
+# Laws `--law all` fits (None: the seed paper's, `compare_laws`'s default); tests narrow it.
+MODEL_CHOICE_LAWS: tuple[str, ...] | None = None
+
+
+# ---------------------------------------------------------------------------- text
+
+
+def _law_line(name):
+    from ._laws import LAWS
+
+    spec = LAWS[name]
+    eq = f"eq. {spec.equation}: " if spec.equation != "-" else ""
+    return f"{name} ({eq}F = {spec.formula})"
+
+
+def _units(name, params):
+    from ._laws import LAWS
+
+    return _concrete_units(LAWS[name], params)
+
+
+def _params_text(name, params, stderr=None, indent=11):
+    units = _units(name, params)
+    width = max(len(k) for k in params)
+    lines = []
+    for key, value in params.items():
+        unit = units.get(key, "-")
+        text = f"{key:<{width}} = {format_number(value)}" + (f" {unit}" if unit != "-" else "")
+        if stderr and key in stderr:
+            relative = abs(stderr[key] / value) if value else math.inf
+            text += f"  +- {format_number(stderr[key], 3)} ({100 * relative:.2g}%)"
+        lines.append(text)
+    return ("\n" + " " * indent).join(lines)
+
+
+def _rows_text(data, rows):
+    has_T = data["T"] is not None
+    header = ["v0 [m/s]", "e", "e fit"] + (["T", "T fit"] if has_T else [])
+    if data["sigma_e"] is not None:
+        header.insert(2, "sigma_e")
+    table = [header]
+    for row in rows:
+        cells = [format_number(row["v0"], 4), f"{row['e']:.4f}"]
+        if data["sigma_e"] is not None:
+            cells.append(format_number(row["sigma_e"], 3))
+        cells.append(f"{row['e_fit']:.4f}")
+        if has_T:
+            cells.append("-" if row["T"] is None else format_quantity(row["T"], "s"))
+            cells.append(format_quantity(row["T_fit"], "s"))
+        table.append(cells)
+    widths = [max(len(line[i]) for line in table) for i in range(len(header))]
+    return "\n".join(
+        "  " + "  ".join(c.rjust(w) for c, w in zip(line, widths, strict=True)) for line in table
+    )
+
+
+def _status_text(record):
+    if record["converged"]:
+        return f"converged after {record['iterations']} iterations"
+    return (
+        f"NOT converged after {record['iterations']} iterations: the law does not reproduce "
+        f"the data (largest residual {format_number(record['max_residual'], 3)}); "
+        "the best fit is shown"
+    )
+
+
+def _one_text(result, data):
+    fitted = {k: v for k, v in result["params"].items() if k in result["free"]}
+    kept = {k: v for k, v in result["params"].items() if k not in result["free"]}
+    rows = data["rows"]
+    lines = [
+        f"law        {_law_line(result['law'])}",
+        f"data       {rows} impact{'s' if rows > 1 else ''}, m = {format_number(result['m'])} kg, "
+        f"separation by {result['separation']}"
+        + (f", g = {format_number(result['g'])} m/s^2" if result["g"] else ""),
+        f"fitted     {_params_text(result['law'], fitted, result['stderr'])}",
+    ]
+    if kept:
+        lines.append(f"kept       {_params_text(result['law'], kept)}")
+    lines.append(
+        f"fit        {_status_text(result)} ({result['optimizer']}, start {result['init']}), "
+        f"loss {format_number(result['loss'], 3)}"
+    )
+    if result["stderr"] is not None:
+        lines.append("           +- one standard error, from the Jacobian and the sigmas")
+    lines += ["", _rows_text(data, result["rows"])]
+    if "plot" in result:
+        lines.append(f"plot written to {result['plot']}")
+    return "\n".join(lines)
+
+
+def _all_text(result, data):
+    criterion = result["criterion"]
+    by = "AIC = chi2 + 2k" if criterion == "aic" else "the sum of squared residuals (no sigmas)"
+    lines = [
+        f"model choice: {result['n_data']} measurements at {data['rows']} speed"
+        f"{'s' if data['rows'] > 1 else ''}, m = {format_number(result['m'])} kg; "
+        f"ranked by {by}",
+        "",
+    ]
+    header = ["rank", "law", "k", "chi2", "AIC", "BIC", "converged", "parameters"]
+    table = [header]
+    for r in result["ranking"]:
+        params = ", ".join(f"{k} = {format_number(v, 4)}" for k, v in r["params"].items())
+        table.append(
+            [
+                str(r["rank"]),
+                r["law"],
+                str(r["k"]),
+                format_number(r["chi2"], 3),
+                "-" if r["aic"] is None else format_number(r["aic"], 4),
+                "-" if r["bic"] is None else format_number(r["bic"], 4),
+                "yes" if r["converged"] else "no",
+                params,
+            ]
+        )
+    widths = [max(len(line[i]) for line in table) for i in range(len(header) - 1)]
+    for line in table:
+        cells = [c.ljust(w) for c, w in zip(line[:-1], widths, strict=True)]
+        lines.append("  ".join(cells) + "  " + line[-1])
+    lines.append("")
+    lines.append(f"best: {result['best']}")
+    k_max = max(r["k"] for r in result["ranking"])
+    if result["n_data"] <= k_max:
+        lines.append(
+            f"note: {result['n_data']} measurements for up to {k_max} free parameters: a law "
+            "that fits them exactly is not thereby supported; measure more speeds"
+        )
+    for name, message in result["failed"].items():
+        lines.append(f"failed: {name} ({message})")
+    if result["skipped"]:
+        lines.append(f"skipped (more free parameters than data): {', '.join(result['skipped'])}")
+    if "plot" in result:
+        lines.append(f"plot written to {result['plot']}")
+    return "\n".join(lines)
+
+
+# ---------------------------------------------------------------------------- plot
+
+
+def _curve(fit, args, speeds):
+    """e and T (NaN where the body does not separate) of a fitted law at `speeds`."""
+    from ._impact import impact
+    from ._status import Status
+
+    es, Ts = [], []
+    for v in speeds:
+        r = impact(
+            fit.law,
+            m=args.mass,
+            v0=float(v),
+            separation=args.separation,
+            g=args.gravity,
+            peaks=False,
+        )
+        ok = int(r.status) == Status.separated
+        es.append(float(r.e) if ok else math.nan)
+        Ts.append(float(r.T) if ok else math.nan)
+    return es, Ts
+
+
+def _plot(args, data, fits):
+    """e (and T) against the impact speed: the data, with error bars from the sigmas, and
+    the fitted curve of each law of `fits` (name, Fit)."""
+    import numpy as np
+
+    v0 = np.asarray(data["v0"])
+    low, high = (
+        (v0.min() / 3, v0.max() * 3) if np.ptp(v0) == 0 else (v0.min() / 1.5, v0.max() * 1.5)
+    )
+    speeds = np.geomspace(low, high, 41)
+    has_T = data["T"] is not None
+    fig = new_figure(figsize=(11.0 if has_T else 5.8, 4.2), layout="constrained")
+    axes = fig.subplots(1, 2 if has_T else 1, squeeze=False)[0]
+    for k, (name, fit) in enumerate(fits):
+        es, Ts = _curve(fit, args, speeds)
+        style = dict(lw=2.0 if k == 0 else 1.2, ls="-" if k == 0 else "--")
+        axes[0].plot(speeds, es, label=f"{name} (fit)", **style)
+        if has_T:
+            axes[1].plot(speeds, 1e3 * np.asarray(Ts), label=f"{name} (fit)", **style)
+    e_err = None if data["sigma_e"] is None else data["sigma_e"]
+    axes[0].errorbar(
+        v0, data["e"], yerr=e_err, fmt="o", color="k", ms=5, capsize=3, label="measured", zorder=5
+    )
+    axes[0].set_ylabel("coefficient of restitution e")
+    if has_T:
+        T = np.asarray(data["T"], dtype=float)
+        T_err = None if data["sigma_T"] is None else 1e3 * np.asarray(data["sigma_T"])
+        if T_err is not None:
+            T_err = np.where(np.isnan(T), 0.0, T_err)
+        axes[1].errorbar(
+            v0, 1e3 * T, yerr=T_err, fmt="o", color="k", ms=5, capsize=3, label="measured", zorder=5
+        )
+        axes[1].set_ylabel("contact duration T [ms]")
+    for ax in axes:
+        ax.set_xscale("log")
+        ax.set_xlabel("impact speed v0 [m/s]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    names = ", ".join(name for name, _ in fits)
+    title = f"{names} fitted; m = {format_number(args.mass)} kg, separation by {args.separation}"
+    fig.suptitle(title, fontsize=10)
+    save_figure(fig, args.plot)

@@ -1,0 +1,471 @@
+"""`jaximpact fit`: fit a contact law to a recorded bounce (a trajectory or impact times).
+
+Formats read (detected from the file unless `--format` says):
+- an ImageJ MTrack2 export (`Frame X1 Y1 Flag1 ...`, whitespace or commas): a video track,
+  time in frames (`--frame-rate` converts it), `Y1` in pixels pointing down, the pixel scale
+  fitted unless `--length-scale` gives it;
+- a CSV with a header: a time column (`t`, `time`, `time_s`, ...) and a height column (`y`,
+  `height`, `h`, `z`, ...) is a trajectory; a time column alone (`event_time_s`,
+  `impact_time`, `t`, ...) is a list of impact times, one group per drop when the file has
+  other columns that tell drops apart (`--where COLUMN=VALUE` selects some);
+- plain numbers: two columns are `t y`, one column is impact times.
+"""
+
+import csv
+import io
+import math
+import sys
+from pathlib import Path
+
+from ._cli import (
+    CLIError,
+    add_law_arguments,
+    add_output_arguments,
+    check_plot_path,
+    command_parser,
+    emit,
+    format_number,
+    law_from_args,
+    new_figure,
+    save_figure,
+)
+
+FORMATS = ("auto", "trajectory", "impacts")
+_TIME_NAMES = ("t", "time", "time_s", "t_s", "times", "seconds", "frame")
+_IMPACT_NAMES = ("event_time_s", "impact_time", "impact_times", "impact_time_s", "event_time")
+_HEIGHT_NAMES = ("y", "height", "h", "z", "y_m", "height_m", "position", "y1")
+_IGNORED = ("impact_index", "index", "n")
+
+
+def add_fit(subparsers):
+    parser = command_parser(
+        subparsers,
+        "fit",
+        help="fit a law to a bouncing ball: a sampled trajectory or the impact times",
+        description="Fit the force law --law to a ball of mass --mass (kg) bouncing on a floor, "
+        "recorded in FILE either as a trajectory (time and height, e.g. a video track) or as "
+        "the instants of its impacts (e.g. a microphone). Free flights are closed-form, each "
+        "contact an impact solve with gravity. The law's damping is fitted (--free to choose), "
+        "with the nuisance quantities of a recording: the first impact's time and speed (the "
+        "drop height), and for a trajectory the floor level and, for a video, the pixel scale. "
+        "Double and missed detections among impact times, and tracking glitches, are found, "
+        "dropped and reported. Prints e per impact with its standard error; parameters the "
+        "data cannot fix are reported as undetermined.",
+        example="jaximpact fit impacts.csv --law hertz_rate --param c=5.5e7 b1=100 --mass 0.0415\n"
+        "jaximpact fit impacts.csv --law kelvin_voigt --param c=2e6 b=5 --mass 0.0027 "
+        "--where ball=pingpong --where trial=1 --drag 0.14 --json\n"
+        "jaximpact fit 1-1-B-A5.csv --law kelvin_voigt --param c=2000 b=0.5 --mass 0.0055 "
+        "--frame-rate 240 --plot marble.png",
+    )
+    parser.add_argument("file", type=Path, metavar="FILE", help="the recording (CSV or text)")
+    add_law_arguments(parser)
+    parser.add_argument("--mass", type=float, required=True, metavar="KG", help="mass, kg (> 0)")
+    parser.add_argument(
+        "--format",
+        choices=FORMATS,
+        default="auto",
+        help="what FILE holds (default: detect it)",
+    )
+    parser.add_argument(
+        "--free",
+        action="extend",
+        nargs="+",
+        metavar="NAME",
+        help="law parameters to fit (default: the damping; the others keep --param's values)",
+    )
+    parser.add_argument(
+        "--separation",
+        choices=("force", "penetration"),
+        default="force",
+        help="end of contact: force back to zero (default) or penetration back to zero",
+    )
+    parser.add_argument(
+        "--gravity", type=float, default=9.81, metavar="M/S^2", help="gravity (default 9.81)"
+    )
+    parser.add_argument(
+        "--drag",
+        type=float,
+        metavar="1/M",
+        help="quadratic air drag k = rho Cd A / (2 m) in flight (default: none)",
+    )
+    parser.add_argument(
+        "--fit-drag", action="store_true", help="fit the air drag, starting from --drag"
+    )
+    parser.add_argument(
+        "--where",
+        action="append",
+        default=[],
+        metavar="COLUMN=VALUE",
+        help="keep only the rows of a CSV whose COLUMN equals VALUE (repeatable)",
+    )
+    parser.add_argument(
+        "--frame-rate",
+        type=float,
+        metavar="FPS",
+        help="frames per second of a track whose time is in frames (required for MTrack2)",
+    )
+    parser.add_argument(
+        "--length-scale",
+        metavar="UNITS/M",
+        help="units of the height per metre (e.g. pixels per metre), or 'fit' "
+        "(default: 'fit' for a video track, 1 otherwise: heights in metres)",
+    )
+    parser.add_argument(
+        "--y-axis",
+        choices=("up", "down"),
+        help="direction of the height axis (default: down for a video track, up otherwise)",
+    )
+    parser.add_argument(
+        "--sigma",
+        type=float,
+        metavar="NOISE",
+        help="measurement noise (s for impact times, height units for a trajectory); "
+        "default: estimated from the residuals",
+    )
+    add_output_arguments(parser)
+    parser.set_defaults(handler=run_fit)
+
+
+# ----------------------------------------------------------------------------- reading
+
+
+class Recording:
+    """What a file held: `kind` ("trajectory" or "impacts"), and per group of rows (drop)
+    either `(t, y)` or the impact times; `video`: a pixel track (y down, scale unknown)."""
+
+    def __init__(self, kind, groups, video=False, columns=()):
+        self.kind, self.groups, self.video, self.columns = kind, groups, video, columns
+
+
+def _number(text):
+    try:
+        value = float(text)
+    except ValueError:
+        return None
+    return value if math.isfinite(value) else None
+
+
+def _read_mtrack(lines):
+    times, heights = [], []
+    for line in lines[1:]:
+        if line.lstrip().startswith("Track ") and times:
+            break  # the summary table MTrack2 appends ("Track Length Distance ...")
+        parts = line.replace(",", " ").split()
+        values = [_number(p) for p in parts[:3]]
+        if len(values) < 3 or any(v is None for v in values):
+            continue  # "Tracks 1 to 2" and the like
+        times.append(values[0])
+        heights.append(values[2])
+    if len(times) < 8:
+        raise CLIError("the MTrack2 file has fewer than 8 tracked frames")
+    return Recording("trajectory", {"track 1": (times, heights)}, video=True)
+
+
+def _read_plain(lines):
+    rows = []
+    for line in lines:
+        parts = line.replace(",", " ").split()
+        if not parts:
+            continue
+        values = [_number(p) for p in parts]
+        if any(v is None for v in values):
+            raise CLIError(f"cannot read {line.strip()!r} as numbers (a header needs names)")
+        rows.append(values)
+    widths = {len(r) for r in rows}
+    if len(widths) != 1 or not rows:
+        raise CLIError("every line must have the same number of columns")
+    width = widths.pop()
+    if width == 1:
+        return Recording("impacts", {"all": [r[0] for r in rows]})
+    if width == 2:
+        return Recording("trajectory", {"all": ([r[0] for r in rows], [r[1] for r in rows])})
+    raise CLIError(f"{width} unnamed columns: give the file a header (t, y) or (impact_time)")
+
+
+def _pick(columns, names):
+    lowered = {c.strip().lower(): c for c in columns}
+    for name in names:
+        if name in lowered:
+            return lowered[name]
+    return None
+
+
+def _read_csv(text, where, fmt):
+    reader = csv.DictReader(io.StringIO(text))
+    columns = reader.fieldnames or []
+    rows = list(reader)
+    for condition in where:
+        column, sep, value = condition.partition("=")
+        if not sep or column not in columns:
+            raise CLIError(
+                f"--where {condition!r}: need COLUMN=VALUE with COLUMN one of {', '.join(columns)}"
+            )
+        rows = [r for r in rows if r[column].strip() == value.strip()]
+    if not rows:
+        raise CLIError("no rows left after --where")
+    impact_column = _pick(columns, _IMPACT_NAMES)
+    time_column = _pick(columns, _TIME_NAMES)
+    height_column = _pick(columns, _HEIGHT_NAMES)
+    kind = fmt
+    if kind == "auto":
+        kind = "trajectory" if time_column and height_column and not impact_column else "impacts"
+    if kind == "trajectory":
+        if not (time_column and height_column):
+            raise CLIError(
+                f"a trajectory needs a time column ({', '.join(_TIME_NAMES)}) and a height "
+                f"column ({', '.join(_HEIGHT_NAMES)}); the file has {', '.join(columns)}"
+            )
+        used = {time_column, height_column}
+    else:
+        impact_column = impact_column or time_column
+        if impact_column is None:
+            raise CLIError(
+                "impact times need a column named one of "
+                f"{', '.join(_IMPACT_NAMES + _TIME_NAMES)}; the file has {', '.join(columns)}"
+            )
+        used = {impact_column}
+    group_by = [c for c in columns if c not in used and c.strip().lower() not in _IGNORED]
+    groups: dict = {}
+    for row in rows:
+        key = ", ".join(f"{c}={row[c]}" for c in group_by if c != "source_file") or "all"
+        groups.setdefault(key, []).append(row)
+
+    def numbers(group, column):
+        values = [_number(r[column]) for r in group]
+        if any(v is None for v in values):
+            raise CLIError(f"column {column!r} has a value that is not a number")
+        return values
+
+    if kind == "trajectory":
+        data = {k: (numbers(g, time_column), numbers(g, height_column)) for k, g in groups.items()}
+    else:
+        data = {k: numbers(g, impact_column) for k, g in groups.items()}
+    return Recording(kind, data, columns=tuple(columns))
+
+
+def read_recording(path: Path, fmt: str = "auto", where=()) -> Recording:
+    """Read FILE (see the module docstring); a `CLIError` for anything it cannot use."""
+    try:
+        text = path.read_text()
+    except OSError as error:
+        raise CLIError(f"cannot read {path}: {error.strerror or error}") from None
+    except UnicodeDecodeError:
+        raise CLIError(f"{path} is not a text file") from None
+    lines = [line for line in text.splitlines() if line.strip()]
+    if not lines:
+        raise CLIError(f"{path} is empty")
+    head = lines[0].replace(",", " ").split()
+    if head[:1] == ["Frame"] and "Y1" in head:
+        if fmt == "impacts":
+            raise CLIError(f"{path} is a video track (MTrack2), not impact times")
+        if where:
+            raise CLIError("--where applies to CSV files with named columns")
+        return _read_mtrack(lines)
+    if all(_number(p) is not None for p in head):
+        recording = _read_plain(lines)
+        if where:
+            raise CLIError("--where applies to CSV files with named columns")
+    else:
+        recording = _read_csv(text, where, fmt)
+    if fmt != "auto" and recording.kind != fmt:
+        raise CLIError(f"{path} holds {recording.kind}, not {fmt}")
+    return recording
+
+
+# ----------------------------------------------------------------------------- fitting
+
+
+def _options(args, recording):
+    if args.length_scale is None:
+        length_scale = "fit" if recording.video else None
+    elif args.length_scale == "fit":
+        length_scale = "fit"
+    else:
+        length_scale = _number(args.length_scale)
+        if length_scale is None or length_scale <= 0:
+            raise CLIError(
+                f"--length-scale must be a number > 0 or 'fit', got {args.length_scale!r}"
+            )
+    y_axis = args.y_axis or ("down" if recording.video else "up")
+    return length_scale, y_axis
+
+
+def _fit_one(law, args, recording, data, length_scale, y_axis):
+    import numpy as np
+
+    from ._fit_bounces import fit_bounces
+
+    common = dict(
+        m=args.mass,
+        free=args.free,
+        g=args.gravity,
+        separation=args.separation,
+        drag=args.drag,
+        fit_drag=args.fit_drag,
+        sigma=args.sigma,
+    )
+    if recording.kind == "impacts":
+        return fit_bounces(law, impact_times=np.asarray(data, dtype=float), **common)
+    t, y = (np.asarray(a, dtype=float) for a in data)
+    if recording.video:
+        if args.frame_rate is None:
+            raise CLIError("a video track's time is in frames: give --frame-rate FPS")
+        t = t / args.frame_rate
+    elif args.frame_rate is not None:
+        t = t / args.frame_rate
+    return fit_bounces(law, t=t, y=y, length_scale=length_scale, y_axis=y_axis, **common)
+
+
+def _summary(fit) -> dict:
+    import numpy as np
+
+    data = dict(
+        kind=fit.kind,
+        law=getattr(fit.law, "name", "custom"),
+        params=fit.params,
+        stderr=fit.stderr,
+        free=list(fit.free),
+        undetermined=list(fit.undetermined),
+        nuisance=fit.nuisance,
+        e=fit.e,
+        e_stderr=fit.e_stderr,
+        impact_speeds=fit.impact_speeds,
+        impact_times=fit.impact_times,
+        T=fit.T,
+        sigma=fit.sigma,
+        dof=fit.dof,
+        loss=fit.loss,
+        converged=fit.converged,
+        iterations=fit.iterations,
+        dropped=fit.dropped,
+    )
+    if fit.kind == "impacts":
+        data.update(missed=fit.missed, used=int(np.size(fit.times)))
+    else:
+        data.update(used=int(np.size(fit.t)))
+    return data
+
+
+def _text(name, fit, units) -> str:
+    import numpy as np
+
+    lines = [
+        f"{name}: {fit.kind}, {'converged' if fit.converged else 'NOT converged'} "
+        f"after {fit.iterations} iterations, noise {format_number(fit.sigma, 3)} {units}"
+    ]
+    for key, value in fit.params.items():
+        if key in fit.undetermined:
+            shown = f"{format_number(value)}  (undetermined by these data: held, not estimated)"
+        elif key in fit.free:
+            shown = f"{format_number(value)} ± {format_number(fit.stderr[key], 2)}"
+        else:
+            shown = f"{format_number(value)}  (held)"
+        lines.append(f"  {key:<12} = {shown}")
+    q = fit.nuisance
+    lines.append(
+        f"  first impact at {q['t_impact']:.4f} s, {q['v_impact']:.4f} m/s "
+        f"(drop height {q['drop_height']:.4f} m)"
+    )
+    if "floor" in q:
+        lines.append(
+            f"  floor {format_number(q['floor'])}, scale {format_number(q['length_scale'])} "
+            f"{units}/m"
+        )
+    if "drag" in q:
+        lines.append(f"  drag {format_number(q['drag'])} 1/m")
+    if fit.kind == "impacts":
+        lines.append(
+            f"  used {np.size(fit.times)} detections; dropped {list(map(int, fit.dropped))}, "
+            f"missed impacts {list(map(int, fit.missed))}"
+        )
+    else:
+        lines.append(f"  used {np.size(fit.t)} samples; dropped {np.size(fit.dropped)}")
+    lines.append("  impact  speed (m/s)  e")
+    for k in range(min(fit.num_impacts, 12)):
+        lines.append(
+            f"  {k:>6}  {fit.impact_speeds[k]:11.4f}  {fit.e[k]:.4f} ± {fit.e_stderr[k]:.4f}"
+        )
+    if fit.num_impacts > 12:
+        lines.append(f"  ... {fit.num_impacts - 12} more")
+    return "\n".join(lines)
+
+
+def _plot(fits, recording, path):
+    import numpy as np
+
+    fig = new_figure(figsize=(13.5, 4.2), layout="constrained")
+    axes = fig.subplots(1, 3)
+    if recording.kind == "trajectory":
+        name, fit = next(iter(fits.items()))
+        ts = np.linspace(float(np.min(fit.t)), float(np.max(fit.t)), 1500)
+        axes[0].plot(fit.t, fit.y, ".", ms=3, label="measured")
+        axes[0].plot(ts, fit.predict(ts), "-", lw=1.2, label="fitted")
+        if fit.y_sign < 0:
+            axes[0].invert_yaxis()
+        axes[0].set_xlabel("time (s)")
+        axes[0].set_ylabel("height (data units)")
+        axes[0].set_title(f"{name}: measured and fitted")
+        axes[0].legend(fontsize="small")
+        axes[1].plot(fit.t, fit.y - fit.y_fit, ".", ms=3)
+        axes[1].set_xlabel("time (s)")
+        axes[1].set_ylabel("residual (data units)")
+        axes[1].set_title("residuals")
+    else:
+        for name, fit in fits.items():
+            gaps = np.diff(fit.times)
+            whole = np.diff(fit.index) == 1
+            model = np.diff(fit.impact_times)
+            axes[0].plot(fit.index[:-1][whole], gaps[whole], "o", ms=3)
+            axes[0].plot(np.arange(model.size), model, "-", lw=1, color="0.3")
+            axes[1].plot(fit.times, fit.residuals * fit.sigma * 1e3, ".", ms=4, label=name)
+        axes[0].set_xlabel("impact number")
+        axes[0].set_ylabel("interval (s)")
+        axes[0].set_title("intervals: measured (dots), fitted (lines)")
+        axes[1].set_xlabel("time (s)")
+        axes[1].set_ylabel("residual (ms)")
+        axes[1].set_title("impact-time residuals")
+    for fit in fits.values():
+        axes[2].errorbar(fit.impact_speeds, fit.e, yerr=fit.e_stderr, fmt="o-", ms=3, lw=0.8)
+    axes[2].set_xlabel("impact speed (m/s)")
+    axes[2].set_ylabel("restitution e")
+    axes[2].set_title("fitted e against impact speed")
+    save_figure(fig, path)
+
+
+def run_fit(args):
+    check_plot_path(args.plot)
+    if not (math.isfinite(args.mass) and args.mass > 0):
+        raise CLIError(f"--mass must be a number > 0 kg, got {args.mass}")
+    if args.fit_drag and args.drag is None:
+        raise CLIError("--fit-drag needs a starting value: --drag K")
+    if args.frame_rate is not None and not args.frame_rate > 0:
+        raise CLIError(f"--frame-rate must be > 0, got {args.frame_rate}")
+    recording = read_recording(args.file, args.format, args.where)
+    law = law_from_args(args)
+    length_scale, y_axis = _options(args, recording)
+    from ._progress import Progress
+
+    fits = {}
+    with Progress(len(recording.groups), "fitting", enabled=sys.stderr.isatty()) as bar:
+        for name, data in recording.groups.items():
+            fits[name] = _fit_one(law, args, recording, data, length_scale, y_axis)
+            bar.update(name[:24])
+    units = "s" if recording.kind == "impacts" else ("px" if recording.video else "m")
+    if args.plot is not None:
+        _plot(fits, recording, args.plot)
+    payload = {
+        "file": str(args.file),
+        "kind": recording.kind,
+        "fits": {name: _summary(fit) for name, fit in fits.items()},
+    }
+    if args.plot is not None:
+        payload["plot"] = str(args.plot)
+
+    def text():
+        blocks = [_text(name, fit, units) for name, fit in fits.items()]
+        if args.plot is not None:
+            blocks.append(f"plot written to {args.plot}")
+        return "\n\n".join(blocks)
+
+    emit(args, payload, text)
+    return 0

@@ -1,0 +1,458 @@
+"""`calibrate` and `compare_laws`: round trips checked by the scipy integrator, several speeds,
+refusals, unreachable targets, standard errors, `jax.vmap`, model choice, the start tables.
+
+Targets come from the independent scipy integrator (`tests/reference.py`, DOP853 at rtol
+1e-12), never from jaximpact itself, and every fitted law is re-simulated by it.
+
+Compilation dominates: `calibrate` compiles once per (law, free parameters, optimizer, number
+of rows, which of e / T / sigmas are given), 10-40 s each on the 2-core test machine; values
+(targets, starts, masses, speeds) never recompile. The default set is grouped on seven such
+configurations: hertz_rate and kelvin_voigt at one row (round trips, the vmap loop), hertz_rate
+with lm at one row, hertz_rate and kelvin_voigt at five rows (several speeds, missing T,
+unreachable, model choice), hertz_rate at five rows with sigmas, and the vmapped fit. The
+other laws, corners and optimizers are marked slow.
+"""
+
+import functools
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+from helpers import PAPER_SETS, V0, M, assert_finite, assert_rel
+from reference import reference_impact
+
+import jaximpact as ji
+from jaximpact import _calibrate
+from jaximpact._hysteresis_damping import FORMULAS
+from jaximpact._restitution_tables import DAMPING, restitution_table
+
+SPEEDS = (0.5, 1.0, 2.5, 5.0, 10.0)  # m/s, the several-speed data sets
+LAW14 = dict(c=2e6, b1=800.0)  # the seed paper's fig. 10
+
+# every law with two or more parameters, its paper parameter set (helpers.PAPER_SETS; fig. 3
+# with b1 = 4e5, the one that gives the printed e) and what is fitted (the rest stays given)
+_PAPER = {name: params for name, params, _, _ in reversed(PAPER_SETS)}
+ROUND_TRIPS = {
+    "kelvin_voigt": ("c", "b"),
+    "kelvin_voigt_modified": ("c", "b1"),
+    "bingham": ("c", "b"),
+    "bingham_modified": ("c", "b1"),
+    "bingham_compression": ("c", "P"),
+    "maxwell": ("c", "b"),
+    "hertz_viscous": ("c", "b"),
+    "hertz_modified": ("c", "b"),
+    "hertz_rate": ("c", "b1"),
+    "hunt_crossley": ("c", "a"),
+    "lankarani_nikravesh": ("c", "e_nominal"),  # a Hunt-Crossley law set by a nominal e
+}
+TRUE = {**_PAPER, "lankarani_nikravesh": dict(c=2e6, e_nominal=0.8)}
+DEFAULT_LAWS = ("hertz_rate", "kelvin_voigt")
+
+
+# ------------------------------------------------------------------------ helpers
+
+
+@functools.cache
+def _reference(name, params_items, v0, separation="force"):
+    params = dict(params_items)
+    if name in FORMULAS:  # c x^n (1 + D v) with D = formula(e_nominal, v0) = 1.5 a
+        damping = float(FORMULAS[name](params["e_nominal"], v0))
+        name, params = "hunt_crossley", dict(c=params["c"], a=damping / 1.5, n=1.5)
+    result = reference_impact(name, params, m=M, v0=float(v0), separation=separation)
+    assert result["status"] == "separated", (name, params, result)
+    return result["e"], result["T"]
+
+
+def reference(name, params, v0s, separation="force"):
+    """(e, T) arrays from the scipy integrator at each speed of `v0s`."""
+    params = tuple(sorted((k, float(v)) for k, v in params.items()))
+    rows = [_reference(name, params, float(v), separation) for v in np.atleast_1d(v0s)]
+    return np.array([r[0] for r in rows]), np.array([r[1] for r in rows])
+
+
+def far_start(name, free, factor):
+    """The true parameters with each free one off by `factor` (10 or 0.1); a nominal
+    restitution cannot be 10 times 0.8, so `e_nominal` moves to 0.98 (1 - e ten times
+    smaller) or 0.08 (e ten times smaller)."""
+    start = dict(TRUE[name])
+    for key in free:
+        if key == "e_nominal":
+            start[key] = 0.98 if factor > 1 else 0.08
+        else:
+            start[key] = start[key] * factor
+    return ji.law(name, **start)
+
+
+def fitted(fit):
+    return {k: float(v) for k, v in fit.params.items()}
+
+
+def check_round_trip(name, start, *, init="given", optimizer="lbfgs", what=""):
+    free, true = ROUND_TRIPS[name], TRUE[name]
+    e, T = reference(name, true, V0)
+    fit = ji.calibrate(start, m=M, v0=V0, e=e, T=T, free=free, init=init, optimizer=optimizer)
+    what = f"{name} {what} {init} {optimizer}"
+    assert bool(fit.converged), f"{what}: not converged, {fitted(fit)}, loss {float(fit.loss)}"
+    for key in free:
+        assert_rel(fit.params[key], true[key], 1e-6, f"{what}: {key}")
+    e_again, T_again = reference(name, fitted(fit), V0)
+    assert_rel(e_again, e, 1e-8, f"{what}: e of the fitted law, re-simulated by scipy")
+    assert_rel(T_again, T, 1e-8, f"{what}: T of the fitted law, re-simulated by scipy")
+    return fit
+
+
+# ------------------------------------------------------------------- (a) round trips
+
+
+@pytest.mark.parametrize("name", DEFAULT_LAWS)
+def test_round_trip_from_far_starts(name):
+    """From every parameter 10 times too large, then 10 times too small (init="given"),
+    and from the table start (init="auto"): the paper's parameters come back to 1e-6 and
+    the independent integrator reproduces e and T to 1e-8."""
+    free = ROUND_TRIPS[name]
+    for factor in (10.0, 0.1):
+        check_round_trip(name, far_start(name, free, factor), what=f"x{factor:g}")
+    fit = check_round_trip(name, far_start(name, free, 10.0), init="auto", what="x10")
+    assert int(fit.iterations) <= 12  # the table start is close: a handful of iterations
+
+
+def test_round_trip_levenberg_marquardt():
+    check_round_trip("hertz_rate", far_start("hertz_rate", ("c", "b1"), 10.0), optimizer="lm")
+    fit = check_round_trip(
+        "hertz_rate", far_start("hertz_rate", ("c", "b1"), 0.1), optimizer="lm", init="auto"
+    )
+    assert fit.optimizer == "lm"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("optimizer", ("lbfgs", "lm"))
+@pytest.mark.parametrize("name", tuple(ROUND_TRIPS))
+def test_round_trip_every_law(name, optimizer):
+    """Every law with two or more parameters, from both far corners and the auto start."""
+    free = ROUND_TRIPS[name]
+    for factor in (10.0, 0.1):
+        check_round_trip(name, far_start(name, free, factor), optimizer=optimizer)
+    check_round_trip(name, far_start(name, free, 10.0), init="auto", optimizer=optimizer)
+
+
+# mixed corners (stiffness and damping off in opposite directions) that do not come back:
+# kelvin_voigt_modified: the force-criterion event (reduced force 1 + beta V, which never
+# crosses zero for this law) raises inside the event root finder's derivative at heavy
+# damping; bingham: the start sticks (e = 0, a flat loss); lm, hertz_modified: a local minimum
+MIXED_FAILURES = {
+    ("kelvin_voigt_modified", 0.1, "lbfgs"),
+    ("kelvin_voigt_modified", 0.1, "lm"),
+    ("bingham", 0.1, "lbfgs"),
+    ("bingham", 0.1, "lm"),
+    ("hertz_modified", 10.0, "lm"),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("optimizer", ("lbfgs", "lm"))
+@pytest.mark.parametrize("c_factor", (10.0, 0.1))
+@pytest.mark.parametrize("name", tuple(ROUND_TRIPS))
+def test_round_trip_mixed_corners(name, c_factor, optimizer):
+    """Stiffness off by `c_factor`, the other free parameter by its inverse."""
+    if (name, c_factor, optimizer) in MIXED_FAILURES:
+        pytest.xfail("known: see MIXED_FAILURES")
+    free = ROUND_TRIPS[name]
+    start = far_start(name, free, 1.0 / c_factor)
+    start = start.replace(c=TRUE[name]["c"] * c_factor)
+    check_round_trip(name, start, optimizer=optimizer, what=f"c x{c_factor:g}")
+
+
+# ------------------------------------------------------------------ (b) several speeds
+
+
+def test_law14_at_five_speeds():
+    """The paper's law 14, whose e falls with speed, fitted to e and T at five speeds from
+    a start 10 times off: c and b1 to 1e-6, e and T re-simulated by scipy to 1e-8."""
+    e, T = reference("hertz_rate", LAW14, SPEEDS)
+    assert np.all(np.diff(e) < 0)  # e falls with speed: a velocity-dependent law
+    for init in ("given", "auto"):
+        start = ji.law("hertz_rate", c=2e7, b1=8e3)
+        fit = ji.calibrate(start, m=M, v0=SPEEDS, e=e, T=T, init=init)
+        assert bool(fit.converged) and fit.free == ("c", "b1")
+        assert_rel(fit.params["c"], LAW14["c"], 1e-6, f"c ({init})")
+        assert_rel(fit.params["b1"], LAW14["b1"], 1e-6, f"b1 ({init})")
+        e_again, T_again = reference("hertz_rate", fitted(fit), SPEEDS)
+        assert_rel(e_again, e, 1e-8, "e re-simulated")
+        assert_rel(T_again, T, 1e-8, "T re-simulated")
+        assert fit.e.shape == fit.T.shape == (5,) and fit.residuals.shape == (10,)
+        assert_rel(fit.e, e, 1e-8, "predicted e")
+
+
+# ---------------------------------------------------------------- (e) e without T
+
+
+def test_rows_without_T():
+    """A row may have e without T (None in a list, NaN in an array): its T residual is 0,
+    its T is still predicted, and law 14 still comes back from three T and five e."""
+    e, T = reference("hertz_rate", LAW14, SPEEDS)
+    rows = [T[0], None, T[2], None, T[4]]
+    start = ji.law("hertz_rate", c=2e7, b1=8e3)
+    fit = ji.calibrate(start, m=M, v0=SPEEDS, e=e, T=rows, init="given")
+    assert bool(fit.converged)
+    assert_rel(fit.params["c"], LAW14["c"], 1e-6, "c")
+    assert_rel(fit.params["b1"], LAW14["b1"], 1e-6, "b1")
+    assert np.all(np.asarray(fit.residuals)[5:][[1, 3]] == 0.0)
+    assert np.array_equal(np.isnan(np.asarray(fit.T_target)), [False, True, False, True, False])
+    assert_rel(fit.T, T, 1e-8, "T predicted at every row, measured or not")
+    as_array = ji.calibrate(start, m=M, v0=SPEEDS, e=e, T=np.where([1, 0, 1, 0, 1], T, np.nan))
+    assert_rel(as_array.params["c"], fit.params["c"], 1e-12, "NaN rows as None rows")
+
+
+@pytest.mark.slow
+def test_e_alone():
+    """Without any T only the damping is fitted (e of law 14 fixes b1 / c^0.6 alone)."""
+    e, _ = reference("hertz_rate", LAW14, SPEEDS)
+    fit = ji.calibrate(ji.law("hertz_rate", c=2e6, b1=80.0), m=M, v0=SPEEDS, e=e)
+    assert fit.free == ("b1",) and bool(fit.converged)
+    assert_rel(fit.params["b1"], LAW14["b1"], 1e-6, "b1")
+    assert np.all(np.isnan(np.asarray(fit.T_target))) and np.all(np.isfinite(fit.T))
+
+
+# ------------------------------------------------------ (c) refusals before any work
+
+
+def _no_work(*args, **kwargs):
+    raise AssertionError("calibrate started a fit instead of refusing the input")
+
+
+BAD_INPUTS = [
+    (dict(e=1.2, T=7.8e-3), "restitution e must lie in (0, 1]"),
+    (dict(e=0.0, T=7.8e-3), "restitution e must lie in (0, 1]"),
+    (dict(e=-0.3), "restitution e must lie in (0, 1]"),
+    (dict(e=[0.8, 1.5], v0=[1.0, 2.0]), "restitution e must lie in (0, 1]"),
+    (dict(e=0.8, T=0.0), "contact durations T must be finite and > 0"),
+    (dict(e=0.8, T=-1e-3), "contact durations T must be finite and > 0"),
+    (dict(e=0.8, T=np.inf), "contact durations T must be finite and > 0"),
+    (dict(e=np.nan, T=7.8e-3), "e contains NaN"),
+    (dict(e=[0.8, np.nan], v0=[1.0, 2.0]), "e contains NaN"),
+    (dict(e=0.8, T=[None, None], v0=[1.0, 2.0]), "T has no value"),
+    (dict(e=[0.8, 0.7, 0.6], v0=[1.0, 2.0]), "e has 3 values but v0 has 2"),
+    (dict(e=0.8, T=[7e-3, 6e-3, 5e-3], v0=[1.0, 2.0]), "T has 3 values but v0 has 2"),
+    (dict(e=[0.8, 0.7], sigma_e=[0.01, 0.01, 0.01], v0=[1.0, 2.0]), "sigma_e has 3 values"),
+    (dict(e=0.8, sigma_e=0.0), "sigma_e must be finite and > 0"),
+    (dict(e=0.8, T=7.8e-3, sigma_T=np.nan), "sigma_T must be finite and > 0"),
+    (dict(e=0.8, v0=0.0), "every impact speed v0 must be a finite number > 0"),
+    (dict(e=0.8, v0=[1.0, np.nan]), "every impact speed v0 must be a finite number > 0"),
+    (dict(e=0.8, m=-1.0), "mass m must be a finite number > 0"),
+    (dict(e=None, T=None), "give e, T or both"),
+    (dict(e=[[0.8]]), "e must be a number or a 1-D array"),
+    (dict(e=0.8, free=("c", "k")), "cannot fit k"),
+    (dict(e=0.8, free=()), "free names no parameter"),
+    (dict(e=0.8, optimizer="newton"), "optimizer must be one of"),
+    (dict(e=0.8, init="table"), "init must be 'auto' or 'given'"),
+]
+
+
+@pytest.mark.parametrize("bad, message", BAD_INPUTS, ids=[m for _, m in BAD_INPUTS])
+def test_refuses_impossible_targets_before_any_work(monkeypatch, bad, message):
+    monkeypatch.setattr(_calibrate, "_fit", _no_work)
+    kwargs = {"m": M, "v0": V0, **bad}
+    with pytest.raises(ValueError) as error:
+        ji.calibrate(ji.law("hertz_rate", **LAW14), **kwargs)
+    assert message in str(error.value)
+    assert "\n" not in str(error.value)
+
+
+def test_refuses_what_is_not_a_law(monkeypatch):
+    monkeypatch.setattr(_calibrate, "_fit", _no_work)
+    with pytest.raises(TypeError, match="calibrate needs a law"):
+        ji.calibrate({"c": 2e6, "b1": 800.0}, m=M, v0=V0, e=0.8)
+
+
+def test_accepts_the_edge_of_the_admissible(monkeypatch):
+    """e = 1 (a perfectly elastic measurement) and one T for several speeds are accepted."""
+    reached = []
+    monkeypatch.setattr(_calibrate, "_fit", lambda *a: reached.append(a) or "fit")
+    assert ji.calibrate(ji.law("hertz_rate", **LAW14), m=M, v0=V0, e=1.0) == "fit"
+    ji.calibrate(ji.law("hertz_rate", **LAW14), m=M, v0=[1.0, 2.0], e=0.8, T=5e-3)
+    _, data, *_ = reached[-1]
+    assert np.array_equal(np.asarray(data[2]), [5e-3, 5e-3])  # broadcast to every row
+
+
+# -------------------------------------------------------------- (d) unreachable targets
+
+
+def test_velocity_independent_law_cannot_follow_speeds():
+    """Kelvin-Voigt's e does not depend on speed: fitted to law 14's falling e at five
+    speeds it ends with converged=False, its best compromise and finite residuals."""
+    e, T = reference("hertz_rate", LAW14, SPEEDS)
+    fit = ji.calibrate(ji.law("kelvin_voigt", c=2e6, b=400.0), m=M, v0=SPEEDS, e=e, T=T)
+    assert not bool(fit.converged)
+    assert_finite(fit, "unreachable fit")
+    assert np.max(np.abs(fit.residuals)) > 1e-2
+    assert float(fit.loss) < float(fit.history[0])  # the best fit, not the start
+    assert np.ptp(np.asarray(fit.e)) < 1e-9  # one e for every speed
+    assert float(np.min(e)) < float(fit.e[0]) < float(np.max(e))  # in the middle of the data
+
+
+@pytest.mark.slow
+def test_stuck_start_ends_without_exception():
+    """A Bingham start that sticks (e = 0 at the start, a flat loss) ends with converged=False
+    and finite values, no exception."""
+    e, T = reference("bingham", TRUE["bingham"], V0)
+    start = ji.law("bingham", c=2e5, b=2000.0, P=400.0)
+    fit = ji.calibrate(start, m=M, v0=V0, e=e, T=T, free=("c", "b"), init="given")
+    assert not bool(fit.converged)
+    assert_finite(fit, "stuck start")
+
+
+# ---------------------------------------------------------------- (f) standard errors
+
+
+def _fd_standard_errors(params, free, v0s, sigma_e, sigma_T, h=1e-4):
+    """Standard errors from the Jacobian formula, `p sqrt(diag((J^T J)^-1))` with J the
+    weighted residuals' derivative in log p, by central differences of the scipy integrator."""
+    columns = []
+    for key in free:
+        up, down = dict(params), dict(params)
+        up[key], down[key] = params[key] * np.exp(h), params[key] * np.exp(-h)
+        (e_up, T_up), (e_down, T_down) = (
+            reference("hertz_rate", up, v0s),
+            reference("hertz_rate", down, v0s),
+        )
+        columns.append(
+            np.concatenate([(e_up - e_down) / sigma_e, (T_up - T_down) / sigma_T]) / (2 * h)
+        )
+    J = np.stack(columns, axis=1)
+    return {
+        k: params[k] * s
+        for k, s in zip(free, np.sqrt(np.diag(np.linalg.inv(J.T @ J))), strict=True)
+    }
+
+
+def test_standard_errors():
+    """With sigmas, `stderr` is the Jacobian formula (checked with scipy finite differences
+    to 1e-3) and matches the scatter of fits to noisy data (Monte Carlo, 40 data sets)."""
+    e, T = reference("hertz_rate", LAW14, SPEEDS)
+    sigma_e, sigma_T = np.full(5, 2e-3), 2e-3 * T
+    start = ji.law("hertz_rate", c=2e7, b1=8e3)
+
+    def fit(e_data, T_data):
+        return ji.calibrate(
+            start, m=M, v0=SPEEDS, e=e_data, T=T_data, sigma_e=sigma_e, sigma_T=sigma_T
+        )
+
+    exact = fit(e, T)
+    assert bool(exact.converged) and exact.stderr is not None
+    expected = _fd_standard_errors(LAW14, ("c", "b1"), SPEEDS, sigma_e, sigma_T)
+    for key in ("c", "b1"):
+        assert_rel(exact.stderr[key], expected[key], 1e-3, f"stderr of {key}")
+
+    rng = np.random.default_rng(20071)
+    draws = []
+    for _ in range(40):
+        noisy = fit(e + sigma_e * rng.standard_normal(5), T + sigma_T * rng.standard_normal(5))
+        draws.append([float(noisy.params["c"]), float(noisy.params["b1"])])
+    scatter = np.std(np.asarray(draws), axis=0, ddof=1)
+    for i, key in enumerate(("c", "b1")):
+        assert_rel(scatter[i], float(exact.stderr[key]), 0.3, f"Monte Carlo scatter of {key}")
+    without = ji.calibrate(start, m=M, v0=SPEEDS, e=e, T=T)
+    assert without.stderr is None
+
+
+# ------------------------------------------------------------------------ (g) vmap
+
+
+def test_vmap_over_bodies_matches_the_loop():
+    """`jax.vmap` over a lambda is the batch of fits: 8 bodies, each its own mass and
+    targets, give what 8 calls give."""
+    rng = np.random.default_rng(3)
+    n = 8
+    masses = np.exp(rng.uniform(np.log(0.2), np.log(5.0), n))
+    cs = LAW14["c"] * np.exp(rng.uniform(-1.0, 1.0, n))
+    b1s = LAW14["b1"] * np.exp(rng.uniform(-1.0, 1.0, n))
+    targets = []
+    for m, c, b1 in zip(masses, cs, b1s, strict=True):
+        r = reference_impact("hertz_rate", dict(c=c, b1=b1), m=float(m), v0=V0)
+        targets.append((r["e"], r["T"]))
+    es, Ts = (np.array(column) for column in zip(*targets, strict=True))
+    start = ji.law("hertz_rate", c=1e6, b1=100.0)
+
+    def one(m, e, T):
+        return ji.calibrate(start, m=m, v0=V0, e=e, T=T)
+
+    batch = jax.vmap(one)(jnp.asarray(masses), jnp.asarray(es), jnp.asarray(Ts))
+    assert batch.params["c"].shape == (n,) and batch.e.shape == (n, 1)
+    assert np.all(np.asarray(batch.converged))
+    assert_rel(batch.params["c"], cs, 1e-6, "c of each body")
+    assert_rel(batch.params["b1"], b1s, 1e-6, "b1 of each body")
+    for i in range(n):
+        single = one(float(masses[i]), float(es[i]), float(Ts[i]))
+        assert_rel(batch.params["c"][i], single.params["c"], 1e-9, f"body {i}: c, vmap vs loop")
+        assert_rel(batch.params["b1"][i], single.params["b1"], 1e-9, f"body {i}: b1")
+        assert int(batch.iterations[i]) == int(single.iterations)
+
+
+# --------------------------------------------------------------- (h) model choice
+
+
+def test_compare_laws_ranks_the_true_law_first():
+    e, T = reference("hertz_rate", LAW14, SPEEDS)
+    ranking = ji.compare_laws(
+        m=M, v0=SPEEDS, e=e, T=T, laws=("kelvin_voigt", "hertz_rate"), progress=False
+    )
+    assert [r.name for r in ranking] == ["hertz_rate", "kelvin_voigt"]
+    best, other = ranking
+    assert best.chi2 < 1e-12 and bool(best.fit.converged) and best.k == 2
+    assert other.chi2 > 1e-4 and not bool(other.fit.converged)
+    assert best.aic is None  # no sigmas: ranked by the sum of squared residuals
+    assert_rel(best.fit.params["c"], LAW14["c"], 1e-6, "c of the winner")
+
+
+@pytest.mark.slow
+def test_compare_every_paper_law_with_sigmas():
+    """Every law of the paper on law 14's data with sigmas: law 14 has the smallest AIC."""
+    e, T = reference("hertz_rate", LAW14, SPEEDS)
+    ranking = ji.compare_laws(
+        m=M, v0=SPEEDS, e=e, T=T, sigma_e=1e-3, sigma_T=1e-3 * T, progress=False
+    )
+    assert ranking[0].name == "hertz_rate"
+    assert all(r.aic is not None and np.isfinite(r.aic) for r in ranking)
+    assert all(ranking[i].aic <= ranking[i + 1].aic for i in range(len(ranking) - 1))
+    for r in ranking:
+        assert_finite(r.fit, r.name)
+
+
+# --------------------------------------------------------- the tables behind init="auto"
+
+# Kelvin-Voigt-modified and Hunt-Crossley: the reduced force 1 + beta V only decays towards 0
+# (it never crosses it while x > 0), so the force criterion is the penetration one, and the
+# reference's force event, which watches that reduced force, misfires at heavy damping
+SAME_AS_PENETRATION = ("kelvin_voigt_modified", "hunt_crossley")
+TABLE_DEFECTS = {
+    ("kelvin_voigt_modified", "force"): "jaximpact's force event watches 1 + beta V too, and "
+    "fires early at heavy damping: tau 14% low at group 100 (e = 0.01); gap='x' for this law "
+    "would make it the penetration event, which is exact here",
+    ("hertz_modified", "force"): "the event x^0.5 + beta V = 0 is placed early at light "
+    "damping: tau 1.1e-4 low at group 1e-4, 5.5e-6 low at 4e-3 (penetration: 4e-10)",
+}
+
+
+@pytest.mark.parametrize("separation", ("force", "penetration"))
+@pytest.mark.parametrize("name", tuple(DAMPING))
+def test_restitution_tables_against_fresh_impacts(name, separation):
+    """The shipped nondimensional tables (e and T/t* against the damping group at unit
+    scales) agree with fresh impacts by the scipy integrator to 1e-6, at five nodes spread
+    over the range a measurement can have (0.01 <= e <= 0.9999)."""
+    if (name, separation) in TABLE_DEFECTS:
+        pytest.xfail(TABLE_DEFECTS[name, separation])
+    groups, e_table, tau_table = restitution_table(name, separation)
+    nodes = np.flatnonzero((e_table >= 0.01) & (e_table <= 0.9999))
+    assert len(nodes) >= 20, f"{name}/{separation}: the table misses measurable e"
+    damping = DAMPING[name]
+    reference_separation = "penetration" if name in SAME_AS_PENETRATION else separation
+    for i in nodes[np.linspace(0, len(nodes) - 1, 5).astype(int)]:
+        value = groups[i] / 1.5 if name == "hunt_crossley" else groups[i]
+        ref = reference_impact(
+            name, {"c": 1.0, damping: float(value)}, m=1.0, v0=1.0, separation=reference_separation
+        )
+        what = f"{name}/{separation} at group {groups[i]:.3g}"
+        assert ref["status"] == "separated", what
+        assert_rel(e_table[i], ref["e"], 1e-6, f"{what}: e", atol=1e-8)
+        assert_rel(tau_table[i], ref["T"], 1e-6, f"{what}: tau")

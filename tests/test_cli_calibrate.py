@@ -1,0 +1,220 @@
+"""`jaximpact calibrate`, run in-process through `main(argv)`.
+
+A fit compiles once per (law, free parameters, number of rows, e / T / sigmas given), so the
+runs below share three configurations with tests/test_calibrate.py: law 14 at one row and at
+five rows, Kelvin-Voigt at five rows (the `--law all` test narrows the model choice to two
+laws); the plot adds one impact solve. Every input error is caught before any compilation.
+"""
+
+import json
+import re
+
+import pytest
+from helpers import assert_rel
+from reference import reference_impact
+
+from jaximpact import _cli_calibrate, _model_choice
+from jaximpact._cli import main
+
+LAW14 = dict(c=2e6, b1=800.0)
+SPEEDS = (0.5, 1.0, 2.5, 5.0, 10.0)
+TARGET = reference_impact("hertz_rate", LAW14, m=1.0, v0=2.5)
+ONE = ["calibrate", "--law", "hertz_rate", "--mass", "1", "--v0", "2.5"]
+ONE += ["--e", repr(TARGET["e"]), "--T", repr(TARGET["T"])]
+
+
+@pytest.fixture(autouse=True)
+def _no_persistent_cache(monkeypatch):
+    """Keep the CLI from writing JAX's compilation cache into the user's home."""
+    monkeypatch.setenv("JAXIMPACT_CACHE_DIR", "")
+    monkeypatch.delenv("JAXIMPACT_DEBUG", raising=False)
+
+
+def run(capsys, argv):
+    try:
+        status = main(argv)
+    except SystemExit as exit:
+        status = exit.code
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def assert_one_line_error(status, out, err, contains):
+    assert status == 2, err
+    assert out == "" and "Traceback" not in err
+    lines = err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("jaximpact: error: "), err
+    assert contains in lines[0], lines[0]
+
+
+@pytest.fixture(scope="module")
+def law14_csv(tmp_path_factory):
+    """Law 14 at five speeds (scipy), the second row without T."""
+    path = tmp_path_factory.mktemp("data") / "drops.csv"
+    lines = ["# law 14, c = 2e6, b1 = 800, m = 1 kg", "v0,e,T"]
+    for i, v in enumerate(SPEEDS):
+        r = reference_impact("hertz_rate", LAW14, m=1.0, v0=v)
+        lines.append(f"{v},{r['e']!r},{'' if i == 1 else repr(r['T'])}")
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+# --------------------------------------------------------------------- one impact
+
+
+def test_one_impact_text(capsys):
+    status, out, err = run(capsys, ONE)
+    assert status == 0 and err == "", err
+    assert "law        hertz_rate (eq. 14: F = c x^1.5 + b1 x^0.5 v)" in out
+    assert re.search(r"^fitted     c  = 2e6 N/m\^1\.5$", out, flags=re.MULTILINE), out
+    assert re.search(r"^           b1 = 800 N s/m\^1\.5$", out, flags=re.MULTILINE), out
+    assert "converged after" in out and "start auto" in out
+    assert "7.845 ms" in out  # the T column: measured and fitted
+
+
+def test_one_impact_json_with_start_values(capsys):
+    """--param values of fitted parameters are a start (init given); JSON carries the rest."""
+    status, out, err = run(capsys, [*ONE, "--param", "c=2e7", "b1=8e3", "--json"])
+    assert status == 0 and err == ""
+    data = json.loads(out)
+    assert data["init"] == "given" and data["start"] == {"c": 2e7, "b1": 8e3}
+    assert data["converged"] is True and data["free"] == ["c", "b1"]
+    assert_rel(data["params"]["c"], LAW14["c"], 1e-6, "c")
+    assert_rel(data["params"]["b1"], LAW14["b1"], 1e-6, "b1")
+    (row,) = data["rows"]
+    assert row["v0"] == 2.5 and row["e"] == TARGET["e"] and row["T"] == TARGET["T"]
+    assert_rel(row["e_fit"], TARGET["e"], 1e-8, "e_fit")
+    assert data["stderr"] is None and data["optimizer"] == "lbfgs"
+
+
+def test_progress_bar(capsys, monkeypatch):
+    monkeypatch.setattr(_cli_calibrate, "_progress_enabled", lambda: True)
+    monkeypatch.setattr(_cli_calibrate._Ticker.__init__, "__defaults__", (0.0,))  # no delay
+    status, _, err = run(capsys, ONE)
+    assert status == 0
+    assert "calibrating hertz_rate [" in err and "1/1" in err and err.endswith("\n")
+
+
+# ----------------------------------------------------------------- several speeds
+
+
+def test_data_file_with_missing_T_and_plot(capsys, tmp_path, law14_csv):
+    png = tmp_path / "fit.png"
+    argv = ["calibrate", "--law", "hertz_rate", "--data", str(law14_csv), "--json"]
+    status, out, err = run(capsys, [*argv, "--plot", str(png)])
+    assert status == 0 and err == ""
+    data = json.loads(out)
+    assert data["converged"] is True
+    assert_rel(data["params"]["c"], LAW14["c"], 1e-6, "c")
+    assert_rel(data["params"]["b1"], LAW14["b1"], 1e-6, "b1")
+    assert [row["v0"] for row in data["rows"]] == list(SPEEDS)
+    assert data["rows"][1]["T"] is None and data["rows"][1]["T_fit"] > 0
+    assert png.is_file() and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert png.stat().st_size > 20_000
+
+
+def test_model_choice(capsys, monkeypatch, law14_csv):
+    """`--law all` (narrowed to two laws, plus one whose fit raises): the true law first, the
+    failing one reported, not fatal."""
+    laws = ("kelvin_voigt", "maxwell", "hertz_rate")
+    monkeypatch.setattr(_cli_calibrate, "MODEL_CHOICE_LAWS", laws)
+    compare_laws = _model_choice.compare_laws
+
+    def failing_maxwell(*, laws, **kwargs):
+        if laws == ("maxwell",):
+            raise RuntimeError("boom\nsecond line")
+        return compare_laws(laws=laws, **kwargs)
+
+    monkeypatch.setattr(_model_choice, "compare_laws", failing_maxwell)
+    status, out, err = run(capsys, ["calibrate", "--law", "all", "--data", str(law14_csv)])
+    assert status == 0 and err == ""
+    table = [line.split() for line in out.splitlines() if re.match(r"^\d+\s+\w+", line)]
+    assert [row[:2] for row in table] == [["1", "hertz_rate"], ["2", "kelvin_voigt"]]
+    assert table[0][6] == "yes" and table[1][6] == "no"  # converged
+    assert "ranked by the sum of squared residuals" in out and "best: hertz_rate" in out
+    assert "failed: maxwell (RuntimeError: boom)" in out
+    monkeypatch.setattr(_cli_calibrate, "MODEL_CHOICE_LAWS", ("kelvin_voigt", "hertz_rate"))
+    status, out, _ = run(capsys, ["calibrate", "--law", "all", "--data", str(law14_csv), "--json"])
+    data = json.loads(out)
+    assert data["best"] == "hertz_rate" and data["criterion"] == "chi2"
+    assert data["ranking"][0]["chi2"] < 1e-12 < data["ranking"][1]["chi2"]
+
+
+# -------------------------------------------------------------------- bad input
+
+
+def _csv(tmp_path, text):
+    path = tmp_path / "bad.csv"
+    path.write_text(text)
+    return str(path)
+
+
+BAD = [
+    (["--v0", "2.5", "--e", "1.5"], "restitution e must lie in (0, 1]"),
+    (["--v0", "2.5", "--e", "0.8", "--T", "-0.001"], "contact durations T must be finite and > 0"),
+    (["--v0", "0", "--e", "0.8"], "impact speed v0"),
+    (["--v0", "2.5", "--e", "0.8", "--mass", "0"], "--mass must be a finite number > 0"),
+    (["--v0", "2.5"], "give --v0 and --e"),
+    (["--e", "0.8"], "give --v0 and --e"),
+    (["--v0", "2.5", "--e", "0.8", "--free", "c,k"], "cannot fit k"),
+    (["--v0", "2.5", "--e", "0.8", "--param", "q=3"], "no parameter q"),
+    (["--v0", "2.5", "--e", "0.8", "--T", "8e-3", "--sigma-e", "0.01"], "sigma_e and sigma_T"),
+    (["--v0", "2.5", "--e", "0.8", "--sigma-T", "1e-4"], "sigma_T is given without any T"),
+    (["--v0", "2.5", "--e", "0.8", "--plot", "fit.xyz"], "unknown figure format"),
+    (["--v0", "2.5", "--e", "0.8", "--max-iter", "0"], "--max-iter"),
+]
+
+
+@pytest.mark.parametrize("argv, contains", BAD, ids=[c for _, c in BAD])
+def test_bad_input_is_one_line(capsys, argv, contains):
+    law = ["--law", "hertz_rate"]
+    assert_one_line_error(*run(capsys, ["calibrate", *law, *argv]), contains=contains)
+
+
+BAD_FILES = [
+    ("v0,e,T\n2.5,0.8,8e-3\n3,,7e-3\n", "line 3: no e"),
+    ("v0,e,x\n2.5,0.8,1\n", "unknown column 'x'"),
+    ("e,T\n0.8,8e-3\n", "no column 'v0'"),
+    ("v0,e\n2.5,0.8,1\n", "line 2: 3 cells for 2 columns"),
+    ("v0,e\n2.5,high\n", "line 2, column e: 'high' is not a number"),
+    ("v0,e\n", "has a header but no rows"),
+    ("v0,e,T,sigma_e,sigma_T\n1,0.8,8e-3,0.01,\n", "sigma_T is missing on a row with a T"),
+    ("v0,e,sigma_e\n1,0.8,0.01\n2,0.7,\n", "sigma_e is missing on some rows"),
+    ("v0,e\n1,0.8\n2,1.2\n", "restitution e must lie in (0, 1]"),
+]
+
+
+@pytest.mark.parametrize("text, contains", BAD_FILES, ids=[c for _, c in BAD_FILES])
+def test_bad_data_file_is_one_line(capsys, tmp_path, text, contains):
+    argv = ["calibrate", "--law", "hertz_rate", "--data", _csv(tmp_path, text)]
+    assert_one_line_error(*run(capsys, argv), contains=contains)
+
+
+def test_conflicting_and_missing_sources(capsys, tmp_path):
+    path = _csv(tmp_path, "v0,e\n1,0.8\n")
+    argv = ["calibrate", "--law", "hertz_rate", "--data", path, "--e", "0.8"]
+    assert_one_line_error(*run(capsys, argv), contains="give either --data or --e, not both")
+    argv = ["calibrate", "--law", "hertz_rate", "--data", str(tmp_path / "none.csv")]
+    assert_one_line_error(*run(capsys, argv), contains="cannot read --data")
+    argv = ["calibrate", "--law", "all", "--data", path, "--free", "c"]
+    assert_one_line_error(*run(capsys, argv), contains="drop --free and --param")
+    argv = ["calibrate", "--law", "no_such_law", "--v0", "1", "--e", "0.8"]
+    assert_one_line_error(*run(capsys, argv), contains="unknown law 'no_such_law'")
+
+
+def test_free_accepts_commas_and_words():
+    args = type("Args", (), {"free": ["c,b1"]})()
+    assert _cli_calibrate._free_names(args) == ("c", "b1")
+    args.free = ["c", "b1"]
+    assert _cli_calibrate._free_names(args) == ("c", "b1")
+
+
+def test_model_choice_when_every_law_fails(capsys, monkeypatch, tmp_path):
+    monkeypatch.setattr(_cli_calibrate, "MODEL_CHOICE_LAWS", ("maxwell",))
+
+    def failing(**kwargs):
+        raise RuntimeError("boom")
+
+    monkeypatch.setattr(_model_choice, "compare_laws", failing)
+    argv = ["calibrate", "--law", "all", "--data", _csv(tmp_path, "v0,e\n1,0.8\n2,0.7\n")]
+    assert_one_line_error(*run(capsys, argv), contains="no law could be fitted: maxwell")
