@@ -156,7 +156,7 @@ def maxwell(c, b, m, v0):
 def power_spring(c, n, m, v0):
     """Undamped `F = c x^n`: `x_max = ((n+1) m v0^2/(2c))^(1/(n+1))` and
     `T = 2 (x_max/v0) B(1/(n+1), 1/2)/(n+1)` (B the Beta function); `e = 1`.
-    For Hertz (`n = 1.5`) `T = K (m^2/(c^2 v0))^(1/5)` with `K = 3.2145...`."""
+    For Hertz (`n = 1.5`) `T = K (m^2/(c^2 v0))^(1/5)` with `K = 3.2181`."""
     x_max = ((n + 1.0) * m * v0**2 / (2.0 * c)) ** (1.0 / (n + 1.0))
     k = 1.0 / (n + 1.0)
     beta = jnp.exp(gammaln(k) + gammaln(0.5) - gammaln(k + 0.5))
