@@ -8,50 +8,11 @@ every report carries the load average and the CPU seen while it ran.
 
 import os
 import platform
-import statistics
 import subprocess
 import time
 
-
-def block(tree):
-    """`jax.block_until_ready` for JAX outputs, nothing for plain Python values."""
-    import jax
-
-    return jax.block_until_ready(tree)
-
-
-def time_call(fn, *args, rounds=7, min_round_s=0.05, max_total_s=20.0):
-    """Median and minimum seconds per call of `fn(*args)` (already compiled/warm).
-
-    Each round repeats the call until it has run `min_round_s`; a call slower than that is
-    one round by itself, and the number of rounds shrinks (down to 3) so that the whole
-    measurement stays near `max_total_s`.
-    """
-    start = time.perf_counter()
-    block(fn(*args))
-    once = time.perf_counter() - start
-    calls = max(1, int(min_round_s / max(once, 1e-7)))
-    rounds = max(3, min(rounds, int(max_total_s / max(once * calls, 1e-9))))
-    per_call = []
-    for _ in range(rounds):
-        start = time.perf_counter()
-        for _ in range(calls):
-            out = fn(*args)
-        block(out)
-        per_call.append((time.perf_counter() - start) / calls)
-    return statistics.median(per_call), min(per_call)
-
-
-def first_call(fn, *args):
-    """Seconds taken by the first call (tracing and compilation included) and its output."""
-    start = time.perf_counter()
-    out = block(fn(*args))
-    return time.perf_counter() - start, out
-
-
-def load_average() -> str:
-    one, five, fifteen = os.getloadavg()
-    return f"{one:.2f}, {five:.2f}, {fifteen:.2f}"
+# the timing helpers live in the package, shared with `jaximpact bench`
+from jaximpact._bench import block, first_call, load_average, time_call  # noqa: F401
 
 
 def machine() -> dict:

@@ -313,7 +313,7 @@ def machine():
     )
 
 
-def markdown(info, load_start, load_end, tables, command):
+def markdown(info, loads, tables, command):
     t, sp, order, mem, shard = (
         tables[k] for k in ("throughput", "scipy", "order", "memory", "sharded")
     )
@@ -332,10 +332,13 @@ def markdown(info, load_start, load_end, tables, command):
         "```",
         "",
         f"Python {info['python']}, jax {info['jax']}, numpy {info['numpy']}. Load average "
-        f"(1, 5, 15 min) at the start: {load_start[0]:.2f}, {load_start[1]:.2f}, "
-        f"{load_start[2]:.2f}; at the end: {load_end[0]:.2f}, {load_end[1]:.2f}, "
-        f"{load_end[2]:.2f}. The VM's 2 cores are shared with other sessions: timings vary "
-        "by up to 2x between runs.",
+        "(1, 5, 15 min) at the start and the end of each part: "
+        + "; ".join(
+            f"{part} {a[0]:.1f}, {a[1]:.1f}, {a[2]:.1f} -> {b[0]:.1f}, {b[1]:.1f}, {b[2]:.1f}"
+            for part, (a, b) in loads.items()
+        )
+        + ". The VM's 2 cores are shared with other sessions: timings vary by up to 2x "
+        "between runs.",
         "",
         "## Impacts per second against batch size",
         "",
@@ -448,49 +451,45 @@ def main():
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--out", default=os.path.join(HERE, "batch.md"))
     parser.add_argument(
+        "--parts",
+        help="comma-separated subset of throughput,scipy,order,memory,sharded to run, merged "
+        "into the tables saved beside --out (.json)",
+    )
+    parser.add_argument(
         "--markdown-only", action="store_true", help="rewrite the .md from the saved .json"
     )
     args = parser.parse_args()
     saved = os.path.splitext(args.out)[0] + ".json"
-    if args.markdown_only:
-        with open(saved) as handle:
-            data = json.load(handle)
-        text = markdown(
-            data["machine"], data["load_start"], data["load_end"], data["tables"], data["command"]
-        )
-        with open(args.out, "w") as handle:
-            handle.write(text)
-        print(text)
-        return
     command = "python benchmarks/batch.py" + (" --quick" if args.quick else "")
-    load_start = os.getloadavg()
     sizes = SIZES[:-1] if args.quick else SIZES
     big = 10_000 if args.quick else 100_000
-    tables = dict(
-        throughput=throughput(sizes, args.repeat),
-        scipy=scipy_times(10 if args.quick else 40),
-        order=cost_ordering(4096 if args.quick else 16384, args.repeat),
-        memory=memory(big),
-        sharded=sharded(
+    parts = {
+        "throughput": lambda: throughput(sizes, args.repeat),
+        "scipy": lambda: scipy_times(10 if args.quick else 40),
+        "order": lambda: cost_ordering(4096 if args.quick else 16384, args.repeat),
+        "memory": lambda: memory(big),
+        "sharded": lambda: sharded(
             {"paper": 8192, "wide": 4096} if args.quick else {"paper": 32768, "wide": 8192},
             args.repeat,
         ),
-    )
-    load_end = os.getloadavg()
-    info = machine()
-    with open(saved, "w") as handle:
-        json.dump(
-            dict(
-                machine=info,
-                load_start=load_start,
-                load_end=load_end,
-                tables=tables,
-                command=command,
-            ),
-            handle,
-            indent=1,
-        )
-    text = markdown(info, load_start, load_end, tables, command)
+    }
+    tables, loads = {}, {}
+    if (args.parts or args.markdown_only) and os.path.exists(saved):
+        with open(saved) as handle:
+            data = json.load(handle)
+        tables, loads = data["tables"], data["loads"]
+    if not args.markdown_only:
+        for part in list(parts) if args.parts is None else args.parts.split(","):
+            start = os.getloadavg()
+            tables[part] = parts[part]()
+            loads[part] = [start, os.getloadavg()]
+        with open(saved, "w") as handle:
+            json.dump(
+                dict(machine=machine(), loads=loads, tables=tables, command=command),
+                handle,
+                indent=1,
+            )
+    text = markdown(machine(), loads, tables, command)
     with open(args.out, "w") as handle:
         handle.write(text)
     print(text)

@@ -119,8 +119,15 @@ def run(args):
     import jaximpact as ji
 
     results = dict(machine=machine(), loads=[load_average()], rows=[], cli=[])
+    if args.resume and os.path.exists(JSON_PATH):
+        with open(JSON_PATH) as f:
+            results = json.load(f)
+        results["loads"].append(load_average())
     laws = args.laws or list(ji.LAW_NAMES)
+    done = {r["law"] for r in results["rows"]}
     for name in laws:
+        if name in done:
+            continue
         params = PAPER.get(name, NOMINAL)
         cold, warm = [], []
         for _ in range(args.repeat):
@@ -140,7 +147,7 @@ def run(args):
         print(json.dumps(row), flush=True)
         with open(JSON_PATH, "w") as f:
             json.dump(results, f, indent=1)
-    for _ in range(args.repeat):
+    for _ in range(0 if results["cli"] else args.repeat):
         cache = tempfile.mkdtemp(prefix="jaximpact-cli-")
         try:
             results["cli"].append(dict(cold_s=cli(cache), warm_s=cli(cache), warm2_s=cli(cache)))
@@ -240,6 +247,7 @@ def main():
     parser.add_argument("--laws", nargs="*")
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--report", action="store_true")
+    parser.add_argument("--resume", action="store_true")
     args = parser.parse_args()
     if args.report:
         with open(JSON_PATH) as f:

@@ -58,6 +58,7 @@ from scipy.integrate import solve_ivp  # noqa: E402
 
 import jaximpact as ji  # noqa: E402
 from jaximpact import closed_forms  # noqa: E402
+from jaximpact._bench import scipy_problem, scipy_solver  # noqa: E402, F401
 
 M, V0 = 1.0, 2.5
 CASES = {
@@ -191,72 +192,9 @@ def rel(value, ref):
 # ------------------------------------------------------------------------ scipy
 
 
-def scipy_problem(name, params):
-    """Right-hand side, initial state, absolute-tolerance scales and the force event of the
-    dimensional problem, written as a scipy user would (one phase: these laws are smooth
-    at maximum compression, so no split is needed)."""
-    c, m, v0 = params["c"], M, V0
-    if name == "maxwell":
-        b = params["b"]
-        t_star = math.sqrt(m / c)
-        x_star = v0 * t_star
-        scales = np.array([x_star, v0, c * x_star])
-
-        def rhs(t, y):
-            return [y[1], -y[2] / m, c * (y[1] - y[2] / b)]
-
-        def event(t, y):
-            return y[2] / (c * x_star)
-
-        return rhs, [0.0, v0, 0.0], scales, event, t_star
-    if name == "hunt_crossley":
-        n, p, b = 1.5, 1.5, 1.5 * params["a"] * c
-    else:
-        n, p = FAMILY[name]
-        b = params[DAMPING[name]]
-    x_star = (m * v0**2 / c) ** (1 / (n + 1))
-    scales = np.array([x_star, v0])
-    f_scale = c * x_star**n
-
-    def pos(x, q):
-        return x if q == 1 else (1.0 if q == 0 else max(x, 0.0) ** q)
-
-    def rhs(t, y):
-        x, v = y
-        return [v, -(c * pos(x, n) + b * pos(x, p) * v) / m]
-
-    if name == "hunt_crossley":
-
-        def event(t, y):
-            return y[0] / x_star
-
-    elif p == 0:
-
-        def event(t, y):
-            return (c * pos(y[0], n) + b * y[1]) / f_scale
-
-    else:
-
-        def event(t, y):
-            return min(y[0] / x_star, (c * pos(y[0], n - p) + b * y[1]) / (c * x_star ** (n - p)))
-
-    return rhs, [0.0, v0], scales, event, x_star / v0
-
-
-def scipy_solver(name, params, method, rtol):
-    rhs, y0, scales, event, t_star = scipy_problem(name, params)
-    event.terminal, event.direction = True, -1
-    atol = rtol * scales
-
-    def run():
-        sol = solve_ivp(
-            rhs, (0.0, 1e3 * t_star), y0, method=method, rtol=rtol, atol=atol, events=[event]
-        )
-        if not sol.t_events[0].size:
-            return float("nan"), float("nan"), sol.nfev
-        return -sol.y_events[0][0][1] / V0, sol.t_events[0][0], sol.nfev
-
-    return run
+# `scipy_problem(name, params)` and `scipy_solver(name, params, method, rtol)`: the
+# dimensional problem with its force event, as a scipy user writes it, shared with
+# `jaximpact bench` (imported above; m = 1 kg and v0 = 2.5 m/s are its defaults, M and V0).
 
 
 # ------------------------------------------------------------------------ Euler

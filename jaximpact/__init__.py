@@ -12,6 +12,7 @@ from ._design import (
     propagate_uncertainty as propagate_uncertainty,
     sensitivity_map as sensitivity_map,
 )
+from ._euler import euler_bounce as euler_bounce
 from ._fit_bounces import BounceFit as BounceFit, fit_bounces as fit_bounces
 from ._impact import ImpactResult as ImpactResult, impact as impact
 from ._laws import (
@@ -25,6 +26,7 @@ from ._laws import (
 )
 from ._maps import plot_map as plot_map, restitution_map as restitution_map
 from ._model_choice import compare_laws as compare_laws, starting_law as starting_law
+from ._paper import reproduce_paper as reproduce_paper
 from ._plotting import plot_impact as plot_impact
 from ._powers import safe_pow as safe_pow
 from ._status import Status as Status

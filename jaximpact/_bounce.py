@@ -436,7 +436,9 @@ def bounce(
     - `min_flight` (s): a flight shorter than this ends the sequence with the ball at rest
       (with a speed-independent restitution the bounces accumulate in finite time).
     - `solver`, `rtol`, `atol`, `max_steps`, `tau_max`, `rest_tol`, `peaks`: each contact's
-      solve, as in `impact`; `adjoint`: default picks the cheapest diffrax adjoint for the
+      solve, as in `impact` (`peaks=False` leaves `F_max` and `x_max` out and integrates each
+      contact in one phase; the histories always use the three phases, so they then agree with
+      the per-contact arrays to the solver's tolerance rather than exactly); `adjoint`: default picks the cheapest diffrax adjoint for the
       transformation in use (`ForwardMode` under `jax.jacfwd`).
     - `throw`: raise if the sequence failed or ran out of `max_impacts`.
     Differentiable (forward and reverse mode) in the law's parameters, `m`, `h0`, `v_drop`,

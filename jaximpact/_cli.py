@@ -515,6 +515,8 @@ COMMANDS: list[tuple[str, Callable | str]] = [
     ("simulate", _add_simulate),
     ("fit", "jaximpact._cli_fit:add_fit"),
     ("calibrate", "jaximpact._cli_calibrate:add_calibrate"),
+    ("paper", "jaximpact._cli_paper:add_paper"),
+    ("bench", "jaximpact._cli_bench:add_bench"),
 ]
 
 

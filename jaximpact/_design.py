@@ -1,14 +1,16 @@
-"""Design studies with gradients: a bumper, sensitivity maps, and uncertainty propagation.
+"""Design studies with gradients: a bumper, sensitivities, uncertainty, a drop.
 
 - `bumper_design`: the stiffness `c` and damping `b1` of law 14 (`c x^1.5 + b1 x^0.5 v`)
   that minimise the peak force over a range of impact speeds while the maximum compression
   stays under a bound and the restitution under a target (optax, constraints by penalty).
-  Several bounds run at once (vmapped): the trade-off curve of peak force against stroke.
+  Several (bound, target) pairs run at once (vmapped): trade-off curves in one compilation.
 - `jacobian_batch`, `sensitivity_map`: `de/dparam` and `dT/dparam` over a batch or a grid
   (forward-mode derivatives through the event-terminated solve).
 - `propagate_uncertainty`: the spread of `e` and `T` from scattered parameters, to first
   order (`J Sigma J^T`) and by Monte Carlo over the same law (vmapped), with the Monte Carlo
   sampling error that says whether the two agree.
+- `drop_design`: the drop height and mass that give a wanted sequence of bounce apexes
+  (Levenberg-Marquardt through `jaximpact.bounce`, forward mode).
 """
 
 import functools

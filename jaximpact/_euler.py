@@ -25,7 +25,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._checks import check_positive
+from ._checks import check_nonnegative, check_positive
 from ._laws import AbstractLaw
 
 SCHEMES = ("paper", "euler")
@@ -95,7 +95,10 @@ def _crossings(t, y, v):
     inside = y >= 0
     enter = np.flatnonzero(~inside[:-1] & inside[1:])
     leave = np.flatnonzero(inside[:-1] & ~inside[1:])
-    return at(enter), at(leave)
+    t_in, v_in = at(enter)
+    if inside[0]:  # dropped from the surface itself (h0 = 0): the contact starts at t[0]
+        t_in, v_in = np.concatenate([t[:1], t_in]), np.concatenate([v[:1], v_in])
+    return (t_in, v_in), at(leave)
 
 
 def euler_bounce(
@@ -115,7 +118,8 @@ def euler_bounce(
     fixed step `dt` (s; the paper's 2e-5) until `t_end` (s). `scheme`: `"paper"` (as
     printed, the force lagging one step) or `"euler"` (textbook explicit Euler). Keeps
     every `stride`-th step in the returned histories. Not differentiable in any useful sense
-    (the contact switches at grid points); a baseline, not a solver to use.
+    (the contact switches at grid points); a baseline, not a solver to use. `h0 = 0` and
+    `g = 0` give one impact at speed `v_drop` from first touch, as the paper's figures 2-11.
 
     **Example**:
     `euler_bounce(law("hertz_rate", c=1e6, b1=1350.0), m=1.0, h0=0.6, t_end=2.0).e[:4]`.
@@ -126,7 +130,8 @@ def euler_bounce(
         raise ValueError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
     for name, value, unit in (("mass m", m, "kg"), ("t_end", t_end, "s"), ("dt", dt, "s")):
         check_positive(name, value, unit)
-    check_positive("gravity g", g, "m/s^2")
+    check_nonnegative("gravity g", g, "m/s^2")
+    check_nonnegative("drop height h0", h0, "m")
     steps = int(np.ceil(float(t_end) / float(dt)))
     y, v, force = _integrate(
         law,

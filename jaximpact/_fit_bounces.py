@@ -11,10 +11,11 @@ bucket.
 What the data can and cannot say:
 - Impact times: each interval is a contact plus a flight, `T_k + 2 e_k v_k / g` without drag,
   so the intervals carry `e` and its speed dependence; the contact durations enter only as a
-  millisecond offset per interval, so the stiffness is held fixed by default and, if freed, is
-  usually reported undetermined.
-- A trajectory sampled more slowly than a contact lasts carries the same information plus the
-  drop height; samples that fall inside a contact are modelled by that contact's own solution.
+  small offset per interval, so the stiffness is held fixed by default; freed, the Jacobian
+  decides (short contacts against the timing noise: undetermined).
+- A trajectory carries the same plus the drop height; a contact shows as a delay between two
+  parabolas, and samples that fall inside a contact are modelled by that contact's own
+  solution.
 - Parameters whose standard error in log space exceeds 1 (a factor e), or that lie in a null
   direction of the Jacobian, are listed in `undetermined` with an infinite standard error.
 """
@@ -234,7 +235,7 @@ class BounceFit(eqx.Module):
     parameters fitted), `residuals` (`(model - data) / sigma` for the data used, with the
     reported `sigma`),
     `loss` (half their sum of squares), `converged`, `iterations`, `history` (loss per
-    accepted step). And:
+    accepted step of the last fit; `iterations` counts the steps of every stage). And:
 
     - `undetermined`: parameters the data cannot fix (see the module docstring); their
       values are the ones given, not estimates.
@@ -358,6 +359,8 @@ def _levenberg_marquardt(evaluate, theta0, active, *, max_iter, tol):
     lam, converged = 1e-3, False
     active = np.asarray(active, dtype=bool)
     for _ in range(max_iter):
+        if not (np.all(np.isfinite(J)) and np.all(np.isfinite(r))):
+            break  # the model failed here (e.g. a contact solve ran out of steps)
         Ja = J[:, active]
         A = Ja.T @ Ja
         grad = Ja.T @ r
@@ -368,7 +371,7 @@ def _levenberg_marquardt(evaluate, theta0, active, *, max_iter, tol):
             break
         improved = False
         while lam < 1e12:
-            step = np.linalg.solve(A + lam * np.diag(diag), -grad)
+            step = np.linalg.lstsq(A + lam * np.diag(diag), -grad, rcond=None)[0]
             trial = theta.copy()
             trial[active] += step
             r_new, J_new, extra_new = evaluate(trial)
@@ -563,7 +566,9 @@ def _with_impacts(options, n):
     return type(options)(impact=options.impact, max_impacts=int(n))
 
 
-def _run(law, free, nuisance, m, g, data, kind, y_sign, options, active, max_iter, tol):
+def _run(law, free, nuisance, m, g, data, kind, y_sign, options, active, max_iter, tol, log):
+    """One Levenberg-Marquardt fit through the compiled model; appends its number of
+    accepted steps to `log`."""
     spec = _Spec(
         kind=kind,
         free=free,
@@ -586,7 +591,9 @@ def _run(law, free, nuisance, m, g, data, kind, y_sign, options, active, max_ite
     theta0 = np.concatenate(
         [[float(_to_unbounded(k, law.parameters[k])) for k in free], np.zeros(len(nuisance))]
     )
-    return _levenberg_marquardt(evaluate, theta0, active, max_iter=max_iter, tol=tol)
+    result = _levenberg_marquardt(evaluate, theta0, active, max_iter=max_iter, tol=tol)
+    log.append(result[6])
+    return result
 
 
 def _tune_damping(law, free, nuisance, m, g, data, kind, y_sign, options, e_target):
@@ -800,6 +807,7 @@ def _fit_impacts(
     """Three fits with one compiled model: on the detections before the first anomaly that
     `clean_impact_times` finds; on every detection within `clean_tol` of the fitted
     model's impacts; without the outliers of that fit."""
+    log = []  # accepted steps of each fit
     raw = np.sort(np.asarray(impact_times, dtype=float).ravel())
     cleaned = _prepare_impacts(raw, clean_tol)
     kept_positions = np.setdiff1d(np.arange(raw.size), cleaned.dropped)
@@ -849,14 +857,14 @@ def _fit_impacts(
     law = _tune_damping(law, free, nuisance, m, g, data, "impacts", 1.0, opts, e0)
     active = np.ones(len(free) + len(nuisance), dtype=bool)
     first = _first_stage(law, free, nuisance)
-    result = _run(law, free, nuisance, m, g, data, "impacts", 1.0, opts, first, max_iter, tol)
+    result = _run(law, free, nuisance, m, g, data, "impacts", 1.0, opts, first, max_iter, tol, log)
     # every detection against the fitted model's impacts
     data, law = _rebase(data, law, free, nuisance, result[0])
     aux = result[3][2]
     predicted = aux["t_land"][aux["valid"]] if np.any(aux["valid"]) else aux["t_land"]
     keep, number = _assign(raw, predicted, clean_tol)
     data = with_mask(data, keep, number)
-    result = _run(law, free, nuisance, m, g, data, "impacts", 1.0, opts, active, max_iter, tol)
+    result = _run(law, free, nuisance, m, g, data, "impacts", 1.0, opts, active, max_iter, tol, log)
     r = result[1][: raw.size]
     if keep.sum() >= 10:  # a robust spread from fewer points is itself too uncertain
         outliers = _outliers(r, keep, outlier_sigma, sigma is not None)
@@ -865,9 +873,10 @@ def _fit_impacts(
             keep = keep & ~outliers
             data = with_mask(data, keep, number)
             result = _run(
-                law, free, nuisance, m, g, data, "impacts", 1.0, opts, active, max_iter, tol
+                law, free, nuisance, m, g, data, "impacts", 1.0, opts, active, max_iter, tol, log
             )
-    theta, r, J, extra, history, converged, iterations = result
+    theta, r, J, extra, history, converged, _ = result
+    iterations = sum(log)
     index = number[keep]
     return _finish(
         "impacts",
@@ -915,6 +924,7 @@ def _fit_trajectory(
     options,
     separation,
 ):
+    log = []  # accepted steps of each fit
     t = np.asarray(t, dtype=float).ravel()
     y = np.asarray(y, dtype=float).ravel()
     if t.shape != y.shape or t.size < 8:
@@ -979,18 +989,18 @@ def _fit_trajectory(
     # first the nuisance alone (the start can be far in time), then everything
     nuisance_only = np.arange(n_theta) >= len(free)
     result = _run(
-        law, free, nuisance, m, g, data, "trajectory", y_sign, opts, nuisance_only, 20, 1e-6
+        law, free, nuisance, m, g, data, "trajectory", y_sign, opts, nuisance_only, 20, 1e-6, log
     )
     data, law = _rebase(data, law, free, nuisance, result[0])
     first = _first_stage(law, free, nuisance)
     active = np.ones(n_theta, dtype=bool)
     if not first.all():
         result = _run(
-            law, free, nuisance, m, g, data, "trajectory", y_sign, opts, first, max_iter, tol
+            law, free, nuisance, m, g, data, "trajectory", y_sign, opts, first, max_iter, tol, log
         )
         data, law = _rebase(data, law, free, nuisance, result[0])
     result = _run(
-        law, free, nuisance, m, g, data, "trajectory", y_sign, opts, active, max_iter, tol
+        law, free, nuisance, m, g, data, "trajectory", y_sign, opts, active, max_iter, tol, log
     )
     r = result[1][: tu.size]
     outliers = _outliers(r, np.ones(tu.size, dtype=bool), outlier_sigma, sigma is not None)
@@ -999,9 +1009,10 @@ def _fit_trajectory(
         mask = ~outliers
         data["mask"] = np.pad(mask, (0, n_pad - tu.size))
         result = _run(
-            law, free, nuisance, m, g, data, "trajectory", y_sign, opts, active, max_iter, tol
+            law, free, nuisance, m, g, data, "trajectory", y_sign, opts, active, max_iter, tol, log
         )
-    theta, r, J, extra, history, converged, iterations = result
+    theta, r, J, extra, history, converged, _ = result
+    iterations = sum(log)
     predicted = extra[2]["predicted"][: tu.size]
     dropped = np.concatenate([positions[:keep_from], positions[keep_from:][outliers]]).astype(int)
     return _finish(

@@ -130,3 +130,28 @@ def jacobian(name, mode="forward", separation="force", rtol=1e-10):
         return jax.tree_util.tree_map(np.asarray, out)
 
     return call
+
+
+# ------------------------------------------------------------------ the command line
+
+
+def run_cli(capsys, argv):
+    """Run `jaximpact argv` in-process: (exit status, stdout, stderr)."""
+    from jaximpact._cli import main
+
+    try:
+        status = main(argv)
+    except SystemExit as exit:
+        status = exit.code
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def assert_one_line_error(status, out, err, expected_status=2, contains=""):
+    """The command line's bad-input contract: nothing on stdout, one line on stderr
+    (`jaximpact: error: ...`, holding `contains`), exit status 2, no traceback."""
+    assert status == expected_status, err
+    assert out == "" and "Traceback" not in err
+    lines = err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("jaximpact: error: "), err
+    assert contains in lines[0], lines[0]

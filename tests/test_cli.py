@@ -16,9 +16,10 @@ import pytest
 
 jax.config.update("jax_enable_x64", True)
 
+from helpers import assert_one_line_error, run_cli  # noqa: E402
+
 import jaximpact as ji  # noqa: E402
 from jaximpact import _cli  # noqa: E402
-from jaximpact._cli import main  # noqa: E402
 from jaximpact._plotting import plot_impact  # noqa: E402
 
 LAW = dict(c=2e6, b1=800.0)
@@ -33,31 +34,11 @@ def _no_persistent_cache(monkeypatch):
     monkeypatch.delenv("JAXIMPACT_DEBUG", raising=False)
 
 
-def run(capsys, argv):
-    """Run `jaximpact argv` in-process: (exit status, stdout, stderr)."""
-    try:
-        status = main(argv)
-    except SystemExit as exit:
-        status = exit.code
-    out, err = capsys.readouterr()
-    return status, out, err
-
-
-def assert_one_line_error(status, out, err, expected_status=2, contains=""):
-    assert status == expected_status
-    assert out == ""
-    lines = err.splitlines()
-    assert len(lines) == 1, err
-    assert lines[0].startswith("jaximpact: error: ")
-    assert "Traceback" not in err
-    assert contains in lines[0]
-
-
 # ------------------------------------------------------------------------------ laws
 
 
 def test_laws_table(capsys):
-    status, out, err = run(capsys, ["laws"])
+    status, out, err = run_cli(capsys, ["laws"])
     assert status == 0 and err == ""
     for name in ji.LAW_NAMES:
         assert f"\n{name} " in out
@@ -68,7 +49,7 @@ def test_laws_table(capsys):
 
 
 def test_laws_json(capsys):
-    status, out, _ = run(capsys, ["laws", "--json"])
+    status, out, _ = run_cli(capsys, ["laws", "--json"])
     assert status == 0
     laws = json.loads(out)["laws"]
     assert [row["name"] for row in laws] == list(ji.LAW_NAMES)
@@ -88,7 +69,7 @@ def test_laws_json(capsys):
 
 
 def test_simulate_text(capsys):
-    status, out, err = run(capsys, SIMULATE)
+    status, out, err = run_cli(capsys, SIMULATE)
     assert status == 0 and err == ""
     values = dict(re.findall(r"^(\w+)\s+= (.*)$", out, flags=re.MULTILINE))
     assert values["e"].startswith("0.83")
@@ -104,7 +85,7 @@ def test_simulate_json_and_plot(capsys, tmp_path):
     png = tmp_path / "impact.png"
     argv = ["simulate", "--law", "kelvin_voigt", "--param", "c=2e6", "b=400", "--v0", "2.5"]
     argv += ["--separation", "penetration", "--json", "--plot", str(png)]
-    status, out, err = run(capsys, argv)
+    status, out, err = run_cli(capsys, argv)
     assert status == 0 and err == ""
     data = json.loads(out)
     law = ji.law("kelvin_voigt", c=2e6, b=400.0)
@@ -142,12 +123,12 @@ def test_simulate_json_and_plot(capsys, tmp_path):
     ],
 )  # fmt: skip
 def test_simulate_bad_input(capsys, argv, contains):
-    assert_one_line_error(*run(capsys, ["simulate", *argv]), contains=contains)
+    assert_one_line_error(*run_cli(capsys, ["simulate", *argv]), contains=contains)
 
 
 @pytest.mark.parametrize("argv", [[], ["frobnicate"], ["laws", "--bogus"]])
 def test_usage_errors(capsys, argv):
-    assert_one_line_error(*run(capsys, argv))
+    assert_one_line_error(*run_cli(capsys, argv))
 
 
 def test_internal_error_is_one_line(capsys, monkeypatch):
@@ -155,12 +136,12 @@ def test_internal_error_is_one_line(capsys, monkeypatch):
         raise RuntimeError("boom\nsecond line")
 
     monkeypatch.setattr(_cli, "_run_laws", broken)
-    assert_one_line_error(*run(capsys, ["laws"]), expected_status=1, contains="boom")
+    assert_one_line_error(*run_cli(capsys, ["laws"]), expected_status=1, contains="boom")
 
 
 @pytest.mark.parametrize("command", [[]] + [[name] for name, _ in _cli.COMMANDS])
 def test_help_has_an_example(capsys, command):
-    status, out, _ = run(capsys, [*command, "--help"])
+    status, out, _ = run_cli(capsys, [*command, "--help"])
     assert status == 0
     assert "example:" in out and "jaximpact " in out.split("example:")[1]
 

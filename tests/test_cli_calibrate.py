@@ -10,11 +10,10 @@ import json
 import re
 
 import pytest
-from helpers import assert_rel
+from helpers import assert_one_line_error, assert_rel, run_cli
 from reference import reference_impact
 
 from jaximpact import _cli_calibrate, _model_choice
-from jaximpact._cli import main
 
 LAW14 = dict(c=2e6, b1=800.0)
 SPEEDS = (0.5, 1.0, 2.5, 5.0, 10.0)
@@ -28,23 +27,6 @@ def _no_persistent_cache(monkeypatch):
     """Keep the CLI from writing JAX's compilation cache into the user's home."""
     monkeypatch.setenv("JAXIMPACT_CACHE_DIR", "")
     monkeypatch.delenv("JAXIMPACT_DEBUG", raising=False)
-
-
-def run(capsys, argv):
-    try:
-        status = main(argv)
-    except SystemExit as exit:
-        status = exit.code
-    out, err = capsys.readouterr()
-    return status, out, err
-
-
-def assert_one_line_error(status, out, err, contains):
-    assert status == 2, err
-    assert out == "" and "Traceback" not in err
-    lines = err.splitlines()
-    assert len(lines) == 1 and lines[0].startswith("jaximpact: error: "), err
-    assert contains in lines[0], lines[0]
 
 
 @pytest.fixture(scope="module")
@@ -63,7 +45,7 @@ def law14_csv(tmp_path_factory):
 
 
 def test_one_impact_text(capsys):
-    status, out, err = run(capsys, ONE)
+    status, out, err = run_cli(capsys, ONE)
     assert status == 0 and err == "", err
     assert "law        hertz_rate (eq. 14: F = c x^1.5 + b1 x^0.5 v)" in out
     assert re.search(r"^fitted     c  = 2e6 N/m\^1\.5$", out, flags=re.MULTILINE), out
@@ -74,7 +56,7 @@ def test_one_impact_text(capsys):
 
 def test_one_impact_json_with_start_values(capsys):
     """--param values of fitted parameters are a start (init given); JSON carries the rest."""
-    status, out, err = run(capsys, [*ONE, "--param", "c=2e7", "b1=8e3", "--json"])
+    status, out, err = run_cli(capsys, [*ONE, "--param", "c=2e7", "b1=8e3", "--json"])
     assert status == 0 and err == ""
     data = json.loads(out)
     assert data["init"] == "given" and data["start"] == {"c": 2e7, "b1": 8e3}
@@ -90,7 +72,7 @@ def test_one_impact_json_with_start_values(capsys):
 def test_progress_bar(capsys, monkeypatch):
     monkeypatch.setattr(_cli_calibrate, "_progress_enabled", lambda: True)
     monkeypatch.setattr(_cli_calibrate._Ticker.__init__, "__defaults__", (0.0,))  # no delay
-    status, _, err = run(capsys, ONE)
+    status, _, err = run_cli(capsys, ONE)
     assert status == 0
     assert "calibrating hertz_rate [" in err and "1/1" in err and err.endswith("\n")
 
@@ -101,7 +83,7 @@ def test_progress_bar(capsys, monkeypatch):
 def test_data_file_with_missing_T_and_plot(capsys, tmp_path, law14_csv):
     png = tmp_path / "fit.png"
     argv = ["calibrate", "--law", "hertz_rate", "--data", str(law14_csv), "--json"]
-    status, out, err = run(capsys, [*argv, "--plot", str(png)])
+    status, out, err = run_cli(capsys, [*argv, "--plot", str(png)])
     assert status == 0 and err == ""
     data = json.loads(out)
     assert data["converged"] is True
@@ -126,7 +108,7 @@ def test_model_choice(capsys, monkeypatch, law14_csv):
         return compare_laws(laws=laws, **kwargs)
 
     monkeypatch.setattr(_model_choice, "compare_laws", failing_maxwell)
-    status, out, err = run(capsys, ["calibrate", "--law", "all", "--data", str(law14_csv)])
+    status, out, err = run_cli(capsys, ["calibrate", "--law", "all", "--data", str(law14_csv)])
     assert status == 0 and err == ""
     table = [line.split() for line in out.splitlines() if re.match(r"^\d+\s+\w+", line)]
     assert [row[:2] for row in table] == [["1", "hertz_rate"], ["2", "kelvin_voigt"]]
@@ -134,7 +116,9 @@ def test_model_choice(capsys, monkeypatch, law14_csv):
     assert "ranked by the sum of squared residuals" in out and "best: hertz_rate" in out
     assert "failed: maxwell (RuntimeError: boom)" in out
     monkeypatch.setattr(_cli_calibrate, "MODEL_CHOICE_LAWS", ("kelvin_voigt", "hertz_rate"))
-    status, out, _ = run(capsys, ["calibrate", "--law", "all", "--data", str(law14_csv), "--json"])
+    status, out, _ = run_cli(
+        capsys, ["calibrate", "--law", "all", "--data", str(law14_csv), "--json"]
+    )
     data = json.loads(out)
     assert data["best"] == "hertz_rate" and data["criterion"] == "chi2"
     assert data["ranking"][0]["chi2"] < 1e-12 < data["ranking"][1]["chi2"]
@@ -168,7 +152,7 @@ BAD = [
 @pytest.mark.parametrize("argv, contains", BAD, ids=[c for _, c in BAD])
 def test_bad_input_is_one_line(capsys, argv, contains):
     law = ["--law", "hertz_rate"]
-    assert_one_line_error(*run(capsys, ["calibrate", *law, *argv]), contains=contains)
+    assert_one_line_error(*run_cli(capsys, ["calibrate", *law, *argv]), contains=contains)
 
 
 BAD_FILES = [
@@ -187,19 +171,19 @@ BAD_FILES = [
 @pytest.mark.parametrize("text, contains", BAD_FILES, ids=[c for _, c in BAD_FILES])
 def test_bad_data_file_is_one_line(capsys, tmp_path, text, contains):
     argv = ["calibrate", "--law", "hertz_rate", "--data", _csv(tmp_path, text)]
-    assert_one_line_error(*run(capsys, argv), contains=contains)
+    assert_one_line_error(*run_cli(capsys, argv), contains=contains)
 
 
 def test_conflicting_and_missing_sources(capsys, tmp_path):
     path = _csv(tmp_path, "v0,e\n1,0.8\n")
     argv = ["calibrate", "--law", "hertz_rate", "--data", path, "--e", "0.8"]
-    assert_one_line_error(*run(capsys, argv), contains="give either --data or --e, not both")
+    assert_one_line_error(*run_cli(capsys, argv), contains="give either --data or --e, not both")
     argv = ["calibrate", "--law", "hertz_rate", "--data", str(tmp_path / "none.csv")]
-    assert_one_line_error(*run(capsys, argv), contains="cannot read --data")
+    assert_one_line_error(*run_cli(capsys, argv), contains="cannot read --data")
     argv = ["calibrate", "--law", "all", "--data", path, "--free", "c"]
-    assert_one_line_error(*run(capsys, argv), contains="drop --free and --param")
+    assert_one_line_error(*run_cli(capsys, argv), contains="drop --free and --param")
     argv = ["calibrate", "--law", "no_such_law", "--v0", "1", "--e", "0.8"]
-    assert_one_line_error(*run(capsys, argv), contains="unknown law 'no_such_law'")
+    assert_one_line_error(*run_cli(capsys, argv), contains="unknown law 'no_such_law'")
 
 
 def test_free_accepts_commas_and_words():
@@ -217,4 +201,4 @@ def test_model_choice_when_every_law_fails(capsys, monkeypatch, tmp_path):
 
     monkeypatch.setattr(_model_choice, "compare_laws", failing)
     argv = ["calibrate", "--law", "all", "--data", _csv(tmp_path, "v0,e\n1,0.8\n2,0.7\n")]
-    assert_one_line_error(*run(capsys, argv), contains="no law could be fitted: maxwell")
+    assert_one_line_error(*run_cli(capsys, argv), contains="no law could be fitted: maxwell")
