@@ -33,7 +33,9 @@ M, H0, G, T_END = 1.0, 0.6, 9.81, 3.0
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--plot", help="write figures 13-21 (position, velocity, force) here")
+    parser.add_argument(
+        "--plot", default="bounce_section7.png", help="figures 13-21: position, velocity, force"
+    )
     args = parser.parse_args()
 
     rows, drops = [], {}

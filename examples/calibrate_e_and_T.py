@@ -19,7 +19,9 @@ import jaximpact as ji  # noqa: E402
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--plot", help="write the fitted force-displacement loop to this PNG")
+    parser.add_argument(
+        "--plot", default="calibration.png", help="the fitted force-displacement loop (PNG)"
+    )
     args = parser.parse_args()
 
     # A 1 kg body hits a surface at 2.5 m/s; we measured e = 0.85 and T = 7.8 ms.
@@ -37,15 +39,21 @@ def main():
     print("law 14: F = c x^1.5 + b1 x^0.5 v, fitted to e = 0.85, T = 7.8 ms at v0 = 2.5 m/s")
     print(f"  c  = {c:.6e} N/m^1.5")
     print(f"  b1 = {b1:.6e} N s/m^1.5")
-    print(f"  converged: {bool(fit.converged)} after {int(fit.iterations)} iterations, "
-          f"loss {float(fit.loss):.2e}")
-    print(f"  time: {first:.1f} s for the first fit (includes compilation), "
-          f"{1e3 * again:.1f} ms for the next")
+    print(
+        f"  converged: {bool(fit.converged)} after {int(fit.iterations)} iterations, "
+        f"loss {float(fit.loss):.2e}"
+    )
+    print(
+        f"  time: {first:.1f} s for the first fit (includes compilation), "
+        f"{1e3 * again:.1f} ms for the next"
+    )
 
     check = ji.impact(fit.law, m=m, v0=v0, method="integrate", rtol=1e-12)
     print("re-simulated at rtol 1e-12:")
-    print(f"  e = {float(check.e):.10f} (target {e}), T = {1e3 * float(check.T):.8f} ms "
-          f"(target {1e3 * T} ms)")
+    print(
+        f"  e = {float(check.e):.10f} (target {e}), T = {1e3 * float(check.T):.8f} ms "
+        f"(target {1e3 * T} ms)"
+    )
     print(f"  x_max = {1e3 * float(check.x_max):.4f} mm, F_max = {float(check.F_max):.1f} N")
     if args.plot:
         ts = jax.numpy.linspace(0.0, 1.05 * float(check.T), 600)

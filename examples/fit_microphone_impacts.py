@@ -66,7 +66,9 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--balls", nargs="+", default=list(BALLS), choices=list(BALLS))
     parser.add_argument("--laws", nargs="+", default=["kelvin_voigt", "hertz_rate"])
-    parser.add_argument("--plot", help="write e against impact speed and residuals here")
+    parser.add_argument(
+        "--plot", default="microphone_impacts.png", help="e against impact speed, residuals"
+    )
     args = parser.parse_args()
     if not FILE.exists():
         raise SystemExit(f"data not found: {FILE} (the shared folder next to the repository)")

@@ -48,7 +48,9 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--sheets", nargs="+", type=int, default=[1, 10, 50, 100, 200, 340])
     parser.add_argument("--trials", nargs="+", type=int, default=[1, 2, 3])
-    parser.add_argument("--plot", help="write measured against fitted tracks here")
+    parser.add_argument(
+        "--plot", default="video_trajectory.png", help="measured against fitted tracks"
+    )
     args = parser.parse_args()
     if not DATA.exists():
         raise SystemExit(f"data not found: {DATA}")

@@ -1,6 +1,14 @@
 """jaximpact: impact force laws, integrated exactly and differentiably, and fitted to data."""
 
 import importlib.metadata
+import os
+import sys
+
+if os.path.basename(sys.argv[0]) == "jaximpact":
+    # the command line: XLA's CPU compiler logs harmless "algebraic simplifier ... circular"
+    # notes at error level for diffrax's loops; the level is read when jax loads, so it is
+    # set here, before the imports below, and only for the `jaximpact` console script
+    os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "3")
 
 from . import closed_forms as closed_forms
 from ._batch import impact_batch as impact_batch, run_batch as run_batch, write_table as write_table

@@ -168,6 +168,18 @@ def parse_params(items: Iterable[str]) -> dict[str, float]:
     return params
 
 
+def free_names(items) -> tuple[str, ...] | None:
+    """`--free c,b1` or `--free c b1` -> `("c", "b1")`; None when not given."""
+    if not items:
+        return None
+    names = [name.strip() for item in items for name in item.split(",") if name.strip()]
+    if not names:
+        raise CLIError("--free names no parameter, e.g. --free c,b1")
+    if len(set(names)) != len(names):
+        raise CLIError("--free names a parameter twice")
+    return tuple(names)
+
+
 def law_from_args(args):
     """The law of `--law` and `--param` (the library checks the name and the values)."""
     from ._laws import law

@@ -23,6 +23,7 @@ from ._cli import (
     emit,
     format_number,
     format_quantity,
+    free_names,
     new_figure,
     parse_params,
     save_figure,
@@ -306,17 +307,6 @@ def run_calibrate(args):
     return _run_one(args, data)
 
 
-def _free_names(args):
-    if not args.free:
-        return None
-    names = [name.strip() for item in args.free for name in item.split(",") if name.strip()]
-    if not names:
-        raise CLIError("--free names no parameter, e.g. --free c,b1")
-    if len(set(names)) != len(names):
-        raise CLIError("--free names a parameter twice")
-    return tuple(names)
-
-
 def _fit_kwargs(args, data):
     return dict(
         m=args.mass,
@@ -353,7 +343,7 @@ def _run_one(args, data):
     )
     if given:
         start = start.replace(**given)
-    free = _free_names(args)
+    free = free_names(args.free)
     fitted_names = free or _default_free(start, data["T"] is not None)
     init = args.init or ("given" if set(given) & set(fitted_names) else "auto")
     with _Ticker(1, f"calibrating {args.law}", _progress_enabled()) as bar:

@@ -25,6 +25,7 @@ from ._cli import (
     command_parser,
     emit,
     format_number,
+    free_names,
     law_from_args,
     new_figure,
     save_figure,
@@ -71,7 +72,8 @@ def add_fit(subparsers):
         action="extend",
         nargs="+",
         metavar="NAME",
-        help="law parameters to fit (default: the damping; the others keep --param's values)",
+        help="law parameters to fit, e.g. --free c,b1 (default: the damping; the others keep "
+        "--param's values)",
     )
     parser.add_argument(
         "--separation",
@@ -297,7 +299,7 @@ def _fit_one(law, args, recording, data, length_scale, y_axis):
 
     common = dict(
         m=args.mass,
-        free=args.free,
+        free=free_names(args.free),
         g=args.gravity,
         separation=args.separation,
         drag=args.drag,

@@ -122,7 +122,12 @@ class PowerDynamics(AbstractDynamics):
 
     def force_gap(self, y, compressing):
         x = y[0]
-        if self.gap == "x":
+        if self.gap == "x" or (not isinstance(self.gap, str) and self.gap == 0):
+            # n = p (Kelvin-Voigt modified, F = x (c + b1 v)): the reduced force
+            # G = 1 + beta V obeys G' = -beta X G + beta gamma, so it cannot reach 0 while
+            # X > 0; it only decays towards 0 (heavy damping) where its sign is rounding
+            # noise, and a noise crossing ended contact early (T off by up to 3x). The force
+            # vanishes at X = 0 only, as for the Hunt-Crossley family.
             return x
         if self.gap == "force":
             reduced = self.force(y, compressing)

@@ -187,10 +187,12 @@ def test_conflicting_and_missing_sources(capsys, tmp_path):
 
 
 def test_free_accepts_commas_and_words():
-    args = type("Args", (), {"free": ["c,b1"]})()
-    assert _cli_calibrate._free_names(args) == ("c", "b1")
-    args.free = ["c", "b1"]
-    assert _cli_calibrate._free_names(args) == ("c", "b1")
+    from jaximpact._cli import CLIError, free_names
+
+    assert free_names(["c,b1"]) == ("c", "b1") == free_names(["c", "b1"])
+    assert free_names(None) is None
+    with pytest.raises(CLIError, match="twice"):
+        free_names(["c,c"])
 
 
 def test_model_choice_when_every_law_fails(capsys, monkeypatch, tmp_path):
