@@ -23,11 +23,7 @@ class ImpactResult(eqx.Module):
     - `e`: coefficient of restitution `-v_out / v0` (0 unless `status == separated`).
     - `T`: contact duration (s), from first touch to separation; for `stuck` the time at
       which the body came to rest; for `captured` the time the solve gave up (the horizon
-      `tau_max t*`, or the instant its speed and net force fell below `rest_tol`; in closed
-      form for over-damped Kelvin-Voigt under `"penetration"` and for over-damped Maxwell,
-      `mu = sqrt(m c)/b >= 2` without gravity, which never reaches maximum compression).
-      Its derivatives are those of that instant (finite); `e` of a captured member is 0
-      with derivative 0.
+      `tau_max t*`, or the instant its speed and net force fell below `rest_tol`).
     - `x_max` (m), `t_max` (s): maximum penetration and when it is reached.
     - `F_max` (N): largest contact force (at first touch, at the first force peak in
       compression, or at maximum compression, whichever is largest).
@@ -127,11 +123,9 @@ def _integrate(
     tau_max,
     rest_tol,
     adjoint,
-    hold=None,
 ):
     """Run the phases of `plan`; return the state and time at the end of each
-    (nondimensional), stacked along a leading axis. `hold` (a boolean): skip every phase
-    (a contact known in closed form never to return, see `AbstractDynamics.creeping`)."""
+    (nondimensional), stacked along a leading axis."""
     term = dfx.ODETerm(lambda t, y, args: dynamics.rhs(y, args < _TO_SEPARATION))
     event = dfx.Event(
         _event_conditions(dynamics, separation, plan, rest_tol),
@@ -146,7 +140,6 @@ def _integrate(
         rest_push = dynamics.force(y, False) - dynamics.gamma
         skip = (
             ~alive
-            | (False if hold is None else hold)
             | ((phase == _TO_MAX_COMPRESSION) & (dynamics.velocity(y) <= 0))
             | ((phase == _TO_SEPARATION) & (rest_push <= 0))
         )
@@ -197,7 +190,7 @@ def _integrate(
     return phases
 
 
-def _assemble_integrated(dynamics, phases, plan, *, m, v0, g, tau_grid, creep=None):
+def _assemble_integrated(dynamics, phases, plan, *, m, v0, g, tau_grid):
     x_star, t_star, scale = dynamics.x_star, dynamics.t_star, dynamics.force_scale
     last = len(plan) - 1
     y_end = phases["y"][last]
@@ -235,22 +228,6 @@ def _assemble_integrated(dynamics, phases, plan, *, m, v0, g, tau_grid, creep=No
         candidates = [dynamics.y0(), phases["y"][plan.index(_TO_PEAK)], phases["y"][k]]
         forces = jnp.stack([dynamics.force(y, True) for y in candidates])
         result["F_max"] = jnp.max(forces) * scale
-    if creep is not None:
-        # never returns (over-damped Maxwell): captured at the closed-form rest instant,
-        # sinking in all along (x_max at that instant), no integration was run
-        held = creep["captured"]
-        result["status"] = jnp.where(held, Status.captured, result["status"]).astype(jnp.int32)
-        result["e"] = jnp.where(held, 0.0, result["e"])
-        result["v_out"] = jnp.where(held, 0.0, result["v_out"])
-        result["T"] = jnp.where(held, creep["tau"] * t_star, result["T"])
-        result["dissipated"] = jnp.where(
-            held, 0.5 * m * v0**2 + m * g * creep["x"] * x_star, result["dissipated"]
-        )
-        if "x_max" in result:
-            result["x_max"] = jnp.where(held, creep["x"] * x_star, result["x_max"])
-            result["t_max"] = jnp.where(held, creep["tau"] * t_star, result["t_max"])
-        if "F_max" in result:
-            result["F_max"] = jnp.where(held, creep["force_peak"] * scale, result["F_max"])
     if tau_grid is not None:
         result.update(_histories(dynamics, phases, plan, tau_grid, v0, g))
     return ImpactResult(**result, path="integrated")
@@ -308,8 +285,6 @@ def solve_impact(law, m, v0, g, ts, options: ImpactOptions) -> ImpactResult:
         return ImpactResult(**fields, path="closed_form")
     tau_grid = None if ts is None else ts / dynamics.t_star
     plan = _phase_plan(dynamics, options.peaks or tau_grid is not None)
-    # with a time grid the histories need the integration itself
-    creep = dynamics.creeping(options.rest_tol) if tau_grid is None else None
     phases = _integrate(
         dynamics,
         plan=plan,
@@ -322,11 +297,8 @@ def solve_impact(law, m, v0, g, ts, options: ImpactOptions) -> ImpactResult:
         tau_max=options.tau_max,
         rest_tol=options.rest_tol,
         adjoint=options.adjoint,
-        hold=None if creep is None else creep["captured"],
     )
-    return _assemble_integrated(
-        dynamics, phases, plan, m=m, v0=v0, g=g, tau_grid=tau_grid, creep=creep
-    )
+    return _assemble_integrated(dynamics, phases, plan, m=m, v0=v0, g=g, tau_grid=tau_grid)
 
 
 def impact(
