@@ -13,7 +13,7 @@ subprocess with JAX's x64 mode off, compared with the same float64 references.
 
 Run: `python benchmarks/stress.py` (writes benchmarks/stress.json and benchmarks/stress.md);
 `--n 16` for a quick run, `--report` to rebuild the report, `--laws`, `--criteria`,
-`--no-float32`, `--resume`.
+`--no-float32`, `--only32`, `--no-loose32`, `--resume`.
 """
 
 import argparse
@@ -80,9 +80,12 @@ def sweep(args, x64: bool, label: str, rtol=None, gradients=("jacfwd", "grad"), 
                 name, sep, members, method=method, gradients=gradients, rtol=rtol, dtype=dtype
             )
         except Exception as ex:  # an error raised inside the compiled batch (jacfwd)
-            error = f"{type(ex).__name__}: " + " ".join(
-                line.strip() for line in str(ex).splitlines() if "non-finite" in line
-            )[:300]
+            error = (
+                f"{type(ex).__name__}: "
+                + " ".join(line.strip() for line in str(ex).splitlines() if "non-finite" in line)[
+                    :300
+                ]
+            )
             print(f"[{label}] {name} {sep} {method}: {error}; again without jacfwd", flush=True)
             out, first, again = sc.run_sweep(
                 name,
@@ -157,7 +160,10 @@ def run(args):
         results["loads"].append(load_average())
         save()
     if not args.no_float32:
-        for label, rtol, grads in (("float32", None, "jacfwd"), ("float32 rtol 1e-6", 1e-6, "")):
+        passes = [("float32", None, "jacfwd"), ("float32 rtol 1e-6", 1e-6, "")]
+        if args.no_loose32:
+            passes = passes[:1]
+        for label, rtol, grads in passes:
             tmp = os.path.join(CACHE, f"stress32-{os.getpid()}.json")
             cmd = [
                 sys.executable,
@@ -182,7 +188,14 @@ def run(args):
             with open(tmp) as f:
                 rows = json.load(f)
             os.remove(tmp)
-            results["rows"] = [r for r in results["rows"] if r["run"] != label] + rows
+            # replace this run's rows for the laws just done (a partial `--laws` rerun
+            # keeps the others)
+            redone = {(r["law"], r["separation"], r["method"]) for r in rows}
+            results["rows"] = [
+                r
+                for r in results["rows"]
+                if r["run"] != label or (r["law"], r["separation"], r["method"]) not in redone
+            ] + rows
             results["loads"].append(load_average())
             save()
     return results
@@ -203,6 +216,14 @@ def _count(value):
     return value if isinstance(value, int) else 0
 
 
+def _default(name):
+    import inspect
+
+    import jaximpact as ji
+
+    return inspect.signature(ji.impact).parameters[name].default
+
+
 def report(results):
     from _common import fmt, machine_markdown, table
 
@@ -219,7 +240,8 @@ def report(results):
         "spread (scrambled Sobol, plus the 8 corners of the box at both ends of the damping "
         "range) over c in [1e2, 1e13] N/m^n, m in [1e-6, 1e3] kg, v0 in [1e-4, 1e2] m/s and "
         "the law's dimensionless damping from nearly elastic to over-damped (`e_ref range`). "
-        "Every call uses `impact`'s defaults (Tsit5, rtol 1e-10, peaks=True, rest_tol 1e-9) "
+        "Every call uses `impact`'s defaults (Tsit5, rtol 1e-10, peaks=True, rest_tol "
+        f"{_default('rest_tol'):g}, max_steps {_default('max_steps')}) "
         'except `method="integrate"` (Kelvin-Voigt also with its closed-form default, '
         '`method="auto"`).',
         "",
@@ -237,13 +259,33 @@ def report(results):
         "",
         machine_markdown(results["machine"], results["loads"]),
         "",
+        "What the remaining out-of-steps members are (measured on the members listed at the "
+        "end of each run):",
+        "",
+        "- float64, `hertz_viscous` under `\"penetration\"`, over-damped (beta up to 30): the "
+        "body creeps back on the slow manifold `b v = -c x^1.5`, so `x ~ t^-2` never reaches 0 "
+        "(the reference calls it captured) while the fast mode `b/m` keeps the explicit "
+        "solver's step small: Tsit5 needs more than the default 4096 steps to reach the rest "
+        "threshold. `max_steps=100_000` (0.1 s to 2 s) or `solver=diffrax.Kvaerno5()` end the "
+        "three listed members `captured` with no other change. No NaN either way; the status "
+        "says `out_of_steps`, so nothing is silently wrong.",
+        "- float32: `rtol`, `atol` and `rest_tol` are raised to 1e-7, 1e-7 and 1e-5 (a warning "
+        "says so): at the float64 defaults the step controller chased rounding noise (about 700 "
+        "steps per impact instead of 20 to 30) and creeping bodies never met the rest threshold "
+        "(11 of 80 Kelvin-Voigt members out of steps under `\"penetration\"`, 4 Bingham). "
+        "What is left: the creeping `hertz_viscous` members as in float64 (and one creeping "
+        "Kelvin-Voigt member), and heavily damped members whose rebound is below float32's "
+        "resolution of a rest (reference e of 2e-4 for `hertz_viscous` under the force "
+        "criterion, out of steps; 2e-7 for `hertz_rate` under penetration, captured), where a "
+        "separation cannot be told from a rest. `T` under the force criterion is "
+        "ill-conditioned for such members in float32 (the force crosses zero at a grazing "
+        "angle), hence the larger `max err T`.",
+        "",
     ]
     for run_label in runs:
         rs = [r for r in rows if r["run"] == run_label]
         total = sum(r["members"] for r in rs)
-        nan = sum(
-            r["nan_values"] + _count(r["nan_jacfwd"]) + _count(r["nan_grad"]) for r in rs
-        )
+        nan = sum(r["nan_values"] + _count(r["nan_jacfwd"]) + _count(r["nan_grad"]) for r in rs)
         raised = [r for r in rs if r.get("error")]
         lines += [
             f"## {run_label}",
@@ -279,8 +321,13 @@ def report(results):
                         r["separation"],
                         "closed form" if r["method"] == "auto" else "integrate",
                         r["members"],
-                        "/".join(str(r["counts"][k]) for k in ("separated", "stuck", "captured", "out_of_steps")),
-                        "/".join(str(r["ref_counts"][k]) for k in ("separated", "stuck", "captured")),
+                        "/".join(
+                            str(r["counts"][k])
+                            for k in ("separated", "stuck", "captured", "out_of_steps")
+                        ),
+                        "/".join(
+                            str(r["ref_counts"][k]) for k in ("separated", "stuck", "captured")
+                        ),
                         r["status_mismatch"],
                         f"{r['nan_values']}/{fmt(r['nan_jacfwd'])}/{fmt(r['nan_grad'])}",
                         f"{r['e_range'][0]:.3g}-{r['e_range'][1]:.4g}",
@@ -312,7 +359,7 @@ def report(results):
                         f"- {r['law']} / {r['separation']} / {r['method']}: `jax.jacfwd` raised "
                         f"`{r['error']}`"
                     )
-                for member, rep in list(r["repro"].items())[:3]:
+                for _member, rep in list(r["repro"].items())[:3]:
                     call = (
                         f"ji.impact(ji.law({rep['law']!r}, "
                         + ", ".join(f"{k}={v!r}" for k, v in rep["params"].items())
@@ -336,6 +383,9 @@ def main():
     parser.add_argument("--criteria", nargs="*", default=list(CRITERIA))
     parser.add_argument("--no-float32", action="store_true")
     parser.add_argument("--only32", action="store_true", help="redo the float32 runs only")
+    parser.add_argument(
+        "--no-loose32", action="store_true", help="skip the float32 pass at rtol 1e-6"
+    )
     parser.add_argument("--resume", action="store_true")
     parser.add_argument("--report", action="store_true")
     parser.add_argument("--worker32", help=argparse.SUPPRESS)

@@ -29,6 +29,7 @@ from ._impact import (
     _phase_plan,
 )
 from ._laws import AbstractLaw
+from ._precision import resolvable_tolerances
 from ._status import Status
 
 
@@ -378,13 +379,14 @@ def bounce_options(
         raise ValueError(f"separation must be one of {SEPARATIONS}, got {separation!r}")
     if not isinstance(max_impacts, (int, np.integer)) or max_impacts < 1:
         raise ValueError(f"max_impacts must be an integer >= 1, got {max_impacts!r}")
+    rtol, atol, rest_tol = resolvable_tolerances(rtol, rtol if atol is None else atol, rest_tol)
     return BounceOptions(
         impact=ImpactOptions(
             separation=separation,
             closed_form=False,
             solver=dfx.Tsit5() if solver is None else solver,
             rtol=rtol,
-            atol=rtol if atol is None else atol,
+            atol=atol,
             max_steps=max_steps,
             tau_max=tau_max,
             rest_tol=rest_tol,

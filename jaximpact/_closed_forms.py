@@ -153,6 +153,53 @@ def maxwell(c, b, m, v0):
     )
 
 
+def maxwell_creep(mu, rest_tol):
+    """Over-damped Maxwell without gravity (`mu = sqrt(m c)/b >= 2`), nondimensional.
+
+    `V'' + mu V' + V = 0`, `V(0) = 1`, `V'(0) = 0` stays positive for all time when
+    `mu >= 2`: the body never reaches maximum compression, it sinks in while the force
+    relaxes (status captured). With the roots `l2 < l1 < 0` of `l^2 + mu l + 1` and
+    `e_i = exp(l_i tau)`: `Phi = (e1 - e2)/(l1 - l2)`, `V = (l1 e2 - l2 e1)/(l1 - l2)`,
+    `X = Phi + mu (1 - V)` (since `Phi = -V'`). Returns `(tau_rest, X(tau_rest), tau_peak,
+    Phi(tau_peak))`: the instant `V + Phi` falls to `rest_tol` (what `impact` calls at rest;
+    Newton on its logarithm, differentiated implicitly) and the force peak `Phi' = 0`.
+    Call it with `mu >= 2` only (callers substitute a safe value elsewhere); near critical
+    damping the modes are written `exp(-mu tau/2) sinh(q tau)/q` (series in `q`)."""
+    s = 0.5 * mu
+    q2 = s**2 - 1.0
+    near = q2 < 1e-4  # within 1e-2 of critical damping in q: the sinh form, no cancellation
+    q = jnp.sqrt(jnp.where(near, 1.0, q2))
+    fast = -s - q
+    slow = 1.0 / fast  # l1 l2 = 1, without the cancellation of -s + q
+    gap = slow - fast
+    r_near = -jnp.where(near, q2, 0.0)
+
+    def modes(tau):
+        e1, e2 = jnp.exp(slow * tau), jnp.exp(fast * tau)
+        phi_far, v_far = (e1 - e2) / gap, (slow * e2 - fast * e1) / gap
+        decay = jnp.exp(-s * tau)
+        sin_r = _sin_ratio(r_near, tau)
+        phi_near = decay * sin_r
+        v_near = decay * (_cos_continued(r_near, tau) + s * sin_r)
+        return jnp.where(near, phi_near, phi_far), jnp.where(near, v_near, v_far)
+
+    start = jnp.where(near, -jnp.log(rest_tol), jnp.log(rest_tol * gap / (1.0 - fast)) / slow)
+    start = jnp.maximum(start, 1.0)
+
+    def excess(tau, _):
+        phi, v = modes(tau)
+        return jnp.log(phi + v) - jnp.log(rest_tol)
+
+    solution = optx.root_find(
+        excess, optx.Newton(rtol=1e-13, atol=1e-13), start, max_steps=64, throw=False
+    )
+    tau_rest = jnp.where(jnp.isfinite(solution.value), solution.value, start)
+    phi, v = modes(tau_rest)
+    # Phi' = 0 where tanh(q tau) = q/s
+    tau_peak = _arctan_ratio(-q2 / s**2) / s
+    return tau_rest, phi + mu * (1.0 - v), tau_peak, modes(tau_peak)[0]
+
+
 def power_spring(c, n, m, v0):
     """Undamped `F = c x^n`: `x_max = ((n+1) m v0^2/(2c))^(1/(n+1))` and
     `T = 2 (x_max/v0) B(1/(n+1), 1/2)/(n+1)` (B the Beta function); `e = 1`.

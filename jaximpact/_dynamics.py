@@ -13,6 +13,7 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array
 
+from ._closed_forms import maxwell_creep
 from ._powers import contact_pow
 
 
@@ -57,6 +58,13 @@ class AbstractDynamics(eqx.Module):
     def force_rate(self, y: Array, compressing) -> Array:
         """`dF/dtau` along the motion (zero at a force peak)."""
         return jax.jvp(lambda z: self.force(z, compressing), (y,), (self.rhs(y, compressing),))[1]
+
+    def creeping(self, rest_tol):
+        """`None`, or a dict for a law that can be known, before integrating, never to
+        reach maximum compression: `captured` (bool), and the closed-form rest instant
+        `tau`, position `x` there, and force peak `tau_peak`, `force_peak` (nondimensional),
+        valid where `captured`. `impact` then skips the (stiff, endless) integration."""
+        return None
 
     @property
     def force_scale(self) -> Array:
@@ -171,6 +179,14 @@ class MaxwellDynamics(AbstractDynamics):
 
     def force_gap(self, y, compressing):
         return y[2]
+
+    def creeping(self, rest_tol):
+        """Over-damped (`mu >= 2`) and no gravity: `V'' + mu V' + V = 0` keeps `V > 0`, the
+        body sinks in for ever while the force relaxes (`closed_forms.maxwell_creep`)."""
+        captured = (self.mu >= 2.0) & (self.gamma == 0)
+        # a harmless over-damped value elsewhere, so no NaN reaches a discarded gradient
+        tau, x, tau_peak, force_peak = maxwell_creep(jnp.where(captured, self.mu, 3.0), rest_tol)
+        return dict(captured=captured, tau=tau, x=x, tau_peak=tau_peak, force_peak=force_peak)
 
 
 class ScaledDynamics(AbstractDynamics):

@@ -11,6 +11,7 @@ from . import _closed_forms
 from ._adjoint import auto_adjoint
 from ._checks import check_nonnegative, check_positive
 from ._laws import AbstractLaw
+from ._precision import resolvable_tolerances
 from ._status import Status
 
 SEPARATIONS = ("force", "penetration")
@@ -23,7 +24,11 @@ class ImpactResult(eqx.Module):
     - `e`: coefficient of restitution `-v_out / v0` (0 unless `status == separated`).
     - `T`: contact duration (s), from first touch to separation; for `stuck` the time at
       which the body came to rest; for `captured` the time the solve gave up (the horizon
-      `tau_max t*`, or the instant its speed and net force fell below `rest_tol`).
+      `tau_max t*`, or the instant its speed and net force fell below `rest_tol`; in closed
+      form for over-damped Kelvin-Voigt under `"penetration"` and for over-damped Maxwell,
+      `mu = sqrt(m c)/b >= 2` without gravity, which never reaches maximum compression).
+      Its derivatives are those of that instant (finite); `e` of a captured member is 0
+      with derivative 0.
     - `x_max` (m), `t_max` (s): maximum penetration and when it is reached.
     - `F_max` (N): largest contact force (at first touch, at the first force peak in
       compression, or at maximum compression, whichever is largest).
@@ -123,9 +128,11 @@ def _integrate(
     tau_max,
     rest_tol,
     adjoint,
+    hold=None,
 ):
     """Run the phases of `plan`; return the state and time at the end of each
-    (nondimensional), stacked along a leading axis."""
+    (nondimensional), stacked along a leading axis. `hold` (a boolean): skip every phase
+    (a contact known in closed form never to return, see `AbstractDynamics.creeping`)."""
     term = dfx.ODETerm(lambda t, y, args: dynamics.rhs(y, args < _TO_SEPARATION))
     event = dfx.Event(
         _event_conditions(dynamics, separation, plan, rest_tol),
@@ -143,6 +150,8 @@ def _integrate(
             | ((phase == _TO_MAX_COMPRESSION) & (dynamics.velocity(y) <= 0))
             | ((phase == _TO_SEPARATION) & (rest_push <= 0))
         )
+        if hold is not None:
+            skip = skip | hold
         t1 = jnp.where(skip, tau, tau_max)
         subs = [dfx.SubSaveAt(t1=True)]
         if tau_grid is not None:
@@ -190,7 +199,7 @@ def _integrate(
     return phases
 
 
-def _assemble_integrated(dynamics, phases, plan, *, m, v0, g, tau_grid):
+def _assemble_integrated(dynamics, phases, plan, *, m, v0, g, tau_grid, creep=None):
     x_star, t_star, scale = dynamics.x_star, dynamics.t_star, dynamics.force_scale
     last = len(plan) - 1
     y_end = phases["y"][last]
@@ -228,6 +237,22 @@ def _assemble_integrated(dynamics, phases, plan, *, m, v0, g, tau_grid):
         candidates = [dynamics.y0(), phases["y"][plan.index(_TO_PEAK)], phases["y"][k]]
         forces = jnp.stack([dynamics.force(y, True) for y in candidates])
         result["F_max"] = jnp.max(forces) * scale
+    if creep is not None:
+        # never returns (over-damped Maxwell): captured at the closed-form rest instant,
+        # sinking in all along (x_max at that instant), no integration was run
+        held = creep["captured"]
+        result["status"] = jnp.where(held, Status.captured, result["status"]).astype(jnp.int32)
+        result["e"] = jnp.where(held, 0.0, result["e"])
+        result["v_out"] = jnp.where(held, 0.0, result["v_out"])
+        result["T"] = jnp.where(held, creep["tau"] * t_star, result["T"])
+        result["dissipated"] = jnp.where(
+            held, 0.5 * m * v0**2 + m * g * creep["x"] * x_star, result["dissipated"]
+        )
+        if "x_max" in result:
+            result["x_max"] = jnp.where(held, creep["x"] * x_star, result["x_max"])
+            result["t_max"] = jnp.where(held, creep["tau"] * t_star, result["t_max"])
+        if "F_max" in result:
+            result["F_max"] = jnp.where(held, creep["force_peak"] * scale, result["F_max"])
     if tau_grid is not None:
         result.update(_histories(dynamics, phases, plan, tau_grid, v0, g))
     return ImpactResult(**result, path="integrated")
@@ -285,6 +310,8 @@ def solve_impact(law, m, v0, g, ts, options: ImpactOptions) -> ImpactResult:
         return ImpactResult(**fields, path="closed_form")
     tau_grid = None if ts is None else ts / dynamics.t_star
     plan = _phase_plan(dynamics, options.peaks or tau_grid is not None)
+    # with a time grid the histories need the integration itself
+    creep = dynamics.creeping(options.rest_tol) if tau_grid is None else None
     phases = _integrate(
         dynamics,
         plan=plan,
@@ -297,8 +324,11 @@ def solve_impact(law, m, v0, g, ts, options: ImpactOptions) -> ImpactResult:
         tau_max=options.tau_max,
         rest_tol=options.rest_tol,
         adjoint=options.adjoint,
+        hold=None if creep is None else creep["captured"],
     )
-    return _assemble_integrated(dynamics, phases, plan, m=m, v0=v0, g=g, tau_grid=tau_grid)
+    return _assemble_integrated(
+        dynamics, phases, plan, m=m, v0=v0, g=g, tau_grid=tau_grid, creep=creep
+    )
 
 
 def impact(
@@ -340,6 +370,8 @@ def impact(
     - `tau_max`: horizon in units of `t*`; a contact still going on there is `captured`.
     - `rest_tol`: a body whose speed (in units of `v0`) plus net force (in units of
       `m v0^2/x*`) falls below this is at rest: `captured` (or `stuck`), `T` is that time.
+    - In float32 (JAX's x64 off) `rtol`, `atol` below 1e-7 and `rest_tol` below 1e-5 are
+      raised to those values, with a warning: finer ones cannot be met in that precision.
     - `adjoint`: default picks the cheapest diffrax adjoint for the transformation in use
       (`ForwardMode` under `jax.jacfwd`, `RecursiveCheckpointAdjoint` otherwise).
     - `peaks`: find `x_max`, `t_max`, `F_max` (extra events); `False` integrates a smooth
@@ -375,12 +407,13 @@ def impact(
         ts = jnp.asarray(ts, dtype=float)
         if ts.ndim != 1:
             raise ValueError("ts must be a 1-D array of times in seconds")
+    rtol, atol, rest_tol = resolvable_tolerances(rtol, rtol if atol is None else atol, rest_tol)
     options = ImpactOptions(
         separation=separation,
         closed_form=closed is not None and method != "integrate",
         solver=dfx.Tsit5() if solver is None else solver,
         rtol=rtol,
-        atol=rtol if atol is None else atol,
+        atol=atol,
         max_steps=max_steps,
         tau_max=tau_max,
         rest_tol=rest_tol,

@@ -99,6 +99,18 @@ def _solve(name, params, m, v0, separation, g, rtol):
         fun.terminal, fun.direction = True, direction
         return fun
 
+    if maxwell and g == 0.0 and math.sqrt(m * c) / float(params["b"]) >= 2.0:
+        # over-damped Maxwell: V'' + mu V' + V = 0 (tau = t/t*), V(0) = 1, V'(0) = 0 stays
+        # positive for ever (proven, not integrated: a long integration finds a noise-level
+        # zero of V and reports a rest or a rebound with e ~ 1e-20). The body sinks in
+        # towards x = mu x* while the force relaxes: captured.
+        mu = math.sqrt(m * c) / float(params["b"])
+        s_, q_ = 0.5 * mu, math.sqrt(max(0.25 * mu * mu - 1.0, 1e-300))
+        tau_p = math.atanh(q_ / s_) / q_ if q_ > 1e-8 else 1.0 / s_
+        phi_p = math.exp(-s_ * tau_p) * (math.sinh(q_ * tau_p) / q_ if q_ > 1e-8 else tau_p)
+        return dict(x_max=mu * xs, t_max=math.inf, e=0.0, T=math.inf, status="captured",
+                    F_max=phi_p * c * xs), None, None
+
     # ---- phase 1: compression, until v = 0 ------------------------------------
     y0 = [0.0, v0] + ([0.0] if maxwell else [])
     top = event(lambda t, y, s: y[1] / v0, -1)
@@ -121,7 +133,9 @@ def _solve(name, params, m, v0, separation, g, rtol):
         return float(max(vals))
 
     if F_of(ytop, -1) - m * g <= 0.0:                 # cannot rebound: stuck at x_max
-        out.update(e=0.0, T=t_max, status="stuck", F_max=fmax([s1]))
+        # (without a dry force: over-damped Maxwell, whose speed and force only decay
+        # towards 0 together; held without a dry force is a capture)
+        out.update(e=0.0, T=t_max, status="stuck" if dry else "captured", F_max=fmax([s1]))
         return out, s1, None
 
     # ---- phase 2: restitution, until separation / rest ------------------------
@@ -133,6 +147,10 @@ def _solve(name, params, m, v0, separation, g, rtol):
         _, _, d, p, _, pr = law
         if pr > 0.0 or p == 0.0 or d == 0.0:
             sep = lambda t, y, s: _force(law, y[0], y[1], s) / Fs
+        elif n == p:                                  # F = x^p (c + d v), Hunt-Crossley type:
+            # m (c + d v)' = d (m g - x^p (c + d v)), so c + d v only decays towards 0 while
+            # x > 0 (its sign there is rounding noise): the force vanishes at x = 0 only
+            sep = lambda t, y, s: y[0] / xs
         else:                                         # F = x^p (c x^(n-p) + d v)
             sep = lambda t, y, s: min(y[0] / xs,
                                       (c * _pow(y[0], n - p) + d * y[1]) / (c * xs ** (n - p)))
