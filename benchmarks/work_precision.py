@@ -1040,7 +1040,7 @@ def plot(results):
             for r in d:
                 ax.loglog(
                     [r["single_s"]], [max(r[what], floor)], "*", ms=14, color="gold",
-                    markeredgecolor="k", label="default" if i == 0 else None,
+                    markeredgecolor="k", label="default" if (i, j) == (0, 0) else None,
                 )
             ax.axhline(TARGET_ERROR, color="grey", lw=0.5)
             ax.set_title(f"{name}: error in {what[-1]}")
