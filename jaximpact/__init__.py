@@ -9,6 +9,12 @@ if os.path.basename(sys.argv[0]) == "jaximpact":
     # notes at error level for diffrax's loops; the level is read when jax loads, so it is
     # set here, before the imports below, and only for the `jaximpact` console script
     os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "3")
+    # equinox's run-time checks inside the compiled fits (lineax's, in the implicit
+    # derivative of diffrax's event times) are host callbacks, and JAX does not store a
+    # program with host callbacks in its persistent cache; as NaN instead (which the fits
+    # already report as a failed solve) the second `jaximpact calibrate` skips XLA's
+    # compilation: 14 s -> 8 s (benchmarks/first_calls.md). Inputs are checked before.
+    os.environ.setdefault("EQX_ON_ERROR", "nan")
 
 from . import closed_forms as closed_forms
 from ._batch import impact_batch as impact_batch, run_batch as run_batch, write_table as write_table

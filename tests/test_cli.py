@@ -4,6 +4,7 @@ Each impact costs a trace of the solve (about 1-2 s), so the tests ask for as fe
 """
 
 import json
+import os
 import re
 import shutil
 import subprocess
@@ -220,3 +221,32 @@ def test_plot_impact_panels_and_units():
         plot_impact(_synthetic_result(with_histories=False))
     with pytest.raises(ValueError, match="3 axes"):
         plot_impact(_synthetic_result(), axes=axes[:2])
+
+
+def test_console_script_environment():
+    """Run as the `jaximpact` console script (and only then), XLA's notes are hidden and
+    equinox's run-time checks are NaN rather than host callbacks, so that JAX's persistent
+    cache can keep the compiled fits; a library import leaves both alone."""
+    probe = (
+        "import os, sys; sys.argv[0] = {!r}; import jaximpact, equinox._config as c; "
+        "print(os.environ.get('EQX_ON_ERROR'), os.environ.get('TF_CPP_MIN_LOG_LEVEL'), "
+        "c.EQX_ON_ERROR)"
+    )
+    env = {k: v for k, v in os.environ.items() if k not in ("EQX_ON_ERROR", "TF_CPP_MIN_LOG_LEVEL")}
+    script = subprocess.run(
+        [sys.executable, "-c", probe.format("/usr/bin/jaximpact")],
+        capture_output=True,
+        text=True,
+        env=env,
+        check=True,
+    )
+    assert script.stdout.split() == ["nan", "3", "nan"]
+    library = subprocess.run(
+        [sys.executable, "-c", probe.format("analysis.py")],
+        capture_output=True,
+        text=True,
+        env=env,
+        check=True,
+    )
+    eqx_env, _, eqx_mode = library.stdout.split()
+    assert (eqx_env, eqx_mode) == ("None", "raise")
