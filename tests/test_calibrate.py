@@ -426,9 +426,6 @@ def test_compare_every_paper_law_with_sigmas():
 # reference's force event, which watches that reduced force, misfires at heavy damping
 SAME_AS_PENETRATION = ("kelvin_voigt_modified", "hunt_crossley")
 TABLE_DEFECTS = {
-    ("kelvin_voigt_modified", "force"): "jaximpact's force event watches 1 + beta V too, and "
-    "fires early at heavy damping: tau 14% low at group 100 (e = 0.01); gap='x' for this law "
-    "would make it the penetration event, which is exact here",
     ("hertz_modified", "force"): "the event x^0.5 + beta V = 0 is placed early at light "
     "damping: tau 1.1e-4 low at group 1e-4, 5.5e-6 low at 4e-3 (penetration: 4e-10)",
 }
