@@ -137,12 +137,10 @@ def test_round_trip_every_law(name, optimizer):
 
 
 # mixed corners (stiffness and damping off in opposite directions) that do not come back:
-# kelvin_voigt_modified: the force-criterion event (reduced force 1 + beta V, which never
-# crosses zero for this law) raises inside the event root finder's derivative at heavy
-# damping; bingham: the start sticks (e = 0, a flat loss); lm, hertz_modified: a local minimum
+# bingham: the start sticks (e = 0, a flat loss); lm, hertz_modified: a local minimum.
+# (kelvin_voigt_modified came back once its force event ended at x = 0, where its force
+# x (c + b1 v) vanishes: the reduced force 1 + beta V never crosses zero for this law.)
 MIXED_FAILURES = {
-    ("kelvin_voigt_modified", 0.1, "lbfgs"),
-    ("kelvin_voigt_modified", 0.1, "lm"),
     ("bingham", 0.1, "lbfgs"),
     ("bingham", 0.1, "lm"),
     ("hertz_modified", 10.0, "lm"),
@@ -153,10 +151,10 @@ MIXED_FAILURES = {
 @pytest.mark.parametrize("optimizer", ("lbfgs", "lm"))
 @pytest.mark.parametrize("c_factor", (10.0, 0.1))
 @pytest.mark.parametrize("name", tuple(ROUND_TRIPS))
-def test_round_trip_mixed_corners(name, c_factor, optimizer):
+def test_round_trip_mixed_corners(name, c_factor, optimizer, request):
     """Stiffness off by `c_factor`, the other free parameter by its inverse."""
-    if (name, c_factor, optimizer) in MIXED_FAILURES:
-        pytest.xfail("known: see MIXED_FAILURES")
+    if (name, c_factor, optimizer) in MIXED_FAILURES:  # run, and fail loudly once fixed
+        request.applymarker(pytest.mark.xfail(strict=True, reason="known: see MIXED_FAILURES"))
     free = ROUND_TRIPS[name]
     start = far_start(name, free, 1.0 / c_factor)
     start = start.replace(c=TRUE[name]["c"] * c_factor)
@@ -433,12 +431,12 @@ TABLE_DEFECTS = {
 
 @pytest.mark.parametrize("separation", ("force", "penetration"))
 @pytest.mark.parametrize("name", tuple(DAMPING))
-def test_restitution_tables_against_fresh_impacts(name, separation):
+def test_restitution_tables_against_fresh_impacts(name, separation, request):
     """The shipped nondimensional tables (e and T/t* against the damping group at unit
     scales) agree with fresh impacts by the scipy integrator to 1e-6, at five nodes spread
     over the range a measurement can have (0.01 <= e <= 0.9999)."""
-    if (name, separation) in TABLE_DEFECTS:
-        pytest.xfail(TABLE_DEFECTS[name, separation])
+    if (name, separation) in TABLE_DEFECTS:  # run, and fail loudly once fixed
+        request.applymarker(pytest.mark.xfail(strict=True, reason=TABLE_DEFECTS[name, separation]))
     groups, e_table, tau_table = restitution_table(name, separation)
     nodes = np.flatnonzero((e_table >= 0.01) & (e_table <= 0.9999))
     assert len(nodes) >= 20, f"{name}/{separation}: the table misses measurable e"
