@@ -137,13 +137,12 @@ def test_round_trip_every_law(name, optimizer):
 
 
 # mixed corners (stiffness and damping off in opposite directions) that do not come back:
-# bingham: the start sticks (e = 0, a flat loss); lm, hertz_modified: a local minimum.
-# (kelvin_voigt_modified came back once its force event ended at x = 0, where its force
-# x (c + b1 v) vanishes: the reduced force 1 + beta V never crosses zero for this law.)
+# bingham: the start sticks (e = 0, a flat loss). (kelvin_voigt_modified came back once its
+# force event ended at x = 0, where its force x (c + b1 v) vanishes; hertz_modified with lm
+# once its force event was written without the infinite slope of x^0.5 at x = 0.)
 MIXED_FAILURES = {
     ("bingham", 0.1, "lbfgs"),
     ("bingham", 0.1, "lm"),
-    ("hertz_modified", 10.0, "lm"),
 }
 
 
@@ -423,10 +422,8 @@ def test_compare_every_paper_law_with_sigmas():
 # (it never crosses it while x > 0), so the force criterion is the penetration one, and the
 # reference's force event, which watches that reduced force, misfires at heavy damping
 SAME_AS_PENETRATION = ("kelvin_voigt_modified", "hunt_crossley")
-TABLE_DEFECTS = {
-    ("hertz_modified", "force"): "the event x^0.5 + beta V = 0 is placed early at light "
-    "damping: tau 1.1e-4 low at group 1e-4, 5.5e-6 low at 4e-3 (penetration: 4e-10)",
-}
+# (law, criterion): why its table is known to be off; none at present
+TABLE_DEFECTS: dict[tuple[str, str], str] = {}
 
 
 @pytest.mark.parametrize("separation", ("force", "penetration"))
