@@ -93,3 +93,21 @@ def table(header: list[str], rows: list[list]) -> str:
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
     return "\n".join(lines)
+
+
+# the five laws the speed benchmarks compare, at the seed paper's parameters (SI units;
+# m = 1 kg, v0 = 2.5 m/s)
+PAPER_CASES = {
+    "kelvin_voigt": dict(c=2e6, b=400.0),
+    "maxwell": dict(c=2e6, b=2000.0),
+    "hertz_viscous": dict(c=2e6, b=40.0),
+    "hertz_rate": dict(c=2e6, b1=800.0),
+    "hunt_crossley": dict(c=2e6, a=0.1),
+}
+
+
+def write_report(path: str, text: str) -> None:
+    """Write a benchmark's markdown report and print it."""
+    with open(path, "w") as handle:
+        handle.write(text)
+    print(text)

@@ -22,18 +22,20 @@ import jax  # noqa: E402
 jax.config.update("jax_enable_x64", True)
 
 import diffrax as dfx  # noqa: E402
-from _common import fmt, load_average, machine, machine_markdown, table  # noqa: E402
+from _common import (  # noqa: E402
+    PAPER_CASES,
+    fmt,
+    load_average,
+    machine,
+    machine_markdown,
+    table,
+    write_report,
+)
 
 import jaximpact as ji  # noqa: E402
 from jaximpact._bench import reference, time_call  # noqa: E402
 
-CASES = {
-    "kelvin_voigt": dict(c=2e6, b=400.0),
-    "maxwell": dict(c=2e6, b=2000.0),
-    "hertz_viscous": dict(c=2e6, b=40.0),
-    "hertz_rate": dict(c=2e6, b1=800.0),
-    "hunt_crossley": dict(c=2e6, a=0.1),
-}
+CASES = PAPER_CASES
 SOLVERS = {"Tsit5": dfx.Tsit5(), "Dopri8": dfx.Dopri8()}
 RTOLS = (1e-10, 1e-11)
 
@@ -113,9 +115,7 @@ def main():
             "",
         ]
     )
-    with open(os.path.join(HERE, "defaults.md"), "w") as handle:
-        handle.write(text)
-    print(text)
+    write_report(os.path.join(HERE, "defaults.md"), text)
 
 
 if __name__ == "__main__":

@@ -19,7 +19,7 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from _common import load_average, machine, machine_markdown, table  # noqa: E402
+from _common import load_average, machine, machine_markdown, table, write_report  # noqa: E402
 
 CHILD = r"""
 import json, os, sys, time
@@ -161,9 +161,7 @@ def main():
             "",
         ]
     )
-    with open(os.path.join(HERE, "first_calls.md"), "w") as handle:
-        handle.write(text)
-    print(text)
+    write_report(os.path.join(HERE, "first_calls.md"), text)
 
 
 if __name__ == "__main__":

@@ -45,6 +45,7 @@ jax.config.update("jax_enable_x64", True)
 import diffrax as dfx  # noqa: E402
 import jax.numpy as jnp  # noqa: E402
 from _common import (  # noqa: E402
+    PAPER_CASES,
     first_call,
     fmt,
     load_average,
@@ -61,13 +62,7 @@ from jaximpact import closed_forms  # noqa: E402
 from jaximpact._bench import scipy_problem, scipy_solver  # noqa: E402, F401
 
 M, V0 = 1.0, 2.5
-CASES = {
-    "kelvin_voigt": dict(c=2e6, b=400.0),
-    "maxwell": dict(c=2e6, b=2000.0),
-    "hertz_viscous": dict(c=2e6, b=40.0),
-    "hertz_rate": dict(c=2e6, b1=800.0),
-    "hunt_crossley": dict(c=2e6, a=0.1),
-}
+CASES = PAPER_CASES
 DAMPING = {
     "kelvin_voigt": "b",
     "maxwell": "b",
@@ -230,9 +225,7 @@ def euler_function(name):
             return n + 1, x + v * dt, v - f / M * dt, s_new
 
         state = (jnp.asarray(0), jnp.asarray(0.0), jnp.asarray(V0), jnp.asarray(0.0))
-        n, x, v, s = jax.lax.while_loop(
-            lambda st: ~ended(st) & (st[0] < 100_000_000), body, state
-        )
+        n, x, v, s = jax.lax.while_loop(lambda st: ~ended(st) & (st[0] < 100_000_000), body, state)
         return -v / V0, n * dt, n
 
     return jax.jit(run)
@@ -373,7 +366,12 @@ def measure_derivatives(name, solver_name="Tsit5", rtol=1e-10):
 
     def solve(params, m, v0):
         r = ji.impact(
-            ji.law(name, **params), m=m, v0=v0, method="integrate", rtol=rtol, peaks=False,
+            ji.law(name, **params),
+            m=m,
+            v0=v0,
+            method="integrate",
+            rtol=rtol,
+            peaks=False,
             solver=SOLVERS[solver_name](),
         )
         return jnp.stack([r.e, r.T])
@@ -432,7 +430,11 @@ def measure_targets(results, threshold=TARGET_ERROR, rounds=9):
     out = []
     for name in results["references"]:
         dop = loosest(
-            [r for r in rows if r["kind"] == "scipy" and r["law"] == name and r["method"] == "DOP853"],
+            [
+                r
+                for r in rows
+                if r["kind"] == "scipy" and r["law"] == name and r["method"] == "DOP853"
+            ],
             threshold,
         )
         jx = [r for r in rows if r["kind"] == "jaximpact" and r["law"] == name and r["status"] == 0]
@@ -579,16 +581,19 @@ def run(args):
             print("default", results["rows"][-1], flush=True)
         if name == "maxwell" and key(dict(kind="closed_form_function", law=name)) not in done:
             add(measure_maxwell_closed_form(ref))
-        if not args.no_derivatives and key(
-            dict(kind="derivative", law=name, mode="value only", rtol=1e-10)
-        ) not in done:
+        if (
+            not args.no_derivatives
+            and key(dict(kind="derivative", law=name, mode="value only", rtol=1e-10)) not in done
+        ):
             for r in measure_derivatives(name):
                 add(r)
         # jaximpact
         for solver_name in solvers:
             for rtol in rtols if args.quick else SPARSE_RTOLS.get(solver_name, rtols):
                 for peaks in (False, True):
-                    row = dict(kind="jaximpact", law=name, solver=solver_name, rtol=rtol, peaks=peaks)
+                    row = dict(
+                        kind="jaximpact", law=name, solver=solver_name, rtol=rtol, peaks=peaks
+                    )
                     if key(row) in done:
                         continue
                     row = measure_jaximpact(name, solver_name, rtol, peaks, ref)
@@ -631,15 +636,19 @@ def targets(results, threshold=TARGET_ERROR):
     rows = results["rows"]
     for name in results["references"]:
         dop = loosest(
-            [r for r in rows if r["kind"] == "scipy" and r["law"] == name and r["method"] == "DOP853"],
+            [
+                r
+                for r in rows
+                if r["kind"] == "scipy" and r["law"] == name and r["method"] == "DOP853"
+            ],
             threshold,
         )
-        jx = [
-            r for r in rows if r["kind"] == "jaximpact" and r["law"] == name and r["status"] == 0
-        ]
+        jx = [r for r in rows if r["kind"] == "jaximpact" and r["law"] == name and r["status"] == 0]
         if dop is None or not jx:
             continue
-        entry = dict(law=name, scipy_rtol=dop["rtol"], scipy_err_e=dop["err_e"], scipy_s=dop["single_s"])
+        entry = dict(
+            law=name, scipy_rtol=dop["rtol"], scipy_err_e=dop["err_e"], scipy_s=dop["single_s"]
+        )
         for label, subset in (
             ("any", jx),
             ("peaks", [r for r in jx if r["peaks"]]),
@@ -733,9 +742,13 @@ def report(results):
                     f"{t['scipy_rtol']:.1e}: {fmt(t['scipy_err_e'])}, {us(t['scipy_s'])} us",
                     {"any": "any", "peaks": "peaks", "default_solver": "Tsit5+peaks"}[label],
                     "-" if s is None else f"{s['config']}: {fmt(s['err_e'])}, {us(s['s'])} us",
-                    "-" if s is None else f"**{s['ratio']:.0f}x** {'met' if s['ratio'] >= 50 else 'MISSED'}",
+                    "-"
+                    if s is None
+                    else f"**{s['ratio']:.0f}x** {'met' if s['ratio'] >= 50 else 'MISSED'}",
                     "-" if b is None else f"{b['config']}: {us(b['s'])} us",
-                    "-" if b is None else f"**{b['ratio']:.0f}x** {'met' if b['ratio'] >= 1000 else 'MISSED'}",
+                    "-"
+                    if b is None
+                    else f"**{b['ratio']:.0f}x** {'met' if b['ratio'] >= 1000 else 'MISSED'}",
                 ]
             )
     if results.get("targets"):
@@ -849,7 +862,15 @@ def report(results):
             "RecursiveCheckpointAdjoint under `jacrev`).",
             "",
             table(
-                ["law", "mode", "single us", "x value", "compile s", "batch us/impact", "batch compile s"],
+                [
+                    "law",
+                    "mode",
+                    "single us",
+                    "x value",
+                    "compile s",
+                    "batch us/impact",
+                    "batch compile s",
+                ],
                 [
                     [
                         r["law"],
@@ -902,9 +923,7 @@ def report(results):
                         f"{r['compile_s']:.1f}",
                     ]
 
-                trs.append(
-                    [f"{solver} {rtol:.0e}{mark}"] + cells(a) + cells(b, bold=bool(mark))
-                )
+                trs.append([f"{solver} {rtol:.0e}{mark}"] + cells(a) + cells(b, bold=bool(mark)))
         lines += [
             "jaximpact, `peaks=False` | `peaks=True`: steps, error in e and T, µs per jitted "
             f"impact, µs per impact in a vmapped batch ({BATCH}; {BATCH_IMPLICIT} for Kvaerno5), "
@@ -926,7 +945,14 @@ def report(results):
                 table(
                     ["method", "rtol", "nfev", "err e", "err T", "us per impact"],
                     [
-                        [r["method"], f"{r['rtol']:.1e}", r["nfev"], fmt(r["err_e"]), fmt(r["err_T"]), us(r["single_s"])]
+                        [
+                            r["method"],
+                            f"{r['rtol']:.1e}",
+                            r["nfev"],
+                            fmt(r["err_e"]),
+                            fmt(r["err_T"]),
+                            us(r["single_s"]),
+                        ]
                         for r in sc
                     ],
                 ),
@@ -998,30 +1024,58 @@ def plot(results):
                         continue
                     ys = [max(r[what], floor) for r in rs]
                     ax.loglog(
-                        [r["single_s"] for r in rs], ys, style, marker="o", ms=3, color=colors[solver],
-                        label=f"jaximpact {solver}" + (" peaks" if peaks else "") if j == 0 and i == 0 else None,
+                        [r["single_s"] for r in rs],
+                        ys,
+                        style,
+                        marker="o",
+                        ms=3,
+                        color=colors[solver],
+                        label=f"jaximpact {solver}" + (" peaks" if peaks else "")
+                        if j == 0 and i == 0
+                        else None,
                     )
                     if not peaks:
                         ax.loglog(
-                            [r["batch_s"] for r in rs], ys, ":", marker=".", ms=3, color=colors[solver],
+                            [r["batch_s"] for r in rs],
+                            ys,
+                            ":",
+                            marker=".",
+                            ms=3,
+                            color=colors[solver],
                             label=f"jaximpact {solver} batch/impact" if j == 0 and i == 0 else None,
                         )
             for method in SCIPY_METHODS:
                 rs = sorted(
-                    [r for r in rows if r["kind"] == "scipy" and r["law"] == name and r["method"] == method],
+                    [
+                        r
+                        for r in rows
+                        if r["kind"] == "scipy" and r["law"] == name and r["method"] == method
+                    ],
                     key=lambda r: r["rtol"],
                 )
                 if rs:
                     ax.loglog(
-                        [r["single_s"] for r in rs], [max(r[what], floor) for r in rs], "-.",
-                        marker="s", ms=3, color=colors[method],
+                        [r["single_s"] for r in rs],
+                        [max(r[what], floor) for r in rs],
+                        "-.",
+                        marker="s",
+                        ms=3,
+                        color=colors[method],
                         label=f"scipy {method}" if j == 0 and i == 0 else None,
                     )
-            rs = sorted([r for r in rows if r["kind"] == "euler" and r["law"] == name], key=lambda r: -r["dt"])
+            rs = sorted(
+                [r for r in rows if r["kind"] == "euler" and r["law"] == name],
+                key=lambda r: -r["dt"],
+            )
             if rs:
                 ax.loglog(
-                    [r["single_s"] for r in rs], [max(r[what], floor) for r in rs], "-", marker="x",
-                    ms=4, color="k", label="Euler (paper)" if j == 0 and i == 0 else None,
+                    [r["single_s"] for r in rs],
+                    [max(r[what], floor) for r in rs],
+                    "-",
+                    marker="x",
+                    ms=4,
+                    color="k",
+                    label="Euler (paper)" if j == 0 and i == 0 else None,
                 )
                 paper = [r for r in rs if r["dt"] == 2e-5]
                 for r in paper:
@@ -1039,8 +1093,13 @@ def plot(results):
                 d = [r for r in rows if r["kind"] == "default" and r["law"] == name]
             for r in d:
                 ax.loglog(
-                    [r["single_s"]], [max(r[what], floor)], "*", ms=14, color="gold",
-                    markeredgecolor="k", label="default" if (i, j) == (0, 0) else None,
+                    [r["single_s"]],
+                    [max(r[what], floor)],
+                    "*",
+                    ms=14,
+                    color="gold",
+                    markeredgecolor="k",
+                    label="default" if (i, j) == (0, 0) else None,
                 )
             ax.axhline(TARGET_ERROR, color="grey", lw=0.5)
             ax.set_title(f"{name}: error in {what[-1]}")

@@ -233,20 +233,17 @@ def test_console_script_environment():
         "c.EQX_ON_ERROR)"
     )
     env = {k: v for k, v in os.environ.items() if k not in ("EQX_ON_ERROR", "TF_CPP_MIN_LOG_LEVEL")}
-    script = subprocess.run(
-        [sys.executable, "-c", probe.format("/usr/bin/jaximpact")],
-        capture_output=True,
-        text=True,
-        env=env,
-        check=True,
-    )
-    assert script.stdout.split() == ["nan", "3", "nan"]
-    library = subprocess.run(
-        [sys.executable, "-c", probe.format("analysis.py")],
-        capture_output=True,
-        text=True,
-        env=env,
-        check=True,
-    )
-    eqx_env, _, eqx_mode = library.stdout.split()
+
+    def run_as(argv0):
+        done = subprocess.run(
+            [sys.executable, "-c", probe.format(argv0)],
+            capture_output=True,
+            text=True,
+            env=env,
+            check=True,
+        )
+        return done.stdout.split()
+
+    assert run_as("/usr/bin/jaximpact") == ["nan", "3", "nan"]
+    eqx_env, _, eqx_mode = run_as("analysis.py")
     assert (eqx_env, eqx_mode) == ("None", "raise")
