@@ -192,8 +192,16 @@ class MaxwellDynamics(AbstractDynamics):
         """Over-damped (`mu >= 2`) and no gravity: `V'' + mu V' + V = 0` keeps `V > 0`, the
         body sinks in for ever while the force relaxes (`closed_forms.maxwell_creep`)."""
         captured = (self.mu >= 2.0) & (self.gamma == 0)
-        # a harmless over-damped value elsewhere, so no NaN reaches a discarded gradient
-        tau, x, tau_peak, force_peak = maxwell_creep(jnp.where(captured, self.mu, 3.0), rest_tol)
+        # a harmless over-damped value elsewhere, so no NaN reaches a discarded gradient;
+        # the closed form (a Newton root) only runs where it is used (both branches run
+        # under vmap, where `cond` becomes a select): under-damped impacts pay nothing
+        mu = jnp.where(captured, self.mu, 3.0)
+        tau, x, tau_peak, force_peak = jax.lax.cond(
+            captured,
+            lambda mu: maxwell_creep(mu, rest_tol),
+            lambda mu: (jnp.zeros_like(mu),) * 4,
+            mu,
+        )
         return dict(captured=captured, tau=tau, x=x, tau_peak=tau_peak, force_peak=force_peak)
 
 
