@@ -12,6 +12,7 @@ import dataclasses
 from collections.abc import Callable
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 from jaxtyping import Array
 
@@ -36,7 +37,11 @@ class LawSpec:
     contact is integrated as two smooth phases; `dry`: that force can hold the body at rest.
     `gap` says where the force criterion ends contact: `"force"` (a dry force makes `F`
     itself cross zero), `"x"` (the force only vanishes at `x = 0`), or the exponent `n - p`
-    of the reduced force `F / x^p`.
+    of the reduced force `F / x^p` (`"power"`: computed from the law's own `n` and `p`).
+    `one_group`: without gravity the impact depends on the one group `beta` alone (the
+    family without a dry force), so `impact` can read it off the universal curves;
+    `shape_parameters`: parameters that fix the curves' shape `(n, p)` (they must be known
+    numbers, not traced values, for the curves to serve).
     """
 
     name: str
@@ -50,6 +55,8 @@ class LawSpec:
     split: bool = False
     dry: bool = False
     defaults: dict[str, float] = dataclasses.field(default_factory=dict)
+    one_group: bool = False
+    shape_parameters: tuple[str, ...] = ()
 
 
 _PAPER = "Polukoshko et al. 2007"
@@ -79,6 +86,7 @@ _SPECS = [
         f"{_PAPER}, eq. 1",
         lambda q, v0: _family(q["c"], 1, q["b"], 0),
         gap=1,
+        one_group=True,
     ),
     LawSpec(
         "kelvin_voigt_modified",
@@ -89,6 +97,7 @@ _SPECS = [
         f"{_PAPER}, eq. 6",
         lambda q, v0: _family(q["c"], 1, q["b1"], 1),
         gap=0,
+        one_group=True,
     ),
     LawSpec(
         "bingham",
@@ -141,6 +150,7 @@ _SPECS = [
         f"{_PAPER}, eq. 12",
         lambda q, v0: _family(q["c"], 1.5, q["b"], 0),
         gap=1.5,
+        one_group=True,
     ),
     LawSpec(
         "hertz_modified",
@@ -151,6 +161,7 @@ _SPECS = [
         f"{_PAPER}, eq. 13",
         lambda q, v0: _family(q["c"], 1.5, q["b"], 1),
         gap=0.5,
+        one_group=True,
     ),
     LawSpec(
         "hertz_rate",
@@ -161,6 +172,7 @@ _SPECS = [
         f"{_PAPER}, eq. 14 (the paper's proposal; Kuwabara & Kono 1987)",
         lambda q, v0: _family(q["c"], 1.5, q["b1"], 0.5),
         gap=1,
+        one_group=True,
     ),
     LawSpec(
         "hunt_crossley",
@@ -172,6 +184,8 @@ _SPECS = [
         lambda q, v0: _family(q["c"], q["n"], 1.5 * q["a"] * q["c"], q["n"]),
         gap="x",
         defaults={"n": 1.5},
+        one_group=True,
+        shape_parameters=("n",),
     ),
 ]
 
@@ -191,10 +205,27 @@ def _nominal_spec(name, formula):
         coefficients,
         gap="x",
         defaults={"n": 1.5},
+        one_group=True,
+        shape_parameters=("n",),
     )
 
 
 _SPECS += [_nominal_spec(name, formula) for name, formula in _hysteresis_damping.FORMULAS.items()]
+
+_SPECS.append(
+    LawSpec(
+        "power",
+        "-",
+        "c x^n + b x^p v",
+        ("c", "n", "b", "p"),
+        _UNITS,
+        "the family of eqs. 1, 6, 12-16 with the user's own exponents (0 <= p <= n)",
+        lambda q, v0: _family(q["c"], q["n"], q["b"], q["p"]),
+        gap="power",
+        one_group=True,
+        shape_parameters=("n", "p"),
+    )
+)
 
 LAWS: dict[str, LawSpec] = {spec.name: spec for spec in _SPECS}
 LAW_NAMES: tuple[str, ...] = tuple(LAWS)
@@ -254,6 +285,9 @@ class Law(AbstractLaw):
         if self.name == "maxwell":
             return maxwell_dynamics(self.params["c"], self.params["b"], m=m, v0=v0, g=g)
         c, n, b, p, p_in, p_out = self.spec.coefficients(self.params, v0)
+        gap = self.spec.gap
+        if gap == "power":
+            gap = _power_gap(n, p)
         return power_dynamics(
             c,
             n,
@@ -264,7 +298,7 @@ class Law(AbstractLaw):
             m=m,
             v0=v0,
             g=g,
-            gap=self.spec.gap,
+            gap=gap,
             split=self.spec.split,
             can_stick=self.spec.dry,
         )
@@ -317,6 +351,29 @@ class CustomLaw(AbstractLaw):
         return self.fn(jnp.asarray(x, dtype=float), jnp.asarray(v, dtype=float), self.params)
 
 
+def _power_gap(n, p):
+    """`PowerDynamics.gap` of the power law: `"x"` where `n = p` (the force vanishes at
+    `x = 0` only), else `n - p`; the force itself if the exponents are traced values."""
+    try:
+        k = float(n) - float(p)
+    except (TypeError, jax.errors.ConcretizationTypeError, jax.errors.TracerArrayConversionError):
+        return "force"
+    return "x" if k == 0 else k
+
+
+def shape_of(law) -> tuple[float, float] | None:
+    """The exponents `(n, p)` of a one-group law as numbers, or `None` (not one-group, or
+    its exponents are traced values under a transformation)."""
+    spec = getattr(law, "spec", None)
+    if spec is None or not spec.one_group:
+        return None
+    _, n, _, p, _, _ = spec.coefficients(law.params, 1.0)
+    try:
+        return float(n), float(p)
+    except (TypeError, jax.errors.ConcretizationTypeError, jax.errors.TracerArrayConversionError):
+        return None
+
+
 def _as_arrays(params):
     return {k: jnp.asarray(v, dtype=float) for k, v in params.items()}
 
@@ -367,7 +424,18 @@ def law(name: str, **params) -> Law:
             + (f" (defaults: {spec.defaults})" if spec.defaults else "")
         )
     given = {k: given[k] for k in spec.parameters}
+    if name == "power" and _concrete_numbers(given["n"], given["p"]):
+        if not 0 <= float(given["p"]) <= float(given["n"]):
+            raise ValueError(
+                f"law 'power' needs exponents 0 <= p <= n, got n={given['n']}, p={given['p']}"
+            )
     return Law(name, _as_arrays(_check_law_parameters(name, given)))
+
+
+def _concrete_numbers(*values) -> bool:
+    return all(
+        not isinstance(v, jax.core.Tracer) and jnp.ndim(v) == 0 for v in values
+    )
 
 
 def custom_law(fn: Callable, **params) -> CustomLaw:
