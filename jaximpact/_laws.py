@@ -227,6 +227,71 @@ _SPECS.append(
     )
 )
 
+# the engines' own laws (jaximpact._engines; formulas and sources in docs/engines.md)
+_ENGINE_UNITS = {**_UNITS, "d": "s/m", "m_eff": "kg"}
+
+
+def _log_damping(e):
+    """`-ln e / sqrt(pi^2 + ln^2 e)`: the damping ratio of a linear spring-dashpot whose
+    penetration-criterion restitution is `e`."""
+    log_e = jnp.log(e)
+    return -log_e / jnp.sqrt(jnp.pi**2 + log_e**2)
+
+
+_SPECS += [
+    LawSpec(
+        "tsuji",
+        "-",
+        "c x^1.5 + b x^0.25 v",
+        ("c", "b"),
+        _ENGINE_UNITS,
+        "Tsuji, Tanaka & Ishida, Powder Technol. 71 (1992) 239; LAMMPS pair granular "
+        "hertz/material with damping coeff_restitution or tsuji, LIGGGHTS, Chrono SMC Hertz",
+        lambda q, v0: _family(q["c"], 1.5, q["b"], 0.25),
+        gap=1.25,
+    ),
+    LawSpec(
+        "tsuji_restitution",
+        "-",
+        "c x^1.5 + b x^0.25 v, b = sqrt(5) (-ln e) / sqrt(pi^2 + ln^2 e) sqrt(m_eff c)",
+        ("c", "e_nominal", "m_eff"),
+        _ENGINE_UNITS,
+        "LAMMPS pair granular, damping coeff_restitution (src/GRANULAR/"
+        "gran_sub_mod_damping.cpp); LIGGGHTS model hertz; Chrono ChContactSMC Hertz",
+        lambda q, v0: _family(
+            q["c"],
+            1.5,
+            jnp.sqrt(5.0) * _log_damping(q["e_nominal"]) * jnp.sqrt(q["m_eff"] * q["c"]),
+            0.25,
+        ),
+        gap=1.25,
+    ),
+    LawSpec(
+        "spring_dashpot_restitution",
+        "-",
+        "c x + b v, b = 2 (-ln e) / sqrt(pi^2 + ln^2 e) sqrt(m_eff c)",
+        ("c", "e_nominal", "m_eff"),
+        _ENGINE_UNITS,
+        "LAMMPS pair granular hooke, damping coeff_restitution; a MuJoCo dampratio set "
+        "from e the same way; exact under separation='penetration' only",
+        lambda q, v0: _family(
+            q["c"], 1, 2.0 * _log_damping(q["e_nominal"]) * jnp.sqrt(q["m_eff"] * q["c"]), 0
+        ),
+        gap=1,
+    ),
+    LawSpec(
+        "point_contact",
+        "-",
+        "c x (1 + d v)",
+        ("c", "d"),
+        _ENGINE_UNITS,
+        "Drake MultibodyPlant point contact (point_contact_stiffness c, "
+        "hunt_crossley_dissipation d); Hunt & Crossley with n = 1",
+        lambda q, v0: _family(q["c"], 1, q["c"] * q["d"], 1),
+        gap="x",
+    ),
+]
+
 LAWS: dict[str, LawSpec] = {spec.name: spec for spec in _SPECS}
 LAW_NAMES: tuple[str, ...] = tuple(LAWS)
 

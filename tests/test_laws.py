@@ -27,7 +27,14 @@ NOMINAL_LAWS = tuple(
     name for name in ji.LAW_NAMES if ji.LAWS[name].parameters == ("c", "e_nominal", "n")
 )
 # laws beyond the paper and the nominal family, with parameters to try them with
-OTHER_LAWS = {"power": dict(c=2e6, n=1.5, b=800.0, p=0.5)}
+OTHER_LAWS = {
+    "power": dict(c=2e6, n=1.5, b=800.0, p=0.5),
+    # the engines' own laws (jaximpact._engines)
+    "tsuji": dict(c=2e6, b=800.0),
+    "tsuji_restitution": dict(c=2e6, e_nominal=0.8, m_eff=1.0),
+    "spring_dashpot_restitution": dict(c=2e6, e_nominal=0.8, m_eff=1.0),
+    "point_contact": dict(c=2e6, d=0.2),
+}
 # laws whose every term carries a fractional power of x: no force at all outside contact
 FRACTIONAL = ("hertz_rate", "hunt_crossley") + NOMINAL_LAWS
 
