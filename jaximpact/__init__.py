@@ -45,6 +45,15 @@ from ._plotting import plot_impact as plot_impact
 from ._powers import safe_pow as safe_pow
 from ._status import Status as Status
 
+# engines: material inputs and exports to MuJoCo, Drake, LAMMPS (issue 14)
+from ._engines import (
+    Export as Export,
+    effective_mass as effective_mass,
+    effective_radius as effective_radius,
+    export as export,
+    hertz_stiffness as hertz_stiffness,
+)
+
 try:
     __version__ = importlib.metadata.version("jaximpact")
 except importlib.metadata.PackageNotFoundError:  # running from a source tree

@@ -1,0 +1,256 @@
+"""`export`: from a law, a fit or target e and T to an engine's own contact parameters, with
+the e and T that the engine will realise."""
+
+import dataclasses
+import math
+
+import numpy as np
+
+from . import drake, lammps, mujoco
+from .materials import check_positive, check_restitution
+
+ENGINES = {"mujoco": mujoco, "lammps": lammps, "drake": drake}
+_SPEED_FACTORS = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0)
+
+
+@dataclasses.dataclass(frozen=True)
+class Export:
+    """An engine's contact parameters and what the engine realises with them.
+
+    - `engine`, `scene`: the engine and the collision the promise is for.
+    - `parameters`: the engine's own names and units (MuJoCo `solref`, `solimp`, `timestep`;
+      Drake `point_contact_stiffness` N/m, `hunt_crossley_dissipation` s/m, `time_step` s;
+      LAMMPS `pair_style`, `pair_coeff`, `timestep`, the strings its input takes, SI units).
+    - `snippet`: text to paste into the engine's model or script.
+    - `e`, `T` (s): what the engine realises at `v0` with `timestep` (its time stepping
+      included: the mean over where the first touch falls inside a step); `e_range`,
+      `T_range`: their extremes over those start phases (None for Drake's continuous plant).
+    - `timestep` (s): the recommended (or given) step; `steps_per_contact`.
+    - `target_e`, `target_T`: what was asked (the law's e and T at `v0`, or the targets).
+    - `law`: the engine's law as a jaximpact law, `separation`: its end of contact.
+    - `speeds` (m/s), `e_engine`, `T_engine`, `e_target`, `T_target`: e(v) and T(v) of the
+      engine's law and of the given law (None when targets were given) over a range of speeds.
+    - `warnings`: where the engine will not do what was asked, or only with care.
+    """
+
+    engine: str
+    scene: str
+    parameters: dict
+    snippet: str
+    e: float
+    T: float
+    timestep: float | None
+    warnings: tuple[str, ...]
+    target_e: float
+    target_T: float
+    m: float
+    v0: float
+    e_range: tuple | None = None
+    T_range: tuple | None = None
+    steps_per_contact: float | None = None
+    law: object = None
+    separation: str = "force"
+    speeds: tuple = ()
+    e_engine: tuple = ()
+    T_engine: tuple = ()
+    e_target: tuple | None = None
+    T_target: tuple | None = None
+
+    def to_dict(self) -> dict:
+        out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "law"}
+        out["law"] = None if self.law is None else {
+            "name": self.law.name,
+            "parameters": {k: float(v) for k, v in self.law.parameters.items()},
+        }
+        return out
+
+
+def _law_of(law_or_fit):
+    from .._laws import AbstractLaw
+
+    if isinstance(law_or_fit, AbstractLaw):
+        return law_or_fit
+    inner = getattr(law_or_fit, "law", None)
+    if isinstance(inner, AbstractLaw):
+        return inner
+    raise ValueError(
+        "export needs a law (jaximpact.law(...)), a fit (calibrate's result) or None with "
+        f"e= and T=; got {type(law_or_fit).__name__}"
+    )
+
+
+def _curve(law, m, speeds, separation):
+    from .._impact import impact
+
+    es, Ts = [], []
+    for v in speeds:
+        r = impact(law, m=m, v0=float(v), separation=separation)
+        es.append(float(r.e))
+        Ts.append(float(r.T))
+    return tuple(es), tuple(Ts)
+
+
+def export(
+    law_or_fit,
+    engine: str,
+    *,
+    m,
+    v0,
+    timestep=None,
+    radius=None,
+    poisson=None,
+    e=None,
+    T=None,
+    limit_damping: bool = False,
+    curves: bool = True,
+) -> Export:
+    """Parameters for `engine` (`"mujoco"`, `"drake"`, `"lammps"`) that realise the e and T of
+    `law_or_fit` (a law or `calibrate`'s fit) for mass `m` (kg) at impact speed `v0` (m/s), or
+    the targets `e` and `T` (s) when `law_or_fit` is None.
+
+    The scene: MuJoCo and Drake, a body of mass `m` on a fixed plane; LAMMPS, two spheres each
+    of mass `m` and radius `radius` (m, required) colliding head-on at relative speed `v0`
+    (`poisson`: their Poisson's ratio, default 0.3; `limit_damping`: keep the force
+    non-attractive). `timestep` (s): the engine's step if already chosen (the export then
+    corrects for it where it can and warns where it cannot); default, a recommended step.
+    The returned `Export` states what the engine realises, computed through a replica of its
+    time stepping (MuJoCo, LAMMPS) checked against the engines in tests/test_engines.py.
+
+    **Example**: `export(law("hertz_rate", c=2e6, b1=800.0), "mujoco", m=1.0, v0=2.5).parameters`.
+    """
+    if engine not in ENGINES:
+        raise ValueError(f"unknown engine {engine!r}; choose one of: {', '.join(ENGINES)}")
+    m = check_positive("m", m, "kg")
+    v0 = check_positive("v0", v0, "m/s")
+    if timestep is not None:
+        timestep = check_positive("timestep", timestep, "s")
+    if poisson is not None:
+        from .materials import _poisson
+
+        poisson = _poisson("poisson", poisson)
+    source = None
+    if law_or_fit is None:
+        if e is None:
+            raise ValueError("export needs a law or fit, or the target e= (and T=)")
+        target_e = check_restitution(e)
+        target_T = None if T is None else check_positive("T", T, "s")
+    else:
+        if e is not None or T is not None:
+            raise ValueError("give either a law (or fit) or the targets e= and T=, not both")
+        source = _law_of(law_or_fit)
+        from .._impact import impact
+
+        result = impact(source, m=m, v0=v0)
+        if int(result.status) != 0:
+            raise ValueError("the law does not separate at this m and v0 (e = 0): no engine target")
+        target_e, target_T = float(result.e), float(result.T)
+    warnings = []
+    module = ENGINES[engine]
+    if engine == "mujoco":
+        if target_T is None:
+            # MuJoCo's default timeconst (0.02 s) at the damping ratio the target needs
+            zeta = mujoco.dampratio_for(target_e)
+            target_T = mujoco.continuous(zeta)[1] * 0.02 * max(zeta, 1e-300)
+            if zeta == 0:
+                target_T = math.pi * 0.02
+            warnings.append(f"no T given: MuJoCo's default timeconst 0.02 s, T = {target_T:.4g} s")
+        out = mujoco.design(target_e, target_T, v0, timestep)
+        separation = "force"
+        h = out["parameters"]["timestep"]
+    elif engine == "lammps":
+        if radius is None:
+            raise ValueError("LAMMPS needs the spheres' radius: pass radius= (m)")
+        radius = check_positive("radius", radius, "m")
+        if target_T is None:
+            raise ValueError("LAMMPS needs a contact duration: pass T= (s) or a law")
+        out = lammps.design(
+            target_e, target_T, m=m, v0=v0, radius=radius,
+            poisson=0.3 if poisson is None else poisson, timestep=timestep,
+            limit_damping=limit_damping,
+        )
+        separation = out["separation"]
+        h = out["parameters"]["timestep_s"]
+    else:
+        if target_T is None:
+            raise ValueError("Drake needs a contact duration: pass T= (s) or a law")
+        out = drake.design(target_e, target_T, m=m, v0=v0, timestep=timestep)
+        separation = "force"
+        h = out["parameters"]["time_step"]
+    warnings += out["warnings"]
+    # the law each side realises; LAMMPS's promise is for the pair (effective mass m/2)
+    engine_law = module.law(out["parameters"], m)
+    m_engine = m / 2.0 if engine == "lammps" else m
+    speeds, e_engine, T_engine, e_target, T_target = (), (), (), None, None
+    if curves:
+        speeds = tuple(v0 * f for f in _SPEED_FACTORS)
+        e_engine, T_engine = _curve(engine_law, m_engine, speeds, separation)
+        if source is not None:
+            e_target, T_target = _curve(source, m, speeds, "force")
+            spread = max(abs(a - b) for a, b in zip(e_engine, e_target, strict=True))
+            if spread > 0.02:
+                warnings.append(
+                    f"the engine's e(v) departs from the law's by up to {spread:.3f} between "
+                    f"{speeds[0]:.3g} and {speeds[-1]:.3g} m/s: the export is exact at v0 only"
+                )
+    return Export(
+        engine=engine,
+        scene=module.SCENE,
+        parameters=out["parameters"],
+        snippet=module.snippet(out["parameters"]),
+        e=out["e"],
+        T=out["T"],
+        timestep=h,
+        warnings=tuple(warnings),
+        target_e=target_e,
+        target_T=target_T,
+        m=m,
+        v0=v0,
+        e_range=out["e_range"],
+        T_range=out["T_range"],
+        steps_per_contact=out["steps_per_contact"],
+        law=engine_law,
+        separation=separation,
+        speeds=speeds,
+        e_engine=e_engine,
+        T_engine=T_engine,
+        e_target=e_target,
+        T_target=T_target,
+    )
+
+
+def engine_response(engine: str, parameters: dict, *, m, speeds, radius=None):
+    """The inverse: e(v) and T(v) (continuous law of the engine) that given engine parameters
+    produce, for a body of mass `m` (kg; LAMMPS: each sphere) at each speed of `speeds` (m/s).
+    Returns `(law, separation, e, T)`."""
+    if engine not in ENGINES:
+        raise ValueError(f"unknown engine {engine!r}; choose one of: {', '.join(ENGINES)}")
+    m = check_positive("m", m, "kg")
+    speeds = [check_positive("speed", v, "m/s") for v in np.atleast_1d(speeds)]
+    if engine == "mujoco":
+        params = {"solref": parameters["solref"], "timestep": parameters.get("timestep", 0.002)}
+        law, separation, m_engine = mujoco.law(params, m), "force", m
+    elif engine == "lammps":
+        if radius is None:
+            raise ValueError("LAMMPS needs the spheres' radius: pass radius= (m)")
+        radius = check_positive("radius", radius, "m")
+        E = check_positive("E", parameters["E"], "Pa")
+        from .materials import _poisson, hertz_stiffness
+
+        nu = _poisson("poisson", parameters.get("poisson", 0.3))
+        coefficient = check_restitution(parameters["coeff_restitution"], "coeff_restitution")
+        c = hertz_stiffness(E, nu, radius, R2=radius)
+        b = lammps._damp(coefficient) * math.sqrt(m / 2.0 * c) if coefficient < 1 else 0.0
+        from .._laws import law as make_law
+
+        law = make_law("tsuji", c=c, b=b)
+        separation = "force" if parameters.get("limit_damping") else "penetration"
+        m_engine = m / 2.0
+    else:
+        k = check_positive("point_contact_stiffness", parameters["point_contact_stiffness"], "N/m")
+        d = parameters["hunt_crossley_dissipation"]
+        if d < 0:
+            raise ValueError(f"hunt_crossley_dissipation must be >= 0 s/m, got {d}")
+        law = drake.law({"point_contact_stiffness": k, "hunt_crossley_dissipation": d}, m)
+        separation, m_engine = "force", m
+    e, T = _curve(law, m_engine, speeds, separation)
+    return law, separation, e, T

