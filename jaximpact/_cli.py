@@ -529,6 +529,8 @@ COMMANDS: list[tuple[str, Callable | str]] = [
     ("calibrate", "jaximpact._cli_calibrate:add_calibrate"),
     ("paper", "jaximpact._cli_paper:add_paper"),
     ("bench", "jaximpact._cli_bench:add_bench"),
+    ("export", "jaximpact._cli_export:add_export"),
+    ("engine-e", "jaximpact._cli_export:add_engine_e"),
 ]
 
 

@@ -211,3 +211,54 @@ def test_drake_continuous_realises_the_promise(e, T):
     assert e_of_v[0] > e_of_v[1] > e_of_v[2] and e_of_v[1] == pytest.approx(x.e, rel=1e-9)
     e_fast, _ = drake_engine.simulate(x.parameters, m=0.05, v0=2.0)
     assert abs(e_fast / e_of_v[2] - 1) < 0.005
+
+
+# ------------------------------------------------------------------------- command line
+
+
+@pytest.mark.parametrize(
+    "argv, match",
+    [
+        (["export", "--engine", "bullet", "--e", "0.5", "--T", "1e-3", "--v0", "1"], "unknown engine"),
+        (["export", "--engine", "lammps", "--e", "0.5", "--T", "1e-3", "--v0", "1"], "radius"),
+        (["export", "--engine", "mujoco", "--e", "1.5", "--T", "1e-3", "--v0", "1"], r"\(0, 1\]"),
+        (["export", "--engine", "mujoco", "--e", "0.5", "--T", "0", "--v0", "1"], "T must be"),
+        (["export", "--engine", "mujoco", "--e", "0.5", "--T", "1e-3", "--v0", "1",
+          "--mass", "-1"], "m must be"),
+        (["export", "--engine", "lammps", "--e", "0.5", "--T", "1e-3", "--v0", "1",
+          "--radius", "0.01", "--poisson", "0.5"], r"\(-1, 0.5\)"),
+        (["export", "--engine", "mujoco", "--law", "maxwell", "--param", "c=1e6", "b=1",
+          "--e", "0.5", "--v0", "1"], "not both"),
+        (["engine-e", "--engine", "lammps", "--params", '{"E": -1, "coeff_restitution": 0.5}',
+          "--radius", "0.01", "--speed", "1"], "E must be"),
+        (["engine-e", "--engine", "drake", "--params", "{", "--speed", "1"], "not JSON"),
+    ],
+)
+def test_cli_bad_input_is_one_line_with_status_2(argv, match, capsys):
+    from jaximpact._cli import main
+
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    assert info.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("jaximpact: error:") and "\n" not in err
+    import re
+
+    assert re.search(match, err), err
+
+
+def test_cli_export_json_and_engine_e_round_trip(capsys):
+    """export then engine-e on the exported solref gives back the same continuous e."""
+    import json
+
+    from jaximpact._cli import main
+
+    main(["export", "--engine", "mujoco", "--e", "0.6", "--T", "5e-3", "--mass", "0.05",
+          "--v0", "1", "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert abs(out["e"] / 0.6 - 1) < 1e-3 and len(out["parameters"]["solimp"]) == 5
+    params = json.dumps({"solref": out["parameters"]["solref"]})
+    main(["engine-e", "--engine", "mujoco", "--params", params, "--mass", "0.05",
+          "--speed", "0.5", "1", "--json"])
+    back = json.loads(capsys.readouterr().out)
+    assert back["e"][0] == pytest.approx(out["e_engine"][3], rel=1e-9)
