@@ -10,6 +10,7 @@ program, differentiable in both modes (shared/notes/diffrax-impact-notes.md, sec
 """
 
 import enum
+import math
 
 import diffrax as dfx
 import equinox as eqx
@@ -360,6 +361,34 @@ def _solve_bounce(law, m, g, drag, start, t_end, min_flight, options: BounceOpti
     )
 
 
+def _check_real(name, value):
+    """A number or array of real numbers (a traced one passes)."""
+    if value is None and name == "drag" or isinstance(value, jax.core.Tracer):
+        return
+    try:
+        kind = np.asarray(value).dtype.kind
+    except (TypeError, ValueError):
+        kind = "O"
+    if kind not in "biuf":
+        raise TypeError(f"{name} must be a real number, got {value!r}")
+
+
+def _check_count(name, value):
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
+    if value < 1:
+        raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
+
+
+def _check_tolerance(name, value, below_one=False):
+    """A static option: a real number > 0 (and < 1 for a relative tolerance)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)):
+        raise TypeError(f"{name} must be a number, got {value!r}")
+    if not (math.isfinite(value) and value > 0 and (value < 1 or not below_one)):
+        limit = "0 < {name} < 1" if below_one else "a finite number > 0"
+        raise ValueError(f"{name} must be {limit.format(name=name)}, got {value!r}")
+
+
 def bounce_options(
     *,
     separation="force",
@@ -377,8 +406,21 @@ def bounce_options(
     `RecursiveCheckpointAdjoint`."""
     if separation not in SEPARATIONS:
         raise ValueError(f"separation must be one of {SEPARATIONS}, got {separation!r}")
-    if not isinstance(max_impacts, (int, np.integer)) or max_impacts < 1:
-        raise ValueError(f"max_impacts must be an integer >= 1, got {max_impacts!r}")
+    _check_count("max_impacts", max_impacts)
+    _check_count("max_steps", max_steps)
+    _check_tolerance("rtol", rtol, below_one=True)
+    if atol is not None:
+        _check_tolerance("atol", atol)
+    _check_tolerance("rest_tol", rest_tol, below_one=True)
+    _check_tolerance("tau_max", tau_max)
+    if not isinstance(peaks, (bool, np.bool_)):
+        raise TypeError(f"peaks must be True or False, got {peaks!r}")
+    if solver is not None and not isinstance(solver, dfx.AbstractSolver):
+        raise TypeError(f"solver must be a diffrax solver such as diffrax.Tsit5(), got {solver!r}")
+    if adjoint is not None and not isinstance(adjoint, dfx.AbstractAdjoint):
+        raise TypeError(
+            f"adjoint must be a diffrax adjoint such as diffrax.ForwardMode(), got {adjoint!r}"
+        )
     rtol, atol, rest_tol = resolvable_tolerances(rtol, rtol if atol is None else atol, rest_tol)
     return BounceOptions(
         impact=ImpactOptions(
@@ -439,9 +481,12 @@ def bounce(
       (with a speed-independent restitution the bounces accumulate in finite time).
     - `solver`, `rtol`, `atol`, `max_steps`, `tau_max`, `rest_tol`, `peaks`: each contact's
       solve, as in `impact` (`peaks=False` leaves `F_max` and `x_max` out and integrates each
-      contact in one phase; the histories always use the three phases, so they then agree with
-      the per-contact arrays to the solver's tolerance rather than exactly); `adjoint`: default picks the cheapest diffrax adjoint for the
-      transformation in use (`ForwardMode` under `jax.jacfwd`).
+      contact in one phase; the histories always use the three phases, so they then agree
+      with the per-contact arrays to the solver's tolerance rather than exactly); `adjoint`:
+      default picks the cheapest diffrax adjoint for the transformation in use
+      (`ForwardMode` under `jax.jacfwd`). Tolerances must lie in (0, 1), `tau_max` be > 0,
+      `max_steps` and `max_impacts` integers >= 1 (a ValueError otherwise).
+    - `h0 = 0` needs a downward (or upward) `v_drop`: a ball at rest on the floor is refused.
     - `throw`: raise if the sequence failed or ran out of `max_impacts`.
     Differentiable (forward and reverse mode) in the law's parameters, `m`, `h0`, `v_drop`,
     `g` and `drag`; works under `jax.vmap`.
@@ -457,6 +502,11 @@ def bounce(
             f"bounce needs a law from jaximpact.law(...) or jaximpact.custom_law(...), "
             f"got {type(law).__name__}"
         )
+    for name, value in (
+        ("m", m), ("h0", h0), ("t_end", t_end), ("g", g), ("v_drop", v_drop),
+        ("min_flight", min_flight), ("drag", drag),
+    ):  # fmt: skip
+        _check_real(name, value)
     m = jnp.asarray(check_positive("mass m", m, "kg"), dtype=float)
     h0 = jnp.asarray(check_nonnegative("drop height h0", h0, "m"), dtype=float)
     t_end = jnp.asarray(check_positive("t_end", t_end, "s"), dtype=float)
@@ -474,6 +524,16 @@ def bounce(
     for name, value in (("m", m), ("h0", h0), ("t_end", t_end), ("g", g), ("v_drop", v_drop)):
         if jnp.ndim(value):
             raise ValueError(f"bounce takes a scalar {name}; use jax.vmap for a batch")
+    resting = (h0 == 0) & (v_drop == 0)
+    message = (
+        "h0 = 0 with v_drop = 0: the ball starts at rest on the floor and never bounces "
+        "(give a drop height h0 > 0 m or a downward speed v_drop > 0 m/s)"
+    )
+    if not any(isinstance(a, jax.core.Tracer) for a in (h0, v_drop)):
+        if bool(resting):
+            raise ValueError(message)
+    else:
+        h0 = eqx.error_if(h0, resting, message)
     if adjoint is None:
         adjoint = auto_adjoint(law, m, h0, v_drop, g, drag, t_end)
     options = bounce_options(

@@ -383,13 +383,59 @@ def test_drag_matches_independent_chain():
         (dict(separation="glue"), "separation"),
         (dict(drag=-0.1), "drag"),
         (dict(drag=1.0, v_drop=5.0), "terminal speed"),
+        (dict(h0=0.0), "h0 = 0 with v_drop = 0"),
+        (dict(h0=math.nan), "h0"),
+        (dict(h0=math.inf), "h0"),
+        (dict(t_end=-1.0), "t_end"),
+        (dict(t_end=math.nan), "t_end"),
+        (dict(m=0.0), "mass"),
+        (dict(v_drop=math.nan), "v_drop"),
+        (dict(min_flight=-1.0), "min_flight"),
+        (dict(h0=[0.1, 0.2]), "scalar h0"),
+        (dict(rtol=0.0), "rtol"),
+        (dict(rtol=-1e-8), "rtol"),
+        (dict(rtol=math.nan), "rtol"),
+        (dict(rtol=1.0), "rtol"),
+        (dict(atol=0.0), "atol"),
+        (dict(rest_tol=0.0), "rest_tol"),
+        (dict(tau_max=-1.0), "tau_max"),
+        (dict(max_steps=0), "max_steps"),
+        (dict(max_steps=2.5), "max_steps"),
+        (dict(max_impacts=True), "max_impacts"),
     ],
 )
 def test_bad_input_is_a_one_line_value_error(kwargs, message):
     args = dict(m=M, h0=H0, t_end=1.0)
     args.update(kwargs)
-    with pytest.raises(ValueError, match=message):
+    with pytest.raises(ValueError, match=message) as error:
         bounce(ji.law("hertz_rate", c=1e6, b1=1350.0), **args)
+    assert len(str(error.value).splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        (dict(h0="0.5"), "h0 must be a real number"),
+        (dict(m=None), "m must be a real number"),
+        (dict(peaks="no"), "peaks"),
+        (dict(solver="tsit5"), "diffrax solver"),
+        (dict(adjoint="forward"), "diffrax adjoint"),
+        (dict(rtol="1e-8"), "rtol must be a number"),
+    ],
+)
+def test_wrong_type_is_a_type_error(kwargs, message):
+    args = dict(m=M, h0=H0, t_end=1.0)
+    args.update(kwargs)
+    with pytest.raises(TypeError, match=message):
+        bounce(ji.law("hertz_rate", c=1e6, b1=1350.0), **args)
+
+
+def test_h0_zero_with_a_downward_speed_is_a_drop():
+    """Only a ball at rest on the floor is refused: thrown down from the floor it bounces."""
+    b = bounce(ji.law("hertz_rate", c=1e6, b1=1350.0), m=M, h0=0.0, v_drop=1.0, t_end=0.3,
+               max_impacts=MAX_IMPACTS)  # fmt: skip
+    assert int(b.num_impacts) >= 2
+    assert float(b.impact_times[0]) == 0.0 and np.isfinite(float(b.e[0]))
 
 
 def test_bad_law_is_a_type_error():
