@@ -14,7 +14,6 @@ Formats read (detected from the file unless `--format` says):
 import csv
 import io
 import math
-import sys
 from pathlib import Path
 
 from ._cli import (
@@ -51,7 +50,10 @@ def add_fit(subparsers):
         "drop height), and for a trajectory the floor level and, for a video, the pixel scale. "
         "Double and missed detections among impact times, and tracking glitches, are found, "
         "dropped and reported. Prints e per impact with its standard error; parameters the "
-        "data cannot fix are reported as undetermined.",
+        "data cannot fix are reported as undetermined. A CSV with more columns than the "
+        "times (e.g. trial, ball, height) holds one drop per distinct row of those columns: "
+        "each drop is fitted on its own; impact times that go backwards within one drop are "
+        "refused.",
         example="jaximpact fit impacts.csv --law hertz_rate --param c=5.5e7 b1=100 --mass 0.0415\n"
         "jaximpact fit impacts.csv --law kelvin_voigt --param c=2e6 b=5 --mass 0.0027 "
         "--where ball=pingpong --where trial=1 --drag 0.14 --json\n"
@@ -292,7 +294,7 @@ def _options(args, recording):
     return length_scale, y_axis
 
 
-def _fit_one(law, args, recording, data, length_scale, y_axis):
+def _fit_one(law, args, recording, name, data, length_scale, y_axis):
     import numpy as np
 
     from ._fit_bounces import fit_bounces
@@ -307,7 +309,18 @@ def _fit_one(law, args, recording, data, length_scale, y_axis):
         sigma=args.sigma,
     )
     if recording.kind == "impacts":
-        return fit_bounces(law, impact_times=np.asarray(data, dtype=float), **common)
+        times = np.asarray(data, dtype=float)
+        back = np.flatnonzero(np.diff(times) < 0)
+        if back.size:
+            i = int(back[0]) + 1
+            where = "" if name == "all" else f" of {name}"
+            raise CLIError(
+                f"the impact times{where} go backwards at time number {i + 1} "
+                f"({times[i]:.6g} s after {times[i - 1]:.6g} s): several drops in one list? "
+                "add a column that tells them apart (e.g. trial; each is fitted on its own) "
+                "or pick one with --where"
+            )
+        return fit_bounces(law, impact_times=times, **common)
     t, y = (np.asarray(a, dtype=float) for a in data)
     if recording.video:
         if args.frame_rate is None:
@@ -445,12 +458,12 @@ def run_fit(args):
     recording = read_recording(args.file, args.format, args.where)
     law = law_from_args(args)
     length_scale, y_axis = _options(args, recording)
-    from ._progress import Progress
+    from ._progress import Progress, progress_enabled
 
     fits = {}
-    with Progress(len(recording.groups), "fitting", enabled=sys.stderr.isatty()) as bar:
+    with Progress(len(recording.groups), "fitting", enabled=progress_enabled()) as bar:
         for name, data in recording.groups.items():
-            fits[name] = _fit_one(law, args, recording, data, length_scale, y_axis)
+            fits[name] = _fit_one(law, args, recording, name, data, length_scale, y_axis)
             bar.update(name[:24])
     units = "s" if recording.kind == "impacts" else ("px" if recording.video else "m")
     if args.plot is not None:

@@ -46,7 +46,7 @@ class CleanedImpacts:
 
     - `times` (s): the detections kept; `index`: the impact number (0 = first) of each, so a
       jump in `index` marks missed impacts.
-    - `dropped`: positions (in the sorted input) of detections dropped as double (too soon
+    - `dropped`: positions (in the input) of detections dropped as double (too soon
       after the previous impact) or inconsistent (between two predicted impacts);
       `missed`: impact numbers with no detection.
     - `ratio`: the median ratio of consecutive intervals (about `e`).
@@ -64,6 +64,9 @@ def clean_impact_times(
 ) -> CleanedImpacts:
     """Find missed and double detections in a sequence of impact times (s) of one drop.
 
+    The times must not go backwards (a ValueError says where: two drops whose clock
+    restarted must be passed apart).
+
     The intervals of a bouncing ball shrink nearly geometrically, `D_{k+1} = r D_k` with `r`
     about `e`. Walking along the detections, the next impacts are predicted from the last
     kept one, the last interval and the median ratio `r` of the last `window` pairs of
@@ -78,7 +81,7 @@ def clean_impact_times(
     **Example**: `clean_impact_times([0, 1, 1.8, 1.83, 2.44, 3.36])` keeps 0, 1, 1.8, 2.44
     and 3.36 (as impact 5: impact 4, near 2.95 s, was missed) and drops 1.83.
     """
-    t = np.sort(np.asarray(times, dtype=float).ravel())
+    t = times_in_order(times, "impact times")
     if t.size < 3:
         raise ValueError(f"need at least 3 impact times to find the intervals, got {t.size}")
     if not np.all(np.isfinite(t)):
@@ -138,6 +141,50 @@ def clean_impact_times(
         missed=np.setdiff1d(np.arange(index.max() + 1), index),
         ratio=float(np.median(whole)) if whole else r,
     )
+
+
+def times_in_order(times, what="impact times") -> np.ndarray:
+    """`times` as a 1-D float array, refused (ValueError) when it is not 1-D or when it goes
+    backwards: impact times of several drops concatenated (each drop's clock starting again
+    at zero) must be passed apart, never sorted into one sequence."""
+    try:
+        t = np.asarray(times, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"{what} must be numbers (s): one 1-D array for one drop, or a list of 1-D "
+            "arrays, one per drop"
+        ) from None
+    if t.ndim != 1:
+        raise ValueError(
+            f"{what} must be a 1-D array (one drop), got shape {t.shape}; for several drops "
+            "pass a list of 1-D arrays, one per drop"
+        )
+    back = np.flatnonzero(np.diff(t) < 0)
+    if back.size:
+        i = int(back[0]) + 1
+        hint = (
+            "several drops? pass them apart, impact_times=[times_1, times_2, ...] (each drop "
+            "fitted on its own)"
+            if "impact" in what
+            else "fit one recording at a time, in time order"
+        )
+        raise ValueError(
+            f"{what} go backwards at index {i} ({t[i]:.6g} s after {t[i - 1]:.6g} s): {hint}"
+        )
+    return t
+
+
+def _is_list_of_drops(impact_times) -> bool:
+    """A list or tuple of 1-D arrays (one per drop), rather than one drop's times."""
+    if not isinstance(impact_times, (list, tuple)):
+        return False
+    dims = [np.ndim(x) for x in impact_times]
+    if any(d >= 1 for d in dims) and not all(d == 1 for d in dims):
+        raise ValueError(
+            "impact_times must be one 1-D array (one drop) or a list of 1-D arrays (one per "
+            "drop), not a mix of numbers and arrays"
+        )
+    return bool(dims) and all(d == 1 for d in dims)
 
 
 def interval_restitution(cleaned: CleanedImpacts) -> tuple[np.ndarray, np.ndarray]:
@@ -250,7 +297,7 @@ class BounceFit(eqx.Module):
       `(estimate - truth) / stderr` follow Student's t with `dof` degrees of freedom rather
       than a normal law); `dof`: data minus parameters.
     - impact times: `times`, `index` (impact number of each used detection), `dropped`
-      (positions in the sorted input of detections not used: double, inconsistent, or
+      (positions in the input of detections not used: double, inconsistent, or
       outliers of the first fit), `missed` (impact numbers with no detection).
     - trajectory: `t`, `y`, `y_fit` (the data used and the model there), `dropped` (sample
       positions not used: before the release, or outliers).
@@ -475,6 +522,11 @@ def fit_bounces(
     - Impact times: detections are sorted out by `clean_impact_times` (`clean_tol`): double
       and inconsistent ones are dropped, missed impacts left as gaps, and all are reported;
       then outliers of the first fit, as above. Nuisance: first impact time and speed.
+      The times of one drop must not go backwards (ValueError, with the index where they
+      do). Several drops: pass a list of 1-D arrays, `impact_times=[times_1, times_2]`;
+      each drop is fitted on its own (its own first impact, speed and noise) and the result
+      is a list of `BounceFit`, one per drop, in order: compare their `params` and `e`
+      to see the spread between drops.
     - `free`: the law's parameters to fit (default: its damping parameter; the stiffness is
       then held at the value in `law`, which the data rarely fix). The values in `law` are the
       starting point and the values of everything held.
@@ -494,6 +546,17 @@ def fit_bounces(
     """
     if not isinstance(law, AbstractLaw):
         raise TypeError("fit_bounces needs a law from jaximpact.law(...) or custom_law(...)")
+    if impact_times is not None and _is_list_of_drops(impact_times):
+        if t is not None or y is not None:
+            raise ValueError(
+                "give either a trajectory (t=..., y=...) or impact_times=..., not both"
+            )
+        options = dict(
+            m=m, free=free, g=g, separation=separation, drag=drag, fit_drag=fit_drag,
+            sigma=sigma, clean_tol=clean_tol, outlier_sigma=outlier_sigma, max_iter=max_iter,
+            tol=tol, rtol=rtol, max_steps=max_steps,
+        )  # fmt: skip
+        return [fit_bounces(law, impact_times=times, **options) for times in impact_times]
     if (impact_times is None) == (t is None and y is None):
         raise ValueError("give either a trajectory (t=..., y=...) or impact_times=..., not both")
     if impact_times is None and (t is None or y is None):
@@ -808,7 +871,7 @@ def _fit_impacts(
     `clean_impact_times` finds; on every detection within `clean_tol` of the fitted
     model's impacts; without the outliers of that fit."""
     log = []  # accepted steps of each fit
-    raw = np.sort(np.asarray(impact_times, dtype=float).ravel())
+    raw = times_in_order(impact_times, "impact_times")
     cleaned = _prepare_impacts(raw, clean_tol)
     kept_positions = np.setdiff1d(np.arange(raw.size), cleaned.dropped)
     anomalies = np.concatenate(
@@ -925,13 +988,13 @@ def _fit_trajectory(
     separation,
 ):
     log = []  # accepted steps of each fit
-    t = np.asarray(t, dtype=float).ravel()
-    y = np.asarray(y, dtype=float).ravel()
-    if t.shape != y.shape or t.size < 8:
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(y, dtype=float)
+    if t.ndim != 1 or t.shape != y.shape or t.size < 8:
         raise ValueError("t and y must be 1-D arrays of the same length (at least 8 samples)")
     good = np.isfinite(t) & np.isfinite(y)
-    order = np.argsort(t[good])
-    positions = np.flatnonzero(good)[order]
+    positions = np.flatnonzero(good)
+    times_in_order(t[positions], "the times t of a trajectory")
     t, y = t[positions], y[positions]
     y_sign = 1.0 if y_axis == "up" else -1.0
     guess = _guess_trajectory(t, y_sign * y, g)

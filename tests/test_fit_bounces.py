@@ -238,6 +238,54 @@ def test_bad_input(kwargs, message):
         fit_bounces(ji.law("hertz_rate", **GOLF), **args)
 
 
+# ------------------------------------------------------------- several drops, one list
+
+
+def two_drops_concatenated():
+    """Two drops recorded one after the other, each clock starting again near zero."""
+    first, second = noisy_detections(0), noisy_detections(1) - 0.9
+    return first, second, np.concatenate([first, second])
+
+
+def test_impact_times_that_go_backwards_are_refused():
+    first, second, both = two_drops_concatenated()
+    law = ji.law("hertz_rate", **GOLF)
+    with pytest.raises(ValueError, match=f"go backwards at index {first.size} ") as error:
+        fit_bounces(law, m=GOLF_M, impact_times=both)
+    message = str(error.value)
+    assert len(message.splitlines()) == 1 and "impact_times=[times_1, times_2" in message
+    with pytest.raises(ValueError, match="go backwards at index 2"):
+        clean_impact_times([1.0, 2.0, 1.5, 3.0])
+    with pytest.raises(ValueError, match="1-D array"):
+        fit_bounces(law, m=GOLF_M, impact_times=np.stack([first[:8], second[:8]]))
+    with pytest.raises(ValueError, match="not a mix"):
+        fit_bounces(law, m=GOLF_M, impact_times=[first, 3.0])
+    with pytest.raises(ValueError, match="go backwards at index 1"):
+        fit_bounces(law, m=GOLF_M, impact_times=[first, second[::-1]])
+
+
+def test_a_list_of_drops_is_fitted_drop_by_drop():
+    """`impact_times=[drop_1, drop_2]`: one fit per drop, each as if given alone (the second
+    drop is the first one's detections shifted in time: the same e)."""
+    first = noisy_detections(0)
+    fits = fit_bounces(
+        ji.law("hertz_rate", c=5.5e7, b1=100.0), m=GOLF_M, impact_times=[first, first - 1.0]
+    )
+    assert isinstance(fits, list) and len(fits) == 2
+    alone = golf_fit()
+    for fit, shift in zip(fits, (0.0, 1.0), strict=True):
+        assert isinstance(fit, ji.BounceFit) and fit.converged
+        np.testing.assert_allclose(fit.e, alone.e, rtol=1e-6)
+        assert fit.dropped.tolist() == alone.dropped.tolist() == [4]
+        assert abs(fit.nuisance["t_impact"] - (alone.nuisance["t_impact"] - shift)) < 1e-6
+
+
+def test_a_trajectory_going_backwards_is_refused():
+    t = np.concatenate([np.linspace(0.0, 1.0, 10), np.linspace(0.0, 1.0, 10)])
+    with pytest.raises(ValueError, match="times t of a trajectory go backwards at index 10"):
+        fit_bounces(ji.law("hertz_rate", **GOLF), m=GOLF_M, t=t, y=np.ones_like(t))
+
+
 # ---------------------------------------------------------------------- command line
 
 
@@ -295,6 +343,32 @@ def test_cli_bad_input_is_one_line_exit_2(capsys, tmp_path, extra, contents, mes
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("jaximpact: error: "), err
     assert message in lines[0]
+
+
+def test_cli_refuses_impact_times_going_backwards(capsys, tmp_path):
+    first, second, both = two_drops_concatenated()
+    path = tmp_path / "two.csv"
+    path.write_text("impact_time\n" + "\n".join(f"{t:.6f}" for t in both))
+    status, out, err = run_cli(capsys, ["fit", str(path), *FIT[1:]])
+    assert status == 2 and out == "", err
+    (line,) = err.strip().splitlines()
+    assert f"go backwards at time number {first.size + 1} " in line
+    assert "trial" in line and "--where" in line
+
+
+@pytest.mark.slow
+def test_cli_trial_column_fits_each_drop(capsys, tmp_path):
+    """A `trial` column splits the file into drops, each fitted on its own."""
+    first, second, _ = two_drops_concatenated()
+    rows = [f"1,{t:.6f}" for t in first] + [f"2,{t:.6f}" for t in second]
+    path = tmp_path / "trials.csv"
+    path.write_text("trial,impact_time\n" + "\n".join(rows))
+    status, out, err = run_cli(capsys, ["fit", str(path), *FIT[1:], "--json"])
+    assert status == 0, err
+    fits = json.loads(out)["fits"]
+    assert sorted(fits) == ["trial=1", "trial=2"]
+    np.testing.assert_allclose(fits["trial=1"]["e"], golf_fit().e, rtol=1e-6)
+    assert all(f["converged"] for f in fits.values())
 
 
 def test_cli_video_track_needs_a_frame_rate(capsys, tmp_path):
