@@ -9,7 +9,6 @@ its nondimensional restitution table (`calibrate(..., init="auto")`).
 
 import csv
 import math
-import sys
 import threading
 from pathlib import Path
 
@@ -28,7 +27,7 @@ from ._cli import (
     parse_params,
     save_figure,
 )
-from ._progress import Progress
+from ._progress import Progress, progress_enabled
 
 COLUMNS = ("v0", "e", "T", "sigma_e", "sigma_T")
 ALL = "all"
@@ -246,8 +245,11 @@ class _Ticker:
     """A `Progress` bar redrawn every 0.2 s while the work runs (a first fit compiles for
     tens of seconds without other sign of life), shown only once it has taken `delay` s."""
 
-    def __init__(self, total, what, enabled, delay=0.5):
-        self.bar = Progress(total, what, enabled=False)
+    def __init__(self, total, what, enabled, delay=None):
+        # lines when stderr is not a terminal: one per 10 s, none for work under 3 s
+        self.bar = Progress(total, what, enabled=False, delay=0.0, interval=10.0)
+        if delay is None:
+            delay = 0.5 if self.bar.terminal else 3.0
         self.enabled, self.delay, self.label = enabled, delay, ""
         self._lock, self._stop = threading.Lock(), threading.Event()
         self._thread = threading.Thread(target=self._run, daemon=True)
@@ -284,7 +286,7 @@ class _Ticker:
 
 
 def _progress_enabled():
-    return sys.stderr.isatty()
+    return progress_enabled()  # on a terminal a bar, elsewhere a line every 10 s
 
 
 # ------------------------------------------------------------------------- running

@@ -1,18 +1,56 @@
-"""A minimal progress bar on stderr, for work that takes more than a moment."""
+"""Progress of long work on stderr: a bar on a terminal, plain lines elsewhere (a log, a pipe,
+CI), so that a run of minutes is never silent.
 
+`JAXIMPACT_PROGRESS` chooses what `progress_enabled()` answers for the command line:
+`auto` (default: on), `off` (or `0`: none); a `Progress` that is enabled draws a bar when its
+stream is a terminal and writes a line at most every `interval` seconds (and at the end)
+when it is not.
+"""
+
+import os
 import sys
 import time
 
+PROGRESS_ENV = "JAXIMPACT_PROGRESS"
+
+
+def progress_enabled() -> bool:
+    """Whether the command line reports progress: yes unless `JAXIMPACT_PROGRESS` is `off`
+    (or `0`, `no`, `false`)."""
+    value = os.environ.get(PROGRESS_ENV, "auto").strip().lower()
+    return value not in ("off", "0", "no", "false")
+
+
+def _is_terminal(stream) -> bool:
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, ValueError):
+        return False
+
 
 class Progress:
-    """`with Progress(total, "fitting") as bar: ... bar.update(label)`; silent if not
-    `enabled` or when stderr is not a terminal and `force` is not set."""
+    """`with Progress(total, "fitting") as bar: ... bar.update(label)`; silent unless
+    `enabled`. On a terminal a bar redrawn in place; otherwise one line per `interval`
+    seconds at most (the first after `delay` seconds) and a last one at the end."""
 
-    def __init__(self, total: int, what: str, enabled: bool = True, stream=None):
+    def __init__(
+        self,
+        total: int,
+        what: str,
+        enabled: bool = True,
+        stream=None,
+        interval: float = 5.0,
+        delay: float = 2.0,
+    ):
         self.total, self.what, self.done = total, what, 0
         self.stream = sys.stderr if stream is None else stream
         self.enabled = enabled
+        self.interval, self.delay = interval, delay
+        self.terminal = _is_terminal(self.stream)
         self.start = time.perf_counter()
+        self._last_line = None  # when the last line was written (lines mode)
+        self._last_done = -1
+        self._label = ""
 
     def __enter__(self):
         self._draw("")
@@ -22,20 +60,38 @@ class Progress:
         self.done += 1
         self._draw(label)
 
-    def _draw(self, label):
-        if not self.enabled:
-            return
+    def _text(self, label):
         width = 24
         filled = int(width * self.done / max(self.total, 1))
         elapsed = time.perf_counter() - self.start
         bar = "#" * filled + "-" * (width - filled)
-        self.stream.write(
-            f"\r{self.what} [{bar}] {self.done}/{self.total} {elapsed:5.1f}s {label:<24}"
-        )
-        self.stream.flush()
+        return f"{self.what} [{bar}] {self.done}/{self.total} {elapsed:5.1f}s {label:<24}"
+
+    def _draw(self, label, final=False):
+        if not self.enabled:
+            return
+        self._label = label
+        if self.terminal:
+            self.stream.write("\r" + self._text(label))
+            self.stream.flush()
+            return
+        now = time.perf_counter()
+        if final:
+            due = self._last_done != self.done or self._last_line is None
+        elif self._last_line is None:
+            due = now - self.start >= self.delay
+        else:
+            due = now - self._last_line >= self.interval
+        if due:
+            self.stream.write(self._text(label).rstrip() + "\n")
+            self.stream.flush()
+            self._last_line, self._last_done = now, self.done
 
     def __exit__(self, *exc):
         if self.enabled:
-            self.stream.write("\n")
+            if self.terminal:
+                self.stream.write("\n")
+            else:
+                self._draw(self._label, final=True)
             self.stream.flush()
         return False
