@@ -1,7 +1,7 @@
 """100 000 impacts at once: a Monte Carlo over a population of bodies (law 14), run through
 `impact_batch` in chunks with a progress bar, written to a table and summarised in a plot.
 
-Run: python examples/batch_100k.py [--n 100000] [--table impacts.csv] [--plot batch_100k.png]
+Run: python examples/batch_100k.py [--n 100000] [--table batch_100k.csv] [--plot batch_100k.png]
 """
 
 import argparse
@@ -23,7 +23,9 @@ from jaximpact._batch import impact_batch, write_table  # noqa: E402
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=100_000)
-    parser.add_argument("--table", default="impacts.csv", help=".csv or .json ('' for none)")
+    parser.add_argument(
+        "--table", default="batch_100k.csv", help=".csv or .json ('' for none; git ignores it)"
+    )
     parser.add_argument("--plot", default="batch_100k.png")
     args = parser.parse_args()
 

@@ -2,7 +2,9 @@
 from drops of a ping-pong ball on parquet (rebound heights read off video, 10 repeats per
 drop height), fitted by every law of the seed paper and ranked by AIC.
 
-Data: ../shared/data/giiulia_method1_rebound_heights.csv (read in place, never copied).
+Data: ../shared/data/giiulia_method1_rebound_heights.csv (read in place, never copied) when it
+is there, else the synthetic examples/data/rebound_heights.csv (made by
+examples/data/make_samples.py; the numbers below are the real data's).
 With no air drag, `e = sqrt(h1 / h0)` and `v0 = sqrt(2 g h0)`; the spread of the ten repeats
 gives the standard error of each e. Three laws whose restitutions depend on the impact speed
 in three ways, each through one dimensionless group: not at all (Kelvin-Voigt, eq. 1), through
@@ -29,16 +31,18 @@ import numpy as np  # noqa: E402
 
 import jaximpact as ji  # noqa: E402
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
+SAMPLES = Path(__file__).resolve().parent / "data"  # synthetic, made by data/make_samples.py
 MASS = {"pingpong": 0.0027, "golf": 0.0415, "tennis": 0.056}  # kg (data README)
 G = 9.81
 
 
 def restitutions(ball):
     """(v0 in m/s, e, standard error of e) per drop height of `ball`."""
-    path = DATA / "giiulia_method1_rebound_heights.csv"
-    if not path.exists():
-        raise SystemExit(f"{path} not found: this example reads the shared measurements")
+    path = SHARED / "giiulia_method1_rebound_heights.csv"
+    if not path.exists():  # the real measurements are not shipped: the synthetic sample
+        path = SAMPLES / "rebound_heights.csv"
+    print(f"data: {path}")
     rows = []
     with open(path) as handle:
         for row in csv.reader(handle):

@@ -1,10 +1,13 @@
 """Every script of examples/ runs from a fresh install and writes its plot (slow set).
 
 Each runs in its own process, in a temporary directory, as a user would run it; the seconds
-each took are printed (`pytest -m slow -s tests/test_examples.py`). Scripts that read the
-shared measurements skip, saying so, when ../shared/data is not there.
+each took are printed (`pytest -m slow -s tests/test_examples.py`). The scripts that read
+measurements use ../shared/data when it is there and the synthetic samples of examples/data
+otherwise: `test_example_runs_on_the_samples` runs them from a copy of examples/ with no
+shared data next to it, as from a fresh clone.
 """
 
+import shutil
 import subprocess
 import sys
 import time
@@ -13,10 +16,9 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-DATA = ROOT.parent / "shared" / "data"
 NEEDS_DATA = {"fit_microphone_impacts.py", "fit_video_trajectory.py", "pick_a_law.py"}
 OUTPUTS = {  # script -> (arguments, files it must write)
-    "batch_100k.py": ([], ["batch_100k.png", "impacts.csv"]),
+    "batch_100k.py": ([], ["batch_100k.png", "batch_100k.csv"]),
     "bounce_paper_section7.py": ([], ["bounce_section7.png"]),
     "bumper_design.py": ([], ["bumper_design.png"]),
     "calibrate_e_and_T.py": ([], ["calibration.png"]),
@@ -33,16 +35,45 @@ def test_every_example_is_listed():
     assert {p.name for p in (ROOT / "examples").glob("*.py")} == set(OUTPUTS)
 
 
+def test_samples_are_small_and_what_make_samples_writes(tmp_path):
+    """The shipped samples are small, and examples/data/make_samples.py writes them again
+    byte for byte (fixed seeds)."""
+    data = ROOT / "examples" / "data"
+    shipped = {p.relative_to(data): p.read_bytes() for p in data.rglob("*.csv")}
+    assert len(shipped) == 5 and all(0 < len(b) < 20_000 for b in shipped.values())
+    copy = tmp_path / "data"
+    copy.mkdir()
+    shutil.copy(data / "make_samples.py", copy)
+    subprocess.run([sys.executable, str(copy / "make_samples.py")], check=True, capture_output=True)
+    assert {p.relative_to(copy): p.read_bytes() for p in copy.rglob("*.csv")} == shipped
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("script", sorted(OUTPUTS))
 def test_example_runs(script, tmp_path):
-    if script in NEEDS_DATA and not DATA.is_dir():
-        pytest.skip(f"{script} reads ../shared/data, which is not here")
+    run_example(ROOT / "examples" / script, tmp_path)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("script", sorted(NEEDS_DATA))
+def test_example_runs_on_the_samples(script, tmp_path):
+    """From a copy of examples/ with no ../shared/data beside it (a fresh clone)."""
+    clone = tmp_path / "clone"
+    shutil.copytree(ROOT / "examples", clone / "examples")
+    assert not (clone.parent / "shared").exists()
+    out = tmp_path / "out"
+    out.mkdir()
+    stdout = run_example(clone / "examples" / script, out)
+    assert "examples/data" in stdout
+
+
+def run_example(path, cwd):
+    script = path.name
     arguments, outputs = OUTPUTS[script]
     start = time.perf_counter()
     done = subprocess.run(
-        [sys.executable, str(ROOT / "examples" / script), *arguments],
-        cwd=tmp_path,
+        [sys.executable, str(path), *arguments],
+        cwd=cwd,
         capture_output=True,
         text=True,
         timeout=900,
@@ -52,5 +83,6 @@ def test_example_runs(script, tmp_path):
     assert done.returncode == 0, done.stderr[-3000:]
     assert "Traceback" not in done.stderr
     for name in outputs:
-        path = tmp_path / name
-        assert path.exists() and (path.is_dir() or path.stat().st_size > 5_000), name
+        written = cwd / name
+        assert written.exists() and (written.is_dir() or written.stat().st_size > 5_000), name
+    return done.stdout
