@@ -105,7 +105,10 @@ def check_round_trip(name, start, *, init="given", optimizer="lbfgs", what=""):
 # ------------------------------------------------------------------- (a) round trips
 
 
-@pytest.mark.parametrize("name", DEFAULT_LAWS)
+@pytest.mark.parametrize(
+    "name",
+    [pytest.param(n, marks=[] if n == "hertz_rate" else [pytest.mark.slow]) for n in DEFAULT_LAWS],
+)
 def test_round_trip_from_far_starts(name):
     """From every parameter 10 times too large, then 10 times too small (init="given"),
     and from the table start (init="auto"): the paper's parameters come back to 1e-6 and
@@ -275,6 +278,7 @@ def test_accepts_the_edge_of_the_admissible(monkeypatch):
 # -------------------------------------------------------------- (d) unreachable targets
 
 
+@pytest.mark.slow
 def test_velocity_independent_law_cannot_follow_speeds():
     """Kelvin-Voigt's e does not depend on speed: fitted to law 14's falling e at five
     speeds it ends with converged=False, its best compromise and finite residuals."""
@@ -323,6 +327,7 @@ def _fd_standard_errors(params, free, v0s, sigma_e, sigma_T, h=1e-4):
     }
 
 
+@pytest.mark.slow
 def test_standard_errors():
     """With sigmas, `stderr` is the Jacobian formula (checked with scipy finite differences
     to 1e-3) and matches the scatter of fits to noisy data (Monte Carlo, 40 data sets)."""
@@ -389,6 +394,7 @@ def test_vmap_over_bodies_matches_the_loop():
 # --------------------------------------------------------------- (h) model choice
 
 
+@pytest.mark.slow
 def test_compare_laws_ranks_the_true_law_first():
     e, T = reference("hertz_rate", LAW14, SPEEDS)
     ranking = ji.compare_laws(

@@ -81,6 +81,7 @@ def test_simulate_text(capsys):
     assert "hertz_rate" in out and "b1 = 800 N s/m^1.5" in out
 
 
+@pytest.mark.slow
 def test_simulate_json_and_plot(capsys, tmp_path):
     # Kelvin-Voigt has a closed form (no solve), so only the plot's history costs a solve
     png = tmp_path / "impact.png"

@@ -44,6 +44,7 @@ def quick(tmp_path_factory):
     return status, out, err, plot
 
 
+@pytest.mark.slow
 def test_json_has_the_ratio_rows(quick):
     status, out, err, _ = quick
     assert status == 0, err
@@ -64,6 +65,7 @@ def test_json_has_the_ratio_rows(quick):
     assert machine["cpu_count"] >= 1 and machine["backend"] and machine["load_average"]
 
 
+@pytest.mark.slow
 def test_default_impact_is_accurate(quick):
     data = json.loads(quick[1])
     for row in data["rows"]:
@@ -75,12 +77,14 @@ def test_default_impact_is_accurate(quick):
     assert 1e-4 < euler["err_e"] < 0.5
 
 
+@pytest.mark.slow
 def test_plot_is_a_png(quick):
     plot = quick[3]
     assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert json.loads(quick[1])["plot"] == str(plot)
 
 
+@pytest.mark.slow
 def test_text_table(quick):
     data = json.loads(quick[1])
     text = _cli_bench._text(data)

@@ -76,6 +76,7 @@ def test_table_rows_are_complete(figure_2_and_3):
     assert not (out / "hunt_crossley_variants.md").exists()  # only with the whole paper
 
 
+@pytest.mark.slow
 def test_variants_table_matches_the_closed_form():
     text = _paper.hunt_crossley_variants_markdown(nominal=(0.5, 0.9), check=False)
     line = next(row for row in text.splitlines() if row.startswith("| `gonthier`"))
@@ -85,6 +86,7 @@ def test_variants_table_matches_the_closed_form():
     np.testing.assert_allclose(values, expected, atol=5e-4)
 
 
+@pytest.mark.slow
 def test_cli_paper_json_and_figure(capsys, tmp_path):
     status, out, err = run_cli(
         capsys, ["paper", "--out", str(tmp_path), "--figures", "2", "--json"]

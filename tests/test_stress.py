@@ -73,9 +73,9 @@ def _sweep(name, separation, n, method="integrate", gradients=("jacfwd",)):
 
 FAST = [
     # Hertz with x^0.5 damping: fractional powers, the Lienard variable, the force criterion
-    ("hertz_rate", "force", "integrate"),
+    pytest.param("hertz_rate", "force", "integrate", marks=pytest.mark.slow),
     # a dry force: split phases, stuck members, the penetration criterion
-    ("bingham", "penetration", "integrate"),
+    pytest.param("bingham", "penetration", "integrate", marks=pytest.mark.slow),
     # the closed-form default path, over-damped members captured
     ("kelvin_voigt", "penetration", "auto"),
 ]
@@ -194,6 +194,7 @@ def test_regression_kv_closed_form_captured_gradients():
     assert summary["fwd_rev_max_all"] < 1e-10
 
 
+@pytest.mark.slow
 def test_regression_kv_integrate_creeping_is_captured():
     """Over-damped creeping ends captured at the rest instant, not out of steps, and near
     the closed form's rest time (same definition, `rest_tol`)."""
@@ -227,6 +228,7 @@ MAXWELL_OVERDAMPED = [
 ]
 
 
+@pytest.mark.slow
 def test_regression_maxwell_overdamped_is_captured():
     members = _members(MAXWELL_OVERDAMPED)
     refs = sc.references("maxwell", "force", members)
@@ -271,6 +273,7 @@ KVM_FORCE_HEAVY = [
 ]
 
 
+@pytest.mark.slow
 def test_regression_kv_modified_force_heavy_damping():
     members = _members(KVM_FORCE_HEAVY)
     refs = sc.references("kelvin_voigt_modified", "force", members)
