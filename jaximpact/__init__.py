@@ -1,5 +1,13 @@
-"""jaximpact: impact force laws, integrated exactly and differentiably, and fitted to data."""
+"""jaximpact: impact force laws, integrated exactly and differentiably, and fitted to data.
 
+The public names below load their module on first use (PEP 562), so that `import jaximpact`
+costs little and a call pays only for what it needs: an impact read off the universal
+curves never imports diffrax or optimistix, and nothing imports matplotlib before a plot.
+The first use also turns on JAX's persistent compilation cache (`_cache`; opt out with
+`JAXIMPACT_CACHE_DIR=`), so a second process reuses the compiled programs.
+"""
+
+import importlib
 import importlib.metadata
 import os
 import sys
@@ -7,7 +15,7 @@ import sys
 if os.path.basename(sys.argv[0]) == "jaximpact":
     # the command line: XLA's CPU compiler logs harmless "algebraic simplifier ... circular"
     # notes at error level for diffrax's loops; the level is read when jax loads, so it is
-    # set here, before the imports below, and only for the `jaximpact` console script
+    # set here, before anything imports jax, and only for the `jaximpact` console script
     os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "3")
     # equinox's run-time checks inside the compiled fits (lineax's, in the implicit
     # derivative of diffrax's event times) are host callbacks, and JAX does not store a
@@ -16,43 +24,81 @@ if os.path.basename(sys.argv[0]) == "jaximpact":
     # compilation: 14 s -> 8 s (benchmarks/first_calls.md). Inputs are checked before.
     os.environ.setdefault("EQX_ON_ERROR", "nan")
 
-from . import closed_forms as closed_forms
-from ._batch import impact_batch as impact_batch, run_batch as run_batch, write_table as write_table
-from ._bounce import BounceResult as BounceResult, bounce as bounce
-from ._calibrate import Fit as Fit, calibrate as calibrate
-from ._design import (
-    bumper_design as bumper_design,
-    drop_design as drop_design,
-    propagate_uncertainty as propagate_uncertainty,
-    sensitivity_map as sensitivity_map,
-)
-from ._euler import euler_bounce as euler_bounce
-from ._fit_bounces import BounceFit as BounceFit, fit_bounces as fit_bounces
-from ._impact import ImpactResult as ImpactResult, impact as impact
-from ._laws import (
-    LAW_NAMES as LAW_NAMES,
-    LAWS as LAWS,
-    AbstractLaw as AbstractLaw,
-    CustomLaw as CustomLaw,
-    Law as Law,
-    custom_law as custom_law,
-    law as law,
-)
-from ._maps import plot_map as plot_map, restitution_map as restitution_map
-from ._model_choice import compare_laws as compare_laws, starting_law as starting_law
-from ._paper import reproduce_paper as reproduce_paper
-from ._plotting import plot_impact as plot_impact
-from ._powers import safe_pow as safe_pow
-from ._status import Status as Status
-
+# public name -> the private module that defines it, grouped as the package is layered:
+# force laws, one impact, one drop, fitting, many impacts, studies, figures, the paper
+_PUBLIC = {
+    # force laws
+    "LAW_NAMES": "_laws",
+    "LAWS": "_laws",
+    "AbstractLaw": "_laws",
+    "CustomLaw": "_laws",
+    "Law": "_laws",
+    "custom_law": "_laws",
+    "law": "_laws",
+    "safe_pow": "_powers",
+    # one impact
+    "ImpactResult": "_results",
+    "impact": "_impact",
+    "Status": "_status",
+    # one drop
+    "BounceResult": "_bounce",
+    "bounce": "_bounce",
+    "euler_bounce": "_euler",
+    # fitting
+    "Fit": "_calibrate",
+    "calibrate": "_calibrate",
+    "BounceFit": "_fit_bounces",
+    "fit_bounces": "_fit_bounces",
+    "compare_laws": "_model_choice",
+    "starting_law": "_model_choice",
+    # many impacts
+    "impact_batch": "_batch",
+    "run_batch": "_batch",
+    "write_table": "_batch",
+    # studies
+    "bumper_design": "_design",
+    "drop_design": "_design",
+    "propagate_uncertainty": "_design",
+    "sensitivity_map": "_design",
+    "plot_map": "_maps",
+    "restitution_map": "_maps",
+    # figures, the seed paper
+    "plot_impact": "_plotting",
+    "reproduce_paper": "_paper",
+}
 # engines: material inputs and exports to MuJoCo, Drake, LAMMPS (issue 14)
-from ._engines import (
-    Export as Export,
-    effective_mass as effective_mass,
-    effective_radius as effective_radius,
-    export as export,
-    hertz_stiffness as hertz_stiffness,
+_PUBLIC.update(
+    {
+        "hertz_stiffness": "_engines",
+        "effective_mass": "_engines",
+        "effective_radius": "_engines",
+        "export": "_engines",
+        "Export": "_engines",
+    }
 )
+_SUBMODULES = ("closed_forms",)
+
+__all__ = sorted([*_PUBLIC, *_SUBMODULES])
+
+
+def __getattr__(name):
+    if name in _PUBLIC or name in _SUBMODULES:
+        from ._cache import enable_persistent_cache
+
+        enable_persistent_cache()  # compiled programs kept between processes (_cache)
+    if name in _PUBLIC:
+        value = getattr(importlib.import_module(f".{_PUBLIC[name]}", __name__), name)
+    elif name in _SUBMODULES:
+        value = importlib.import_module(f".{name}", __name__)
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value  # later look-ups skip this function
+    return value
+
+
+def __dir__():
+    return sorted([*globals(), *_PUBLIC, *_SUBMODULES])
+
 
 try:
     __version__ = importlib.metadata.version("jaximpact")

@@ -36,12 +36,13 @@ import math
 import os
 
 import jax
+import jax.numpy as jnp
 import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec, SingleDeviceSharding
 
 from ._checks import check_nonnegative, check_positive
 from ._closed_forms import closed_form_for
-from ._impact import impact
+from ._impact import CURVES_RTOL, impact, similarity_reason
 from ._laws import LAW_NAMES, LAWS, CustomLaw, Law, custom_law, law as make_law
 from ._progress import Progress
 
@@ -394,9 +395,12 @@ def _law_skeleton(law):
 
 def _build_law(skeleton, params):
     """The law of `skeleton` with `params` (arrays, possibly traced), without re-checking
-    them (impact_batch has checked the whole batch at once)."""
+    them (impact_batch has checked the whole batch at once). A table law's skeleton may
+    carry fixed shape parameters as numbers (`_fix_shape`), which the row then lacks."""
     if skeleton[0] == "law":
-        return Law(skeleton[1], params)
+        fixed = dict(skeleton[2]) if len(skeleton) > 2 else {}
+        params = {**{k: jnp.asarray(v, dtype=float) for k, v in fixed.items()}, **params}
+        return Law(skeleton[1], {k: params[k] for k in LAWS[skeleton[1]].parameters})
     return CustomLaw(skeleton[1], params, skeleton[2])
 
 
@@ -441,6 +445,19 @@ def _cost_key(skeleton, params, m, v0, g):
             continue
         keys.append(np.round(20.0 * np.log10(value + 1e-300)))
     return keys or None
+
+
+def _fix_shape(skeleton, params):
+    """Move a table law's shape parameters (Hunt-Crossley's `n`, the power law's `n` and
+    `p`) into the skeleton as numbers when they are the same on every row, so that the
+    rows can be read off the universal curves (which need the shape as numbers)."""
+    if skeleton[0] != "law" or not LAWS[skeleton[1]].shape_parameters:
+        return skeleton, params
+    shape = LAWS[skeleton[1]].shape_parameters
+    if not all(np.ptp(params[k]) == 0 for k in shape):
+        return skeleton, params
+    fixed = tuple((k, float(params[k][0])) for k in shape)
+    return (*skeleton, fixed), {k: v for k, v in params.items() if k not in shape}
 
 
 def prepare_rows(law, params, *, m, v0, g=0.0):
@@ -495,7 +512,7 @@ def impact_batch(
     g=0.0,
     separation: str = "force",
     method: str = "auto",
-    rtol: float = 1e-10,
+    rtol: float = 1e-11,
     peaks: bool = True,
     fields: tuple = IMPACT_FIELDS,
     order: str = "cost",
@@ -520,7 +537,8 @@ def impact_batch(
       fix the step count; see `run_batch`) and returns them in the given order; `"given"`
       runs them as given.
     - `chunk_size`: rows per device per compiled call (default 1024 for integrated impacts,
-      65536 for closed forms, which cost little per row); `progress`, `devices`, `exact`: as
+      65536 for closed forms and the universal curves, which cost little per row);
+      `progress`, `devices`, `exact`: as
       in `run_batch`.
 
     Returns a dict of numpy arrays of length `n` (`status` as integers of `Status`).
@@ -539,6 +557,7 @@ def impact_batch(
     if unknown:
         raise ValueError(f"unknown fields {unknown}; choose from {_ALL_FIELDS}")
     skeleton, law_params, kinematics = prepare_rows(law, params, m=m, v0=v0, g=g)
+    skeleton, law_params = _fix_shape(skeleton, law_params)
     zero_gravity = bool(np.all(kinematics["g"] == 0.0))
     rows = {"params": law_params, "m": kinematics["m"], "v0": kinematics["v0"]}
     if not zero_gravity:
@@ -549,10 +568,15 @@ def impact_batch(
     except TypeError:  # an option that cannot be hashed (an array): compiled for this call
         member = _impact_member.__wrapped__(skeleton, tuple(fields), tuple(options.items()))
     cost = None
+    first = _build_law(skeleton, {k: v[:1] for k, v in law_params.items()})
     closed = (
+        zero_gravity and method != "integrate" and closed_form_for(first, separation) is not None
+    ) or (
         zero_gravity
-        and method != "integrate"
-        and closed_form_for(_build_law(skeleton, law_params), separation) is not None
+        and method in ("auto", "similarity")
+        and rtol >= CURVES_RTOL
+        and "solver" not in impact_options
+        and similarity_reason(first, separation) is None
     )
     if order == "cost" and not closed:
         cost = _cost_key(skeleton, law_params, **kinematics)

@@ -9,9 +9,12 @@ import optax
 import optimistix as optx
 from jaxtyping import Array
 
+from ._curves.shapes import curve_key
+from ._curves.similarity import beta_for_restitution, curve_values
+from ._curves.store import curves_for
 from ._forward_jacobian import value_and_jacobian, with_forward_jacobian
-from ._impact import ImpactOptions, solve_impact
-from ._laws import AbstractLaw
+from ._impact import CURVES_RTOL, ImpactOptions, similarity_reason, solve_impact
+from ._laws import AbstractLaw, shape_of
 from ._restitution_tables import DAMPING, restitution_table
 from ._status import Status
 
@@ -50,20 +53,23 @@ class Fit(eqx.Module):
 
 
 def _as_rows(name, value, rows, allow_missing=False):
+    """`value` as one entry per row: numpy for concrete inputs (no eager JAX dispatch, which
+    would cost more than a fit on the curves), `jax.numpy` for traced ones."""
     if value is None:
         return None
     if isinstance(value, (list, tuple)):
         if allow_missing:
             value = [np.nan if item is None else item for item in value]
-        value = jnp.asarray(value, dtype=float)
-    value = jnp.atleast_1d(jnp.asarray(value, dtype=float))
+        value = np.asarray(value, dtype=float)
+    xp = jnp if isinstance(value, jax.core.Tracer) else np
+    value = xp.atleast_1d(xp.asarray(value, dtype=float))
     if value.ndim != 1:
         raise ValueError(f"{name} must be a number or a 1-D array, got shape {value.shape}")
     if rows is not None and value.shape[0] not in (1, rows):
         raise ValueError(
             f"{name} has {value.shape[0]} values but v0 has {rows}: give one per impact speed"
         )
-    return jnp.broadcast_to(value, (rows,)) if rows is not None else value
+    return xp.broadcast_to(value, (rows,)) if rows is not None else value
 
 
 def _check_targets(m, v0, e, T, sigma_e, sigma_T):
@@ -159,24 +165,53 @@ def _initial_law(law, free, *, m, v0, e, T, separation):
     return law.replace(**({"c": c} if "c" in free else {}), **{damping: value})
 
 
+def _start_on_curves(law, free, *, m, v0, e, T, has_T, key):
+    """The start read off the curves (inside the compiled fit): `beta` from `e` at the
+    median speed by inverting `e(beta)`, then `T/t* = tau(beta)` gives `t*` and so the
+    stiffness, and `beta` the damping (linear in the damping parameter at fixed `c`). At
+    one speed with `e` and `T` this is the fit itself, to the curves' accuracy."""
+    damping = _damping_parameter(law)
+    if damping not in free or damping == "e_nominal":
+        return law
+    curves = curves_for(key)
+    row = jnp.argsort(v0)[v0.shape[0] // 2]
+    v_row = v0[row]
+    beta = beta_for_restitution(curves, e[row])
+    params = dict(law.params)
+    if has_T and "c" in free:
+        tau = curve_values(curves, beta, (1,))[0]
+        x_star = v_row * T[row] / tau
+        c = m * v_row**2 / x_star ** (key.n + 1.0)
+        params["c"] = jnp.where(jnp.isfinite(T[row]) & (c > 0), c, params["c"])
+    unit = eqx.tree_at(lambda item: item.params, law, {**params, damping: jnp.ones_like(v_row)})
+    beta_per_unit = unit.dynamics(m=m, v0=v_row, g=0.0).beta
+    params[damping] = jnp.where(beta_per_unit > 0, beta / beta_per_unit, params[damping])
+    return eqx.tree_at(lambda item: item.params, law, params)
+
+
+def _damping_parameter(law):
+    params = list(law.parameters)
+    return DAMPING.get(getattr(law, "name", None)) or next(
+        (k for k in ("b", "b1", "a", "d", "e_nominal", "P") if k in params), None
+    )
+
+
 # ------------------------------------------------------------------------------ the fit
 
 
 def _default_free(law, has_T):
-    name = getattr(law, "name", None)
     params = list(law.parameters)
-    damping = DAMPING.get(name) or next(
-        (k for k in ("b", "b1", "a", "e_nominal", "P") if k in params), None
-    )
+    damping = _damping_parameter(law)
     free = [damping] if damping else []
     if has_T and "c" in params:
         free = ["c"] + free
     return tuple(free) or tuple(params[:1])
 
 
-def _residual_function(law, free, *, m, separation, g, rtol, has_e, has_T):
+def _residual_function(law, free, *, m, separation, g, rtol, has_e, has_T, curves=None):
     """Weighted residuals and predictions; differentiated in forward mode only (through
-    `with_forward_jacobian`), hence the explicit `ForwardMode` adjoint."""
+    `with_forward_jacobian`), hence the explicit `ForwardMode` adjoint. With `curves` (a
+    `CurveKey`) every impact is read off the universal curves: no ODE solve."""
     options = ImpactOptions(
         separation=separation,
         closed_form=False,
@@ -188,6 +223,7 @@ def _residual_function(law, free, *, m, separation, g, rtol, has_e, has_T):
         rest_tol=1e-9,
         adjoint=dfx.ForwardMode(),
         peaks=False,
+        similarity=curves,
     )
 
     def residuals(theta, data):
@@ -277,6 +313,7 @@ def calibrate(
     tol: float = 1e-12,
     target_tol: float | None = None,
     rtol: float = 1e-10,
+    method: str = "auto",
 ) -> Fit:
     """Fit `law`'s parameters to a measured restitution `e` and/or contact duration `T` (s).
 
@@ -294,6 +331,10 @@ def calibrate(
     - `target_tol`: the largest residual a converged fit may leave (default 1e-6 without
       sigmas, 3 with them, i.e. three standard deviations).
     - `rtol`: tolerance of each impact solve.
+    - `method`: `"auto"` reads every impact off the universal curves where they serve (a
+      one-group law, `g = 0`; see `impact`), with the start read off them too (at one
+      speed with `e` and `T`, that start is the answer); `"similarity"` insists,
+      `"integrate"` solves the ODE for every impact.
     A batch of fits (one body per element: its own mass, speeds and targets) is `jax.vmap`
     over a lambda, `jax.jit(jax.vmap(lambda m, e, T: calibrate(start, m=m, v0=v0, e=e, T=T)))`,
     which returns one `Fit` whose fields carry a leading batch axis; a batch runs until its
@@ -319,7 +360,7 @@ def calibrate(
     sigma_e = _as_rows("sigma_e", sigma_e, rows)
     sigma_T = _as_rows("sigma_T", sigma_T, rows)
     _check_targets(m, v0, e, T, sigma_e, sigma_T)
-    m = jnp.asarray(m, dtype=float)
+    m = jnp.asarray(m, dtype=float) if isinstance(m, jax.core.Tracer) else np.float64(m)
     has_sigma = sigma_e is not None or sigma_T is not None
     free = _default_free(law, T is not None) if free is None else tuple(free)
     unknown = [k for k in free if k not in law.parameters]
@@ -329,15 +370,26 @@ def calibrate(
         )
     if not free:
         raise ValueError("free names no parameter to fit")
-    if init == "auto":
+    g_is_zero = isinstance(g, (int, float)) and g == 0
+    curves = None
+    if method in ("auto", "similarity"):
+        reason = similarity_reason(law, separation, g_is_zero=g_is_zero)
+        if reason is None and (method == "similarity" or rtol >= CURVES_RTOL):
+            curves = curve_key(*shape_of(law), separation)
+        elif method == "similarity":
+            raise ValueError(f"method='similarity' cannot serve this fit: {reason}")
+    elif method != "integrate":
+        raise ValueError(f"method must be 'auto', 'similarity' or 'integrate', got {method!r}")
+    if init == "auto" and curves is None:
         law = _initial_law(law, free, m=m, v0=v0, e=e, T=T, separation=separation)
 
-    ones = jnp.ones(rows)
+    ones = np.ones(rows)
     s_e = ones if sigma_e is None else sigma_e
     if sigma_T is not None:
         s_T = sigma_T
     else:
-        s_T = ones if T is None else jnp.where(jnp.isfinite(T), T, 1.0)
+        xp = jnp if isinstance(T, jax.core.Tracer) else np
+        s_T = ones if T is None else xp.where(xp.isfinite(T), T, 1.0)
     data = (v0, ones if e is None else e, ones if T is None else T, s_e, s_T)
     target_tol = (3.0 if has_sigma else 1e-6) if target_tol is None else target_tol
     options = _Options(
@@ -350,8 +402,11 @@ def calibrate(
         has_e=e is not None,
         has_T=T is not None,
         has_sigma=has_sigma,
+        curves=curves,
+        start_on_curves=init == "auto" and curves is not None,
     )
-    return _fit(law, data, m, jnp.asarray(g, dtype=float), jnp.asarray(target_tol), options)
+    return _fit(law, data, m, np.float64(g) if g_is_zero else jnp.asarray(g, dtype=float),
+                np.float64(target_tol), options)  # fmt: skip
 
 
 class _Options(eqx.Module):
@@ -364,6 +419,8 @@ class _Options(eqx.Module):
     has_e: bool = eqx.field(static=True)
     has_T: bool = eqx.field(static=True)
     has_sigma: bool = eqx.field(static=True)
+    curves: object = eqx.field(static=True, default=None)
+    start_on_curves: bool = eqx.field(static=True, default=False)
 
 
 @eqx.filter_jit
@@ -372,6 +429,10 @@ def _fit(law, data, m, g, target_tol, options):
     free, optimizer = options.free, options.optimizer
     v0, e, T = data[0], data[1], data[2]
     rows = v0.shape[0]
+    if options.start_on_curves and options.has_e:
+        law = _start_on_curves(
+            law, free, m=m, v0=v0, e=e, T=T, has_T=options.has_T, key=options.curves
+        )
     raw = _residual_function(
         law,
         free,
@@ -381,6 +442,7 @@ def _fit(law, data, m, g, target_tol, options):
         rtol=options.rtol,
         has_e=options.has_e,
         has_T=options.has_T,
+        curves=options.curves,
     )
     # one traced copy of the residuals and of their Jacobian, shared by every call site
     raw = jax.jit(raw)
@@ -392,7 +454,18 @@ def _fit(law, data, m, g, target_tol, options):
         return 0.5 * jnp.sum(r**2)
 
     theta0 = jnp.stack([_to_unbounded(k, law.parameters[k]) for k in free])
-    if optimizer == "lm":
+    # one speed, e and T, stiffness and damping free: the start read off the curves is the
+    # solution itself (two equations, two unknowns), so no optimiser runs
+    exact = (
+        options.start_on_curves
+        and rows == 1
+        and options.has_e
+        and options.has_T
+        and set(free) == {"c", _damping_parameter(law)}
+    )
+    if exact:
+        theta, iterations, stopped, history = theta0, jnp.asarray(0), jnp.asarray(True), None
+    elif optimizer == "lm":
         theta, iterations, stopped = _run_lm(residuals, theta0, data, options.max_iter, options.tol)
         history = None
     else:
@@ -410,7 +483,7 @@ def _fit(law, data, m, g, target_tol, options):
         r, (e_fit, T_fit, status) = raw(theta, data)
     final_loss = 0.5 * jnp.sum(r**2)
     if history is None:
-        history = jnp.stack([loss(theta0, data), final_loss])
+        history = jnp.stack([loss(theta0, data), final_loss])[-1 if exact else 0 :]
     else:
         filled = jnp.arange(history.shape[0]) < iterations
         history = jnp.where(filled, history, final_loss)

@@ -40,9 +40,10 @@ import textwrap
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
+from ._cache import enable_persistent_cache
+
 PROG = "jaximpact"
 _DEBUG_ENV = "JAXIMPACT_DEBUG"
-_CACHE_ENV = "JAXIMPACT_CACHE_DIR"
 
 
 class CLIError(Exception):
@@ -271,37 +272,16 @@ def format_quantity(value, unit: str, digits: int = 4) -> str:
     return f"{value / scale:.{digits}g} {prefix}{unit}"
 
 
-def cache_dir() -> Path | None:
-    """Where the CLI keeps JAX's compilation cache: `$JAXIMPACT_CACHE_DIR` (empty: none),
-    else `$XDG_CACHE_HOME/jaximpact/jax`, else `~/.cache/jaximpact/jax`."""
-    if _CACHE_ENV in os.environ:
-        value = os.environ[_CACHE_ENV].strip()
-        return Path(value).expanduser() if value else None
-    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "jaximpact" / "jax"
-
-
 def configure_jax():
-    """float64, and a persistent compilation cache unless JAX already has one set
-    (`JAX_COMPILATION_CACHE_DIR`) or `JAXIMPACT_CACHE_DIR` is empty."""
+    """float64, and the persistent compilation cache (`_cache`) for every program, however
+    small."""
     # XLA's CPU compiler logs harmless "algebraic simplifier ... circular" notes at error
     # level for diffrax's loops; keep them off the user's terminal unless asked for
     os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "3")
     import jax
 
     jax.config.update("jax_enable_x64", True)
-    if jax.config.jax_compilation_cache_dir is not None:
-        return
-    path = cache_dir()
-    if path is None:
-        return
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-    except OSError:
-        return  # an unwritable cache is not worth failing for
-    jax.config.update("jax_compilation_cache_dir", str(path))
-    jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
-    jax.config.update("jax_persistent_cache_min_entry_size_bytes", 0)
+    enable_persistent_cache(min_compile_time_secs=0.0)
 
 
 # --------------------------------------------------------------------------------------

@@ -41,7 +41,9 @@ class LawSpec:
     `one_group`: without gravity the impact depends on the one group `beta` alone (the
     family without a dry force), so `impact` can read it off the universal curves;
     `shape_parameters`: parameters that fix the curves' shape `(n, p)` (they must be known
-    numbers, not traced values, for the curves to serve).
+    numbers, not traced values, for the curves to serve); `shape`: the exponents `(n, p)`,
+    each a number or the name of the parameter that holds it. `closed_form`: `impact` has an
+    exact solution for every parameter value (`_closed_forms.closed_form_for`).
     """
 
     name: str
@@ -57,6 +59,8 @@ class LawSpec:
     defaults: dict[str, float] = dataclasses.field(default_factory=dict)
     one_group: bool = False
     shape_parameters: tuple[str, ...] = ()
+    closed_form: bool = False
+    shape: tuple = ()
 
 
 _PAPER = "Polukoshko et al. 2007"
@@ -86,7 +90,9 @@ _SPECS = [
         f"{_PAPER}, eq. 1",
         lambda q, v0: _family(q["c"], 1, q["b"], 0),
         gap=1,
+        shape=(1.0, 0.0),
         one_group=True,
+        closed_form=True,
     ),
     LawSpec(
         "kelvin_voigt_modified",
@@ -97,6 +103,7 @@ _SPECS = [
         f"{_PAPER}, eq. 6",
         lambda q, v0: _family(q["c"], 1, q["b1"], 1),
         gap=0,
+        shape=(1.0, 1.0),
         one_group=True,
     ),
     LawSpec(
@@ -150,6 +157,7 @@ _SPECS = [
         f"{_PAPER}, eq. 12",
         lambda q, v0: _family(q["c"], 1.5, q["b"], 0),
         gap=1.5,
+        shape=(1.5, 0.0),
         one_group=True,
     ),
     LawSpec(
@@ -161,6 +169,7 @@ _SPECS = [
         f"{_PAPER}, eq. 13",
         lambda q, v0: _family(q["c"], 1.5, q["b"], 1),
         gap=0.5,
+        shape=(1.5, 1.0),
         one_group=True,
     ),
     LawSpec(
@@ -172,6 +181,7 @@ _SPECS = [
         f"{_PAPER}, eq. 14 (the paper's proposal; Kuwabara & Kono 1987)",
         lambda q, v0: _family(q["c"], 1.5, q["b1"], 0.5),
         gap=1,
+        shape=(1.5, 0.5),
         one_group=True,
     ),
     LawSpec(
@@ -184,6 +194,7 @@ _SPECS = [
         lambda q, v0: _family(q["c"], q["n"], 1.5 * q["a"] * q["c"], q["n"]),
         gap="x",
         defaults={"n": 1.5},
+        shape=("n", "n"),
         one_group=True,
         shape_parameters=("n",),
     ),
@@ -205,6 +216,7 @@ def _nominal_spec(name, formula):
         coefficients,
         gap="x",
         defaults={"n": 1.5},
+        shape=("n", "n"),
         one_group=True,
         shape_parameters=("n",),
     )
@@ -222,6 +234,7 @@ _SPECS.append(
         "the family of eqs. 1, 6, 12-16 with the user's own exponents (0 <= p <= n)",
         lambda q, v0: _family(q["c"], q["n"], q["b"], q["p"]),
         gap="power",
+        shape=("n", "p"),
         one_group=True,
         shape_parameters=("n", "p"),
     )
@@ -249,6 +262,8 @@ _SPECS += [
         "hertz/material with damping coeff_restitution or tsuji, LIGGGHTS, Chrono SMC Hertz",
         lambda q, v0: _family(q["c"], 1.5, q["b"], 0.25),
         gap=1.25,
+        one_group=True,
+        shape=(1.5, 0.25),
     ),
     LawSpec(
         "tsuji_restitution",
@@ -265,6 +280,8 @@ _SPECS += [
             0.25,
         ),
         gap=1.25,
+        one_group=True,
+        shape=(1.5, 0.25),
     ),
     LawSpec(
         "spring_dashpot_restitution",
@@ -278,6 +295,8 @@ _SPECS += [
             q["c"], 1, 2.0 * _log_damping(q["e_nominal"]) * jnp.sqrt(q["m_eff"] * q["c"]), 0
         ),
         gap=1,
+        one_group=True,
+        shape=(1.0, 0.0),
     ),
     LawSpec(
         "point_contact",
@@ -289,6 +308,8 @@ _SPECS += [
         "hunt_crossley_dissipation d); Hunt & Crossley with n = 1",
         lambda q, v0: _family(q["c"], 1, q["c"] * q["d"], 1),
         gap="x",
+        one_group=True,
+        shape=(1.0, 1.0),
     ),
 ]
 
@@ -432,9 +453,8 @@ def shape_of(law) -> tuple[float, float] | None:
     spec = getattr(law, "spec", None)
     if spec is None or not spec.one_group:
         return None
-    _, n, _, p, _, _ = spec.coefficients(law.params, 1.0)
     try:
-        return float(n), float(p)
+        return tuple(float(law.params[q]) if isinstance(q, str) else float(q) for q in spec.shape)
     except (TypeError, jax.errors.ConcretizationTypeError, jax.errors.TracerArrayConversionError):
         return None
 
@@ -498,9 +518,7 @@ def law(name: str, **params) -> Law:
 
 
 def _concrete_numbers(*values) -> bool:
-    return all(
-        not isinstance(v, jax.core.Tracer) and jnp.ndim(v) == 0 for v in values
-    )
+    return all(not isinstance(v, jax.core.Tracer) and jnp.ndim(v) == 0 for v in values)
 
 
 def custom_law(fn: Callable, **params) -> CustomLaw:

@@ -29,6 +29,11 @@ MAP_DEFAULTS = {
     "hertz_rate": ("b1", (200.0, 2000.0), {}),
     "hunt_crossley": ("a", (0.02, 0.4), {}),
     **{name: ("e_nominal", (0.3, 0.99), {}) for name in _hysteresis_damping.FORMULAS},
+    "power": ("b", (200.0, 2000.0), {"n": 1.5, "p": 0.5}),  # law 14's shape
+    "tsuji": ("b", (50.0, 1000.0), {}),
+    "tsuji_restitution": ("e_nominal", (0.3, 0.99), {"m_eff": 1.0}),
+    "spring_dashpot_restitution": ("e_nominal", (0.3, 0.99), {"m_eff": 1.0}),
+    "point_contact": ("d", (0.02, 0.4), {}),
 }
 C_RANGE = (2e6, 2e7)
 

@@ -176,12 +176,6 @@ def test_maxwell_under_damped(b):
     assert_rel(want["T"], 2 * math.pi * b * math.sqrt(c * M) / (c * q), 1e-13, "paper T")
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="library bug: F_max misses the force peak when it lies within one solver step of "
-    "maximum compression (light damping): the _TO_PEAK phase's two event conditions change "
-    "sign in the same step and the first one (V = 0) wins (diffrax issue #639)",
-)
 @pytest.mark.parametrize(
     "name, params, exact",
     [
@@ -192,7 +186,8 @@ def test_maxwell_under_damped(b):
 )
 def test_force_peak_near_maximum_compression(name, params, exact):
     got = solver(name, "force", rtol=ORACLE_RTOL)(params)
-    # measured: 1.0e-4 (Maxwell) and 9.9e-7 (Kelvin-Voigt) below the true peak
+    # the peak's event comes first in the _TO_PEAK phase (it was missed by 1.0e-4 for
+    # Maxwell and 9.9e-7 for Kelvin-Voigt while V = 0 came first, diffrax issue #639)
     assert_rel(got["F_max"], np.asarray(exact()["F_max"]), 1e-9, f"{name} F_max")
 
 
