@@ -1,7 +1,8 @@
 """Write the small synthetic sample files the examples and the README's commands read when the
 real measurements (../shared/data, not part of the repository: no licence) are not there.
 
-They are made up, with numpy only (no jaximpact), in the real files' formats:
+They are made up, in the real files' formats (numpy, and `jaximpact.impact` for the
+restitution and duration of each contact of the impact-time samples):
 
 - `rebound_heights.csv`: rebound heights of three balls dropped from several heights, ten
   repeats each (the format of giiulia_method1_rebound_heights.csv), from an `e` falling
@@ -9,9 +10,9 @@ They are made up, with numpy only (no jaximpact), in the real files' formats:
 - `drops.csv`: `v0,e,sigma_e` of the ping-pong ball from those heights (for
   `jaximpact calibrate --law all --data`);
 - `impact_times.csv`: impact times of a golf ball and a ping-pong ball, two drops each (the
-  format of giiulia_phyphox_bounce_impact_times.csv): closed-form flights with quadratic air
-  drag, a short contact per impact, 0.1 ms timing noise, one double detection and one missed
-  impact;
+  format of giiulia_phyphox_bounce_impact_times.csv): each contact's `e` and duration from
+  law 14 (hertz_rate, the law the example fits), closed-form flights with quadratic air drag,
+  0.1 ms timing noise, one double detection and one missed impact;
 - `marble_video/A5_glass_marble/1-{1,50}-B-A5.csv`: a marble dropped on 1 and 50 sheets of
   paper, tracked at 240 frames per second in pixels, y pointing down (ImageJ MTrack2's
   format), held for 10 frames before the release.
@@ -90,15 +91,32 @@ def fall(h, k):
     )
 
 
-BALLS_AUDIO = {  # ball: (drop height cm, drag 1/m, contact time s, e at 0 m/s, slope)
-    "golf": (60, 0.0, 4e-4, 0.86, 0.03),
-    "pingpong": (30, 0.14, 1e-3, 0.95, 0.02),
+BALLS_AUDIO = {  # ball: (drop height cm, drag 1/m, mass kg, law 14's c and b1)
+    "golf": (60, 0.0, 0.0415, 5.5e7, 700.0),
+    "pingpong": (30, 0.14, 0.0027, 9e5, 40.0),
 }
+
+
+def contact(m, c, b1):
+    """`v -> (e, T)` of law 14 (`jaximpact.impact`, float64)."""
+    import jax
+
+    jax.config.update("jax_enable_x64", True)
+    import jaximpact as ji
+
+    solve = jax.jit(lambda v: ji.impact(ji.law("hertz_rate", c=c, b1=b1), m=m, v0=v))
+
+    def e_and_T(v):
+        r = solve(v)
+        return float(r.e), float(r.T)
+
+    return e_and_T
 
 
 def impact_times(rng):
     rows = []
-    for ball, (h_cm, k, contact, e0, slope) in BALLS_AUDIO.items():
+    for ball, (h_cm, k, m, c, b1) in BALLS_AUDIO.items():
+        e_and_T = contact(m, c, b1)
         for trial in (1, 2):
             t = 0.4 + 0.3 * rng.random()  # the release, some time into the recording
             dt, v = fall(h_cm / 100, k)
@@ -106,12 +124,13 @@ def impact_times(rng):
             times = []
             while len(times) < 25:
                 times.append(t)
-                u = restitution(v, e0, slope) * v
+                e, duration = e_and_T(v)
+                u = e * v
                 t_up, h = rise(u, k)
                 t_down, v = fall(h, k)
                 if t_up + t_down < 0.02:
                     break
-                t += contact + t_up + t_down
+                t += duration + t_up + t_down
             times = np.array(times) + 1e-4 * rng.standard_normal(len(times))
             if trial == 1:  # a double detection 3 ms after the fourth impact
                 times = np.sort(np.append(times, times[3] + 3e-3))
