@@ -462,6 +462,7 @@ def _fit(law, data, m, g, target_tol, options):
         and options.has_e
         and options.has_T
         and set(free) == {"c", _damping_parameter(law)}
+        and _damping_parameter(law) != "e_nominal"  # not read off the curves (a formula)
     )
     if exact:
         theta, iterations, stopped, history = theta0, jnp.asarray(0), jnp.asarray(True), None

@@ -307,3 +307,16 @@ def test_calibrate_at_several_speeds_on_the_curves_matches_the_integrated_fit():
     np.testing.assert_allclose([fit.params["c"], fit.params["a"]], [5e7, 0.2], rtol=1e-7)
     with pytest.raises(ValueError, match="not one-group"):
         ji.calibrate(ji.law("maxwell", c=1e6, b=1e3), m=1.0, v0=1.0, e=0.5, method="similarity")
+
+
+def test_calibrate_of_a_nominal_law_runs_the_optimiser_on_the_curves():
+    # the damping of a published variant is a formula of e_nominal: no closed-form start,
+    # so the least squares runs (over the curves) from the given values
+    truth = ji.law("lankarani_nikravesh", c=2e6, e_nominal=0.8)
+    r = ji.impact(truth, m=M, v0=V0)
+    assert r.path == "similarity"
+    fit = ji.calibrate(
+        ji.law("lankarani_nikravesh", c=2e7, e_nominal=0.5), m=M, v0=V0, e=r.e, T=r.T
+    )
+    assert bool(fit.converged) and int(fit.iterations) > 0
+    np.testing.assert_allclose([fit.params["c"], fit.params["e_nominal"]], [2e6, 0.8], rtol=1e-7)
