@@ -14,6 +14,7 @@ from collections.abc import Callable
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+import numpy as np
 from jaxtyping import Array
 
 from . import _hysteresis_damping
@@ -459,8 +460,17 @@ def shape_of(law) -> tuple[float, float] | None:
         return None
 
 
-def _as_arrays(params):
-    return {k: jnp.asarray(v, dtype=float) for k, v in params.items()}
+def _as_arrays(params, numbers=()):
+    """The parameters as JAX arrays; those named in `numbers` (a law's shape exponents)
+    stay numpy arrays when given as numbers, so that they are still known numbers when the
+    law is built inside `jax.jit` (where `jnp.asarray` of a constant is a traced value)."""
+    arrays = {}
+    for key, value in params.items():
+        if key in numbers and isinstance(value, (int, float, np.number, np.ndarray)):
+            arrays[key] = np.asarray(value, dtype=jnp.result_type(float))
+        else:
+            arrays[key] = jnp.asarray(value, dtype=float)
+    return arrays
 
 
 def _check_law_parameters(name, params):
@@ -514,7 +524,8 @@ def law(name: str, **params) -> Law:
             raise ValueError(
                 f"law 'power' needs exponents 0 <= p <= n, got n={given['n']}, p={given['p']}"
             )
-    return Law(name, _as_arrays(_check_law_parameters(name, given)))
+    numbers = [q for q in spec.shape if isinstance(q, str)]
+    return Law(name, _as_arrays(_check_law_parameters(name, given), numbers))
 
 
 def _concrete_numbers(*values) -> bool:

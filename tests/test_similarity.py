@@ -320,3 +320,12 @@ def test_calibrate_of_a_nominal_law_runs_the_optimiser_on_the_curves():
     )
     assert bool(fit.converged) and int(fit.iterations) > 0
     np.testing.assert_allclose([fit.params["c"], fit.params["e_nominal"]], [2e6, 0.8], rtol=1e-7)
+
+
+def test_hunt_crossley_built_inside_jit_still_takes_the_curves():
+    def e_of(c):
+        r = ji.impact(ji.law("hunt_crossley", c=c, a=0.1), m=M, v0=V0)
+        assert r.path == "similarity"  # n = 1.5 stays a number under jit
+        return r.e
+
+    assert abs(float(jax.jit(e_of)(2e6)) - float(e_of(2e6))) <= 1e-15
