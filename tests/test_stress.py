@@ -98,7 +98,14 @@ def test_stress_covers_the_range():
     assert e.max() > 0.999 and np.any(status == sc.STATUS["captured"])
 
 
-ALL = [(name, sep) for name in ji.LAW_NAMES for sep in ("force", "penetration")]
+# the laws whose dimensionless groups the sweep knows (the paper's and the nominal
+# Hunt-Crossley family); the power law and the engines' laws are not swept
+STRESSED = tuple(
+    name
+    for name in ji.LAW_NAMES
+    if name in sc.GROUPS or ji.LAWS[name].parameters == ("c", "e_nominal", "n")
+)
+ALL = [(name, sep) for name in STRESSED for sep in ("force", "penetration")]
 
 
 @pytest.mark.slow
@@ -111,7 +118,7 @@ def test_stress_full_float64(name, separation):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ji.LAW_NAMES)
+@pytest.mark.parametrize("name", STRESSED)
 def test_stress_full_float32(name, tmp_path):
     """float32 (x64 off, in a subprocess): no NaN, no lost impact, e to ~1e-5."""
     out = tmp_path / "rows.json"
