@@ -22,13 +22,8 @@ from jaxtyping import Array
 from ._adjoint import auto_adjoint
 from ._checks import check_nonnegative, check_positive, check_values
 from ._flight import Flight
-from ._impact import (
-    SEPARATIONS,
-    ImpactOptions,
-    _assemble_integrated,
-    _integrate,
-    _phase_plan,
-)
+from ._impact import SEPARATIONS, ImpactOptions
+from ._integrate import assemble_integrated, integrate_phases, phase_plan
 from ._laws import AbstractLaw
 from ._precision import resolvable_tolerances
 from ._status import Status
@@ -71,8 +66,8 @@ def _contact(law, m, v_in, g, ts_local, options: ImpactOptions):
     surface), and, with `ts_local` (s from first touch), the histories on that grid."""
     dynamics = law.dynamics(m=m, v0=v_in, g=g)
     tau_grid = None if ts_local is None else ts_local / dynamics.t_star
-    plan = _phase_plan(dynamics, options.peaks or tau_grid is not None)
-    phases = _integrate(
+    plan = phase_plan(dynamics, options.peaks or tau_grid is not None)
+    phases = integrate_phases(
         dynamics,
         plan=plan,
         separation=options.separation,
@@ -85,7 +80,7 @@ def _contact(law, m, v_in, g, ts_local, options: ImpactOptions):
         rest_tol=options.rest_tol,
         adjoint=options.adjoint,
     )
-    result = _assemble_integrated(dynamics, phases, plan, m=m, v0=v_in, g=g, tau_grid=tau_grid)
+    result = assemble_integrated(dynamics, phases, plan, m=m, v0=v_in, g=g, tau_grid=tau_grid)
     x_end = dynamics.position(phases["y"][-1]) * dynamics.x_star
     return result, x_end
 

@@ -232,16 +232,3 @@ def impact(
         )
     return result
 
-
-def __getattr__(name):
-    # the integration machinery's old private names, for modules not yet moved to `_integrate`
-    legacy = {
-        "_phase_plan": "phase_plan",
-        "_integrate": "integrate_phases",
-        "_assemble_integrated": "assemble_integrated",
-    }
-    if name in legacy:
-        from . import _integrate
-
-        return getattr(_integrate, legacy[name])
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
