@@ -74,6 +74,19 @@ def solve_impact(law, m, v0, g, ts, options: ImpactOptions) -> ImpactResult:
     )
 
 
+def _check_options(*, rtol, atol, rest_tol, max_steps, tau_max):
+    """One-line errors for options outside their range (before anything is traced)."""
+    for name, value in (("rtol", rtol), ("atol", atol), ("rest_tol", rest_tol)):
+        if value is None and name == "atol":
+            continue
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 < value < 1:
+            raise ValueError(f"{name} must be a number in (0, 1), got {value!r}")
+    if isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps < 1:
+        raise ValueError(f"max_steps must be a positive integer, got {max_steps!r}")
+    if isinstance(tau_max, bool) or not isinstance(tau_max, (int, float)) or not tau_max > 0:
+        raise ValueError(f"tau_max must be a number > 0 (units of t*), got {tau_max!r}")
+
+
 def similarity_reason(law, separation: str, *, g_is_zero: bool = True, ts=None) -> str | None:
     """Why the universal curves cannot give this impact, or `None` if they can.
 
@@ -171,6 +184,7 @@ def impact(
         raise ValueError(f"separation must be one of {SEPARATIONS}, got {separation!r}")
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    _check_options(rtol=rtol, atol=atol, rest_tol=rest_tol, max_steps=max_steps, tau_max=tau_max)
     m = jnp.asarray(check_positive("mass m", m, "kg"), dtype=float)
     v0 = jnp.asarray(check_positive("impact speed v0", v0, "m/s"), dtype=float)
     g_is_zero = isinstance(g, (int, float)) and g == 0
@@ -231,4 +245,3 @@ def impact(
             "the impact did not end in separation (stuck, captured or out of steps)",
         )
     return result
-

@@ -343,3 +343,20 @@ def test_hunt_crossley_built_inside_jit_still_takes_the_curves():
         return r.e
 
     assert abs(float(jax.jit(e_of)(2e6)) - float(e_of(2e6))) <= 1e-15
+
+
+@pytest.mark.parametrize(
+    "option",
+    [
+        {"rtol": 0.0},
+        {"rtol": -1e-8},
+        {"atol": 2.0},
+        {"rest_tol": float("nan")},
+        {"max_steps": 0},
+        {"max_steps": 1.5},
+        {"tau_max": 0.0},
+    ],  # fmt: skip
+)
+def test_options_outside_their_range_are_refused(option):
+    with pytest.raises(ValueError, match=next(iter(option))):
+        ji.impact(ji.law("hertz_rate", c=2e6, b1=800.0), m=M, v0=V0, **option)
