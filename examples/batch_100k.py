@@ -17,7 +17,7 @@ jax.config.update("jax_enable_x64", True)
 import numpy as np  # noqa: E402
 
 import jaximpact as ji  # noqa: E402
-from jaximpact._batch import impact_batch, write_table  # noqa: E402
+from jaximpact import impact_batch, write_table  # noqa: E402
 
 
 def main():

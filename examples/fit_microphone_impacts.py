@@ -33,7 +33,7 @@ jax.config.update("jax_enable_x64", True)
 import numpy as np  # noqa: E402
 
 import jaximpact as ji  # noqa: E402
-from jaximpact._fit_bounces import (  # noqa: E402
+from jaximpact import (  # noqa: E402
     clean_impact_times,
     fit_bounces,
     interval_restitution,

@@ -28,8 +28,7 @@ jax.config.update("jax_enable_x64", True)
 import numpy as np  # noqa: E402
 
 import jaximpact as ji  # noqa: E402
-from jaximpact._cli_fit import read_recording  # noqa: E402
-from jaximpact._fit_bounces import fit_bounces  # noqa: E402
+from jaximpact import fit_bounces, read_recording  # noqa: E402
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "marble_on_paper_video"
 if not DATA.exists():  # the real tracks are not shipped: two synthetic ones

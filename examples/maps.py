@@ -27,7 +27,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import jaximpact as ji  # noqa: E402
-from jaximpact._maps import plot_map, restitution_map  # noqa: E402
+from jaximpact import plot_map, restitution_map  # noqa: E402
 
 FILES = {"kelvin_voigt": "fig1_kelvin_voigt.png", "maxwell": "fig7_maxwell.png"}
 

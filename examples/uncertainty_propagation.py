@@ -19,7 +19,7 @@ jax.config.update("jax_enable_x64", True)
 import numpy as np  # noqa: E402
 
 import jaximpact as ji  # noqa: E402
-from jaximpact._design import plot_sensitivity, propagate_uncertainty, sensitivity_map  # noqa: E402
+from jaximpact import plot_sensitivity, propagate_uncertainty, sensitivity_map  # noqa: E402
 
 
 def main():

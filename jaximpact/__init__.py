@@ -50,6 +50,9 @@ _PUBLIC = {
     "BounceFit": "_fit_bounces",
     "fit_bounces": "_fit_bounces",
     "compare_laws": "_model_choice",
+    "clean_impact_times": "_fit_bounces",
+    "interval_restitution": "_fit_bounces",
+    "read_recording": "_cli_fit",
     "starting_law": "_model_choice",
     # many impacts
     "impact_batch": "_batch",
@@ -60,6 +63,7 @@ _PUBLIC = {
     "drop_design": "_design",
     "propagate_uncertainty": "_design",
     "sensitivity_map": "_design",
+    "plot_sensitivity": "_design",
     "plot_map": "_maps",
     "restitution_map": "_maps",
     # figures, the seed paper
