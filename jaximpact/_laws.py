@@ -41,9 +41,9 @@ class LawSpec:
     of the reduced force `F / x^p` (`"power"`: computed from the law's own `n` and `p`).
     `one_group`: without gravity the impact depends on the one group `beta` alone (the
     family without a dry force), so `impact` can read it off the universal curves;
-    `shape_parameters`: parameters that fix the curves' shape `(n, p)` (they must be known
-    numbers, not traced values, for the curves to serve); `shape`: the exponents `(n, p)`,
-    each a number or the name of the parameter that holds it. `closed_form`: `impact` has an
+    `shape`: the exponents `(n, p)`, each a number or the name of the parameter that holds
+    it (`shape_parameters`: those names, which must be known numbers, not traced values,
+    for the curves to serve). `closed_form`: `impact` has an
     exact solution for every parameter value (`_closed_forms.closed_form_for`).
     """
 
@@ -59,9 +59,13 @@ class LawSpec:
     dry: bool = False
     defaults: dict[str, float] = dataclasses.field(default_factory=dict)
     one_group: bool = False
-    shape_parameters: tuple[str, ...] = ()
     closed_form: bool = False
     shape: tuple = ()
+
+    @property
+    def shape_parameters(self) -> tuple[str, ...]:
+        """The parameters that hold the shape's exponents (no repeats)."""
+        return tuple(dict.fromkeys(q for q in self.shape if isinstance(q, str)))
 
 
 _PAPER = "Polukoshko et al. 2007"
@@ -197,7 +201,6 @@ _SPECS = [
         defaults={"n": 1.5},
         shape=("n", "n"),
         one_group=True,
-        shape_parameters=("n",),
     ),
 ]
 
@@ -219,7 +222,6 @@ def _nominal_spec(name, formula):
         defaults={"n": 1.5},
         shape=("n", "n"),
         one_group=True,
-        shape_parameters=("n",),
     )
 
 
@@ -237,7 +239,6 @@ _SPECS.append(
         gap="power",
         shape=("n", "p"),
         one_group=True,
-        shape_parameters=("n", "p"),
     )
 )
 
@@ -524,8 +525,7 @@ def law(name: str, **params) -> Law:
             raise ValueError(
                 f"law 'power' needs exponents 0 <= p <= n, got n={given['n']}, p={given['p']}"
             )
-    numbers = [q for q in spec.shape if isinstance(q, str)]
-    return Law(name, _as_arrays(_check_law_parameters(name, given), numbers))
+    return Law(name, _as_arrays(_check_law_parameters(name, given), spec.shape_parameters))
 
 
 def _concrete_numbers(*values) -> bool:
