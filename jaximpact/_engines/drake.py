@@ -27,14 +27,14 @@ SCENE = (
 def _tau(alpha: float) -> float:
     """The duration of `m x'' = -k x (1 + D v)` at `k = m = v0 = 1`, `D = alpha` (units of
     `sqrt(m/k)`), from jaximpact's solver."""
-    from .._impact import impact
-    from .._laws import law
+    from .. import impact
+    from .. import law
 
     return float(impact(law("point_contact", c=1.0, d=alpha), m=1.0, v0=1.0).T)
 
 
 def alpha_for(e: float) -> float:
-    from .._closed_forms import hunt_crossley_restitution
+    from ..closed_forms import hunt_crossley_restitution
 
     if e >= 1.0:
         return 0.0
@@ -48,7 +48,7 @@ def alpha_for(e: float) -> float:
 
 
 def design(e, T, *, m, v0, timestep=None):
-    from .._closed_forms import hunt_crossley_restitution
+    from ..closed_forms import hunt_crossley_restitution
 
     warnings = []
     alpha = alpha_for(e)
@@ -93,7 +93,7 @@ def snippet(parameters) -> str:
 
 
 def law(parameters, m: float):
-    from .._laws import law as make_law
+    from .. import law as make_law
 
     return make_law(
         "point_contact",

@@ -66,7 +66,7 @@ class Export:
 
 
 def _law_of(law_or_fit):
-    from .._laws import AbstractLaw
+    from .. import AbstractLaw
 
     if isinstance(law_or_fit, AbstractLaw):
         return law_or_fit
@@ -80,7 +80,7 @@ def _law_of(law_or_fit):
 
 
 def _curve(law, m, speeds, separation):
-    from .._impact import impact
+    from .. import impact
 
     es, Ts = [], []
     for v in speeds:
@@ -138,7 +138,7 @@ def export(
         if e is not None or T is not None:
             raise ValueError("give either a law (or fit) or the targets e= and T=, not both")
         source = _law_of(law_or_fit)
-        from .._impact import impact
+        from .. import impact
 
         result = impact(source, m=m, v0=v0)
         if int(result.status) != 0:
@@ -240,7 +240,7 @@ def engine_response(engine: str, parameters: dict, *, m, speeds, radius=None):
         coefficient = check_restitution(parameters["coeff_restitution"], "coeff_restitution")
         c = hertz_stiffness(E, nu, radius, R2=radius)
         b = lammps._damp(coefficient) * math.sqrt(m / 2.0 * c) if coefficient < 1 else 0.0
-        from .._laws import law as make_law
+        from .. import law as make_law
 
         law = make_law("tsuji", c=c, b=b)
         separation = "force" if parameters.get("limit_damping") else "penetration"

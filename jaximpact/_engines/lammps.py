@@ -34,8 +34,8 @@ _E_RANGE_TOL = 0.002
 def _impact(e_coefficient: float, separation: str):
     """`(e, tau)` of the Tsuji-form law at `c = m_eff = v0 = 1` (tau: T in units of
     `t* = (m_eff v0^2/c)^(2/5) / v0`), from jaximpact's solver."""
-    from .._impact import impact
-    from .._laws import law
+    from .. import impact
+    from .. import law
 
     result = impact(
         law("tsuji_restitution", c=1.0, e_nominal=e_coefficient, m_eff=1.0),
@@ -160,7 +160,7 @@ def snippet(parameters) -> str:
 
 def law(parameters, m: float):
     """The continuous law LAMMPS realises between the two spheres (effective mass `m/2`)."""
-    from .._laws import law as make_law
+    from .. import law as make_law
 
     return make_law("tsuji", c=parameters["k"], b=parameters["b"])
 

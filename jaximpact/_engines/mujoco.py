@@ -40,7 +40,7 @@ def continuous(dampratio: float) -> tuple[float, float]:
     """`(e, tau)` of the continuous contact: restitution and duration in units of
     `timeconst * dampratio` (= 1/natural frequency), from jaximpact's exact Kelvin-Voigt
     under the force criterion."""
-    from .._closed_forms import kelvin_voigt
+    from ..closed_forms import kelvin_voigt
 
     out = kelvin_voigt(1.0, 2.0 * dampratio, 1.0, 1.0, "force")
     return float(out["e"]), float(out["T"])
@@ -180,7 +180,7 @@ def snippet(parameters) -> str:
 def law(parameters, m: float):
     """The continuous law MuJoCo realises for a body of mass `m` (kg), as a jaximpact law
     (`kelvin_voigt`, to be used with `separation="force"`)."""
-    from .._laws import law as make_law
+    from .. import law as make_law
 
     stiffness, damping = effective(parameters["solref"], parameters["timestep"])
     return make_law("kelvin_voigt", c=m * stiffness, b=m * damping)
