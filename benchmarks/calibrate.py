@@ -52,8 +52,8 @@ from scipy.integrate import solve_ivp  # noqa: E402
 from scipy.optimize import least_squares  # noqa: E402
 
 import jaximpact as ji  # noqa: E402
-from jaximpact import _calibrate  # noqa: E402
-from jaximpact._calibrate import _fit, _initial_law  # noqa: E402
+from jaximpact._fit import calibrate as _calibrate  # noqa: E402
+from jaximpact._fit.calibrate import _fit, _initial_law  # noqa: E402
 
 M = 1.0
 SPEEDS = (0.5, 1.0, 2.5, 5.0, 10.0)

@@ -2,7 +2,6 @@
 docs/engines.md. Run: python benchmarks/engines_table.py > benchmarks/engines_table.md"""
 
 import jax
-import numpy as np
 
 jax.config.update("jax_enable_x64", True)
 

@@ -32,7 +32,7 @@ if sys.argv[1] == "sync":
     jax.config.update("jax_cpu_enable_async_dispatch", False)
 import diffrax as dfx, equinox as eqx, jax.numpy as jnp, numpy as np, optimistix as optx
 import jaximpact as ji
-from jaximpact._impact import ImpactOptions, solve_impact
+from jaximpact._solve.impact import ImpactOptions, solve_impact
 from _common import time_call
 
 M, V0, RTOL = 1.0, 2.5, 1e-10

@@ -151,3 +151,22 @@ def _arrows(ax, x, y, count: int = 2):
             xytext=(x[k], y[k]),
             arrowprops=dict(arrowstyle="-|>", color="C0", lw=1.2, mutation_scale=14),
         )
+
+
+def new_figure(**kwargs):
+    """A matplotlib Figure drawn by the Agg backend (no display needed)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+
+    return Figure(**kwargs)
+
+
+def save_figure(fig, path):
+    """Write `fig` to `path` (format from the extension); an `OSError` that names the file if
+    that fails."""
+    try:
+        fig.savefig(path, dpi=150, bbox_inches="tight")
+    except OSError as error:
+        raise OSError(f"cannot write {path}: {error.strerror or error}") from None

@@ -17,9 +17,9 @@ from reference import _solve
 from scipy.integrate import solve_ivp
 
 import jaximpact as ji
-from jaximpact._bounce import BounceStatus, bounce
-from jaximpact._euler import euler_bounce
-from jaximpact._flight import Flight, free_flight
+from jaximpact._solve.bounce import BounceStatus, bounce
+from jaximpact._solve.euler import euler_bounce
+from jaximpact._solve.flight import Flight, free_flight
 
 G, H0, M = 9.81, 0.6, 1.0  # the seed paper's section 7
 MAX_IMPACTS = 16

@@ -23,9 +23,9 @@ from helpers import PAPER_SETS, V0, M, assert_finite, assert_rel
 from reference import reference_impact
 
 import jaximpact as ji
-from jaximpact import _calibrate
-from jaximpact._hysteresis_damping import FORMULAS
-from jaximpact._restitution_tables import DAMPING, restitution_table
+from jaximpact._fit import calibrate as _calibrate
+from jaximpact._fit.restitution_tables import DAMPING, restitution_table
+from jaximpact._laws.hunt_crossley_variants import FORMULAS
 
 SPEEDS = (0.5, 1.0, 2.5, 5.0, 10.0)  # m/s, the several-speed data sets
 LAW14 = dict(c=2e6, b1=800.0)  # the seed paper's fig. 10

@@ -20,7 +20,11 @@ jax.config.update("jax_enable_x64", True)
 from helpers import assert_one_line_error, run_cli  # noqa: E402
 
 import jaximpact as ji  # noqa: E402
-from jaximpact import _cli  # noqa: E402
+from jaximpact import _cli, _format  # noqa: E402
+from jaximpact._cli import (
+    common,  # noqa: E402
+    laws as cli_laws,  # noqa: E402
+)
 from jaximpact._plotting import plot_impact  # noqa: E402
 
 LAW = dict(c=2e6, b1=800.0)
@@ -137,7 +141,7 @@ def test_internal_error_is_one_line(capsys, monkeypatch):
     def broken(args):
         raise RuntimeError("boom\nsecond line")
 
-    monkeypatch.setattr(_cli, "_run_laws", broken)
+    monkeypatch.setattr(cli_laws, "_run_laws", broken)
     assert_one_line_error(*run_cli(capsys, ["laws"]), expected_status=1, contains="boom")
 
 
@@ -162,16 +166,16 @@ def test_console_script_runs():
 
 
 def test_parse_params_and_formatting():
-    assert _cli.parse_params(["c=2e6", " b1 = 800 "]) == {"c": 2e6, "b1": 800.0}
+    assert common.parse_params(["c=2e6", " b1 = 800 "]) == {"c": 2e6, "b1": 800.0}
     for bad in ["c", "=3", "c=", "c=x", "1c=3"]:
-        with pytest.raises(_cli.CLIError):
-            _cli.parse_params([bad])
-    assert _cli.format_quantity(7.844925e-3, "s") == "7.845 ms"
-    assert _cli.format_quantity(1033.45, "N") == "1.033 kN"
-    assert _cli.format_quantity(0.9999999, "m") == "1 m"
-    assert _cli.format_quantity(0.0, "J") == "0 J"
-    assert _cli.format_number(2e6) == "2e6" and _cli.format_number(800.0) == "800"
-    assert _cli.jsonable({"a": np.float64(np.nan), "b": np.arange(2)}) == {"a": None, "b": [0, 1]}
+        with pytest.raises(common.CLIError):
+            common.parse_params([bad])
+    assert _format.format_quantity(7.844925e-3, "s") == "7.845 ms"
+    assert _format.format_quantity(1033.45, "N") == "1.033 kN"
+    assert _format.format_quantity(0.9999999, "m") == "1 m"
+    assert _format.format_quantity(0.0, "J") == "0 J"
+    assert _format.format_number(2e6) == "2e6" and _format.format_number(800.0) == "800"
+    assert _format.jsonable({"a": np.float64(np.nan), "b": np.arange(2)}) == {"a": None, "b": [0, 1]}
 
 
 def _synthetic_result(with_histories=True):

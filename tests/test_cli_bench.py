@@ -12,7 +12,7 @@ import math
 
 import pytest
 
-from jaximpact import _cli_bench
+from jaximpact._cli import bench as _cli_bench
 from jaximpact._cli import main
 
 

@@ -13,7 +13,8 @@ import pytest
 from helpers import assert_one_line_error, assert_rel, run_cli
 from reference import reference_impact
 
-from jaximpact import _cli_calibrate, _model_choice
+from jaximpact._cli import calibrate as _cli_calibrate
+from jaximpact._fit import model_choice as _model_choice
 
 LAW14 = dict(c=2e6, b1=800.0)
 SPEEDS = (0.5, 1.0, 2.5, 5.0, 10.0)
@@ -187,7 +188,7 @@ def test_conflicting_and_missing_sources(capsys, tmp_path):
 
 
 def test_free_accepts_commas_and_words():
-    from jaximpact._cli import CLIError, free_names
+    from jaximpact._cli.common import CLIError, free_names
 
     assert free_names(["c,b1"]) == ("c", "b1") == free_names(["c", "b1"])
     assert free_names(None) is None

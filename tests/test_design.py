@@ -12,8 +12,8 @@ import pytest
 from helpers import assert_rel
 
 import jaximpact as ji
-from jaximpact._batch import impact_batch
-from jaximpact._design import (
+from jaximpact._batch.batch import impact_batch
+from jaximpact._studies.design import (
     bumper_design,
     jacobian_batch,
     propagate_uncertainty,
@@ -117,8 +117,8 @@ def test_bumper_design_meets_the_constraints_and_scales():
 @pytest.mark.slow
 def test_drop_design_recovers_height_and_mass():
     """Apexes of a known drop (from `bounce`) give back its height and mass."""
-    from jaximpact._bounce import bounce
-    from jaximpact._design import drop_design
+    from jaximpact._solve.bounce import bounce
+    from jaximpact._studies.design import drop_design
 
     law = ji.law("hertz_rate", c=1e6, b1=1350.0)
     h0, m = 0.6, 0.8

@@ -15,8 +15,8 @@ import pytest
 from helpers import run_cli
 
 import jaximpact as ji
-from jaximpact._bounce import bounce
-from jaximpact._fit_bounces import clean_impact_times, fit_bounces, interval_restitution
+from jaximpact._fit.fit_bounces import clean_impact_times, fit_bounces, interval_restitution
+from jaximpact._solve.bounce import bounce
 
 GOLF_M = 0.0415  # kg
 GOLF = dict(c=5.5e7, b1=700.0)  # contact about 0.5 ms, e about 0.92 at 4 m/s

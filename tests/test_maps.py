@@ -11,7 +11,7 @@ from helpers import assert_rel
 from reference import reference_impact
 
 import jaximpact as ji
-from jaximpact._maps import MAP_DEFAULTS, plot_map, restitution_map
+from jaximpact._studies.maps import MAP_DEFAULTS, plot_map, restitution_map
 
 matplotlib.use("Agg")
 
@@ -85,7 +85,7 @@ def test_restitution_map_rejects_bad_inputs():
 @pytest.mark.parametrize("name", ["lankarani_nikravesh", "flores", "hunt_crossley_nominal"])
 def test_hunt_crossley_variants_match_the_exact_restitution(name):
     """Solved through hunt_crossley's compiled solve; e is exact (Lambert W)."""
-    from jaximpact._hysteresis_damping import FORMULAS
+    from jaximpact._laws.hunt_crossley_variants import FORMULAS
 
     rmap = restitution_map(name, num=6)
     e_nominal, c = np.meshgrid(rmap.damping, rmap.c, indexing="ij")

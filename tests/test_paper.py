@@ -16,7 +16,7 @@ from helpers import assert_one_line_error, run_cli
 jax.config.update("jax_enable_x64", True)
 
 import jaximpact as ji  # noqa: E402
-from jaximpact import _paper  # noqa: E402
+from jaximpact._paper import reproduce as _paper  # noqa: E402
 from jaximpact.closed_forms import kelvin_voigt  # noqa: E402
 
 

@@ -22,11 +22,11 @@ import numpy as np
 import optax
 from jaxtyping import Array
 
-from ._batch import _build_law, _cost_key, prepare_rows, run_batch
-from ._impact import impact
-from ._laws import law as make_law
-from ._maps import C_RANGE, MAP_DEFAULTS, _axis
-from ._status import Status
+from .._batch.batch import _build_law, _cost_key, prepare_rows, run_batch
+from .._laws.law import law as make_law
+from .._solve.impact import impact
+from .._status import Status
+from .maps import C_RANGE, MAP_DEFAULTS, _axis
 
 # ----------------------------------------------------------------------------- bumper
 
@@ -547,7 +547,7 @@ class DropDesign(eqx.Module):
 def _apex_residuals(theta, law, target, g, count, rtol):
     """`ln(apex_k / target_k)` for `theta = (ln h0, ln m)` and its Jacobian (forward mode),
     from `bounce`: the first `count` contacts, flights in closed form."""
-    from ._bounce import bounce
+    from .._solve.bounce import bounce
 
     def residuals(theta):
         h0, m = jnp.exp(theta[0]), jnp.exp(theta[1])

@@ -17,15 +17,15 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array
 
-from . import _hysteresis_damping
-from ._checks import check_nonnegative, check_positive, check_values
-from ._dynamics import (
+from .._checks import check_nonnegative, check_positive, check_values
+from .._powers import contact_pow
+from . import hunt_crossley_variants as _hysteresis_damping
+from .dynamics import (
     AbstractDynamics,
     maxwell_dynamics,
     power_dynamics,
     scaled_dynamics,
 )
-from ._powers import contact_pow
 
 
 @dataclasses.dataclass(frozen=True)

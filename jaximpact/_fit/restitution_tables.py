@@ -3,7 +3,7 @@
 For a law whose restitution depends on one dimensionless damping group `d` (the power-law
 family `F = c x^n + b x^p v`: `d = b x*^(p+1)/(m v0)`; Maxwell: `d = b/sqrt(m c)`), an impact at
 unit scales (`c = m = v0 = 1`, so `x* = t* = 1`) gives `e(d)` and `tau(d) = T/t*` once and for
-all. The tables are computed by this module's `main()` (`python -m jaximpact._restitution_tables`)
+all. The tables are computed by this module's `main()` (`python -m jaximpact._fit.restitution_tables`)
 and shipped in `_restitution_tables.npz`, so a first calibration does not pay their compile;
 `tests/test_calibrate.py` checks them against fresh impacts.
 """
@@ -15,9 +15,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._impact import impact
-from ._laws import Law
-from ._status import Status
+from .._laws.law import Law
+from .._solve.impact import impact
+from .._status import Status
 
 # the damping parameter of each law whose restitution depends on one dimensionless group
 DAMPING = {

@@ -4,13 +4,13 @@ with diffrax and ended by events (`_integrate`, imported only when needed)."""
 import equinox as eqx
 import jax.numpy as jnp
 
-from ._checks import check_nonnegative, check_positive
-from ._curves.shapes import CurveKey, curve_key
-from ._curves.similarity import serves, similarity_fields
-from ._laws import AbstractLaw, shape_of
-from ._precision import resolvable_tolerances
-from ._results import ImpactResult
-from ._status import Status
+from .._checks import check_nonnegative, check_positive
+from .._curves.shapes import CurveKey, curve_key
+from .._curves.similarity import serves, similarity_fields
+from .._laws.law import AbstractLaw, shape_of
+from .._status import Status
+from .precision import resolvable_tolerances
+from .results import ImpactResult
 
 SEPARATIONS = ("force", "penetration")
 METHODS = ("auto", "integrate", "closed_form", "similarity")
@@ -44,12 +44,12 @@ def solve_impact(law, m, v0, g, ts, options: ImpactOptions) -> ImpactResult:
         fields = similarity_fields(dynamics, options.similarity, m=m, v0=v0, peaks=options.peaks)
         return ImpactResult(**fields, path="similarity")
     if options.closed_form:
-        from ._closed_forms import closed_form_for
+        from .._laws.closed_forms import closed_form_for
 
         closed = closed_form_for(law, options.separation)
         fields = closed(law, m=m, v0=v0, rest_tol=options.rest_tol)
         return ImpactResult(**fields, path="closed_form")
-    from ._integrate import assemble_integrated, integrate_phases, phase_plan
+    from .phases import assemble_integrated, integrate_phases, phase_plan
 
     tau_grid = None if ts is None else ts / dynamics.t_star
     plan = phase_plan(dynamics, options.peaks or tau_grid is not None)
@@ -194,7 +194,7 @@ def impact(
 
     closed = None
     if ts is None and g_is_zero and getattr(getattr(law, "spec", None), "closed_form", False):
-        from ._closed_forms import closed_form_for
+        from .._laws.closed_forms import closed_form_for
 
         closed = closed_form_for(law, separation)
     if method == "closed_form" and closed is None:
@@ -220,7 +220,7 @@ def impact(
     if key is None and not closed_form:
         import diffrax as dfx
 
-        from ._adjoint import auto_adjoint
+        from .adjoint import auto_adjoint
 
         solver = dfx.Tsit5() if solver is None else solver
         adjoint = auto_adjoint(law, m, v0, g, ts) if adjoint is None else adjoint

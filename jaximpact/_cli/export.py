@@ -3,12 +3,12 @@ engine realises) and `jaximpact engine-e` (engine parameters -> e(v), T(v))."""
 
 import json
 
-from ._cli import (
+from .._format import format_number
+from .common import (
     CLIError,
     add_output_arguments,
     command_parser,
     emit,
-    format_number,
     parse_params,
 )
 
@@ -48,7 +48,7 @@ def add_export(subparsers):
 
 
 def _run_export(args):
-    from ._engines import export
+    from .._engines import export
 
     if args.engine not in _ENGINES:
         raise CLIError(f"unknown engine {args.engine!r}; choose one of: {', '.join(_ENGINES)}")
@@ -62,7 +62,7 @@ def _run_export(args):
         raise CLIError("LAMMPS needs --radius (m) of the two spheres")
     source = None
     if args.law is not None:
-        from ._laws import law
+        from .._laws.law import law
 
         source = law(args.law, **parse_params(args.param))
     x = export(
@@ -110,11 +110,11 @@ def add_engine_e(subparsers):
         "engine-e",
         help="the e(v) and T(v) that given engine contact parameters produce",
         description="The inverse of export: given an engine's contact parameters as JSON "
-        "(MuJoCo {\"solref\": [timeconst, dampratio], \"timestep\": s} (default step 0.002 s, "
-        "for its refsafe rule); LAMMPS {\"E\": Pa, "
-        "\"coeff_restitution\": e, \"poisson\": nu, \"limit_damping\": false} for "
+        '(MuJoCo {"solref": [timeconst, dampratio], "timestep": s} (default step 0.002 s, '
+        'for its refsafe rule); LAMMPS {"E": Pa, '
+        '"coeff_restitution": e, "poisson": nu, "limit_damping": false} for '
         "hertz/material with damping coeff_restitution; Drake "
-        "{\"point_contact_stiffness\": N/m, \"hunt_crossley_dissipation\": s/m}), the e and T "
+        '{"point_contact_stiffness": N/m, "hunt_crossley_dissipation": s/m}), the e and T '
         "of the continuous law the engine integrates, at each --speed.",
         example="jaximpact engine-e --engine mujoco --params '{\"solref\": [0.02, 1]}' "
         "--mass 0.05 --speed 0.5 1 2",
@@ -136,7 +136,7 @@ _NEEDED = {
 
 
 def _run_engine_e(args):
-    from ._engines import engine_response
+    from .._engines import engine_response
 
     if args.engine not in _ENGINES:
         raise CLIError(f"unknown engine {args.engine!r}; choose one of: {', '.join(_ENGINES)}")

@@ -86,7 +86,7 @@ def _figure_numbers(group: str) -> list[str]:
 
 def _parameters(params: dict) -> str:
     """`{"c": 2e6, "b1": 800.0}` -> `"c = 2e6, b1 = 800"`."""
-    from ._cli import format_number
+    from .._format import format_number
 
     return ", ".join(f"{k} = {format_number(v)}" for k, v in params.items())
 
@@ -98,7 +98,7 @@ def _parameters(params: dict) -> str:
 
 def _euler_impact(law, scheme: str):
     """The paper's Euler scheme for one impact: from first touch at `V0`, no gravity."""
-    from ._euler import euler_bounce
+    from .._solve.euler import euler_bounce
 
     return euler_bounce(law, m=M, h0=0.0, g=0.0, v_drop=V0, t_end=0.03, scheme=scheme)
 
@@ -106,8 +106,8 @@ def _euler_impact(law, scheme: str):
 def _loop_row(case: PaperCase, with_history: bool) -> dict:
     """Printed, Euler and converged `e` and `T` of one single-impact case, and the histories
     for its figure (the converged one only `with_history`)."""
-    from ._impact import impact
-    from ._laws import law as make_law
+    from .._laws.law import law as make_law
+    from .._solve.impact import impact
 
     law = make_law(case.law, **case.params)
     row = dict(figure=case.figure, law=case.law, params=case.params, printed=case.printed)
@@ -143,8 +143,7 @@ def _nearest(row) -> str | None:
 def _plot_loop(row, law, histories, path: Path):
     """The paper's loop figure: force (and its elastic part) and velocity against the
     penetration, converged (force criterion) and Euler as printed."""
-    from ._cli import new_figure
-    from ._plotting import _elastic_part
+    from .._plotting import _elastic_part, new_figure
 
     fig = new_figure(figsize=(11, 4.2), layout="constrained")
     ax_force, ax_speed = fig.subplots(1, 2)
@@ -173,7 +172,7 @@ def _plot_loop(row, law, histories, path: Path):
     fig.suptitle(
         f"Fig. {row['figure']}: {row['law']} ({params}), m = {M:g} kg, v0 = {V0:g} m/s{printed}"
     )
-    from ._cli import save_figure
+    from .._plotting import save_figure
 
     save_figure(fig, path)
 
@@ -185,9 +184,9 @@ def _plot_loop(row, law, histories, path: Path):
 
 def _bounce_row(case: PaperCase) -> tuple[dict, dict]:
     """First-contact `e` and `T` of a section-7 drop: printed, Euler, converged."""
-    from ._bounce import bounce
-    from ._euler import euler_bounce
-    from ._laws import law as make_law
+    from .._laws.law import law as make_law
+    from .._solve.bounce import bounce
+    from .._solve.euler import euler_bounce
 
     law = make_law(case.law, **case.params)
     row = dict(figure=case.figure, law=case.law, params=case.params, printed=case.printed)
@@ -211,7 +210,7 @@ def _bounce_row(case: PaperCase) -> tuple[dict, dict]:
 def _plot_bounce(row, drops, out_dir: Path) -> list[Path]:
     """Figs. 13-15 (or 16-18, 19-21): height, velocity and force against time, converged
     (force criterion) beside the paper's Euler, one file each."""
-    from ._cli import new_figure, save_figure
+    from .._plotting import new_figure, save_figure
 
     drop, euler = drops["force"], drops["paper"]
     grid = np.linspace(0.0, DROP_DURATION, 6000)
@@ -255,8 +254,8 @@ def _plot_bounce(row, drops, out_dir: Path) -> list[Path]:
 
 
 def _plot_maps(case: PaperCase, out_dir: Path) -> list[Path]:
-    from ._cli import new_figure, save_figure
-    from ._maps import plot_map, restitution_map
+    from .._plotting import new_figure, save_figure
+    from .._studies.maps import plot_map, restitution_map
 
     paths = []
     for criterion in CRITERIA:
@@ -391,10 +390,10 @@ def hunt_crossley_variants_markdown(nominal=HC_NOMINAL, *, check: bool = True) -
     so each row holds for every `c`, `n`, `m` and `v0`; `check` also integrates three
     formulas at three nominal values and states the largest difference.
     """
-    from . import _hysteresis_damping
-    from ._closed_forms import hunt_crossley_restitution
-    from ._impact import impact
-    from ._laws import law as make_law
+    from .._laws import hunt_crossley_variants as _hysteresis_damping
+    from .._laws.closed_forms import hunt_crossley_restitution
+    from .._laws.law import law as make_law
+    from .._solve.impact import impact
 
     names = list(_hysteresis_damping.FORMULAS)
     rows = {}
@@ -457,7 +456,7 @@ def reproduce_paper(out_dir, *, only=None, figures: bool = True, progress: bool 
 
     **Example**: `jaximpact.reproduce_paper("paper", only=["10"])["rows"][0]["e_force"]`.
     """
-    from ._progress import Progress
+    from .._progress import Progress
 
     cases = _select(only)
     out_dir = Path(out_dir)

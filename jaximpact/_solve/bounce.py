@@ -1,8 +1,8 @@
 """A ball dropped on a floor: free flights in closed form, one impact solve per contact.
 
 The seed paper's system (17) (Polukoshko et al. 2007, section 7) integrates the whole motion,
-flight and contact, with explicit Euler at a fixed step (`jaximpact._euler`). Here the free
-flight is a parabola (or, with quadratic air drag, its closed form: `jaximpact._flight`), never
+flight and contact, with explicit Euler at a fixed step (`jaximpact._solve.euler`). Here the free
+flight is a parabola (or, with quadratic air drag, its closed form: `jaximpact._solve.flight`), never
 integrated, and each contact is one event-terminated impact solve with gravity inside it (the
 same solve as `jaximpact.impact(..., g=g)`). The contacts run in a `lax.scan` of static
 length `max_impacts`; contacts after the end are masked, so the whole drop is one compiled
@@ -19,14 +19,14 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array
 
-from ._adjoint import auto_adjoint
-from ._checks import check_nonnegative, check_positive, check_values
-from ._flight import Flight
-from ._impact import SEPARATIONS, ImpactOptions
-from ._integrate import assemble_integrated, integrate_phases, phase_plan
-from ._laws import AbstractLaw
-from ._precision import resolvable_tolerances
-from ._status import Status
+from .._checks import check_nonnegative, check_positive, check_values
+from .._laws.law import AbstractLaw
+from .._status import Status
+from .adjoint import auto_adjoint
+from .flight import Flight
+from .impact import SEPARATIONS, ImpactOptions
+from .phases import assemble_integrated, integrate_phases, phase_plan
+from .precision import resolvable_tolerances
 
 
 class BounceStatus(enum.IntEnum):

@@ -8,8 +8,8 @@ import jax
 import jax.numpy as jnp
 import optimistix as optx
 
-from ._results import ImpactResult
-from ._status import Status
+from .._status import Status
+from .results import ImpactResult
 
 # Phases of one contact, integrated one after the other by the same compiled solve.
 _TO_PEAK = 0  # compression, until the first force peak or maximum compression

@@ -13,7 +13,7 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array
 
-from ._powers import contact_pow
+from .._powers import contact_pow
 
 
 class AbstractDynamics(eqx.Module):
@@ -190,7 +190,7 @@ class MaxwellDynamics(AbstractDynamics):
     def creeping(self, rest_tol):
         """Over-damped (`mu >= 2`) and no gravity: `V'' + mu V' + V = 0` keeps `V > 0`, the
         body sinks in for ever while the force relaxes (`closed_forms.maxwell_creep`)."""
-        from ._closed_forms import maxwell_creep  # optimistix, only for Maxwell
+        from .closed_forms import maxwell_creep  # optimistix, only for Maxwell
 
         captured = (self.mu >= 2.0) & (self.gamma == 0)
         # a harmless over-damped value elsewhere, so no NaN reaches a discarded gradient;

@@ -12,22 +12,20 @@ import math
 import threading
 from pathlib import Path
 
-from ._cli import (
+from .._format import format_number, format_quantity
+from .._plotting import new_figure, save_figure
+from .._progress import Progress, progress_enabled
+from .common import (
     CLIError,
-    _concrete_units,
     add_law_arguments,
     add_output_arguments,
     check_plot_path,
     command_parser,
     emit,
-    format_number,
-    format_quantity,
     free_names,
-    new_figure,
     parse_params,
-    save_figure,
 )
-from ._progress import Progress, progress_enabled
+from .laws import concrete_units
 
 COLUMNS = ("v0", "e", "T", "sigma_e", "sigma_T")
 ALL = "all"
@@ -187,7 +185,7 @@ def measurements(args) -> dict:
     NaN where a row has none, sigma_T 1 there)."""
     import numpy as np
 
-    from ._calibrate import _check_targets
+    from .._fit.calibrate import _check_targets
 
     flags = [f"--{k}" for k in ("v0", "e", "T") if getattr(args, k) is not None]
     flags += [
@@ -327,9 +325,9 @@ def _fit_kwargs(args, data):
 def _run_one(args, data):
     import jax
 
-    from ._calibrate import _default_free, calibrate
-    from ._laws import LAW_NAMES, LAWS
-    from ._model_choice import starting_law
+    from .._fit.calibrate import _default_free, calibrate
+    from .._fit.model_choice import starting_law
+    from .._laws.law import LAW_NAMES, LAWS
 
     if args.law not in LAWS:
         raise CLIError(f"unknown law {args.law!r}; choose one of: {', '.join(LAW_NAMES)}, or {ALL}")
@@ -371,7 +369,7 @@ def _run_one(args, data):
 def _fit_record(name, fit, data):
     import numpy as np
 
-    from ._laws import LAWS
+    from .._laws.law import LAWS
 
     rows = []
     for i in range(data["rows"]):
@@ -407,7 +405,7 @@ def _fit_record(name, fit, data):
 
 
 def _run_all(args, data):
-    from ._model_choice import PAPER_LAWS, compare_laws
+    from .._fit.model_choice import PAPER_LAWS, compare_laws
 
     laws = tuple(MODEL_CHOICE_LAWS or PAPER_LAWS)
     has_sigma = data["sigma_e"] is not None
@@ -464,7 +462,7 @@ MODEL_CHOICE_LAWS: tuple[str, ...] | None = None
 
 
 def _law_line(name):
-    from ._laws import LAWS
+    from .._laws.law import LAWS
 
     spec = LAWS[name]
     eq = f"eq. {spec.equation}: " if spec.equation != "-" else ""
@@ -472,9 +470,9 @@ def _law_line(name):
 
 
 def _units(name, params):
-    from ._laws import LAWS
+    from .._laws.law import LAWS
 
-    return _concrete_units(LAWS[name], params)
+    return concrete_units(LAWS[name], params)
 
 
 def _params_text(name, params, stderr=None, indent=11):
@@ -598,8 +596,8 @@ def _all_text(result, data):
 
 def _curve(fit, args, speeds):
     """e and T (NaN where the body does not separate) of a fitted law at `speeds`."""
-    from ._impact import impact
-    from ._status import Status
+    from .._solve.impact import impact
+    from .._status import Status
 
     es, Ts = [], []
     for v in speeds:

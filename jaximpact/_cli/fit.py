@@ -16,18 +16,17 @@ import io
 import math
 from pathlib import Path
 
-from ._cli import (
+from .._format import format_number
+from .._plotting import new_figure, save_figure
+from .common import (
     CLIError,
     add_law_arguments,
     add_output_arguments,
     check_plot_path,
     command_parser,
     emit,
-    format_number,
     free_names,
     law_from_args,
-    new_figure,
-    save_figure,
 )
 
 FORMATS = ("auto", "trajectory", "impacts")
@@ -297,7 +296,7 @@ def _options(args, recording):
 def _fit_one(law, args, recording, name, data, length_scale, y_axis):
     import numpy as np
 
-    from ._fit_bounces import fit_bounces
+    from .._fit.fit_bounces import fit_bounces
 
     common = dict(
         m=args.mass,
@@ -458,7 +457,7 @@ def run_fit(args):
     recording = read_recording(args.file, args.format, args.where)
     law = law_from_args(args)
     length_scale, y_axis = _options(args, recording)
-    from ._progress import Progress, progress_enabled
+    from .._progress import Progress, progress_enabled
 
     fits = {}
     with Progress(len(recording.groups), "fitting", enabled=progress_enabled()) as bar:

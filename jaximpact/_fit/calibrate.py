@@ -9,14 +9,14 @@ import optax
 import optimistix as optx
 from jaxtyping import Array
 
-from ._curves.shapes import curve_key
-from ._curves.similarity import beta_for_restitution, curve_values
-from ._curves.store import curves_for
-from ._forward_jacobian import value_and_jacobian, with_forward_jacobian
-from ._impact import CURVES_RTOL, ImpactOptions, similarity_reason, solve_impact
-from ._laws import AbstractLaw, shape_of
-from ._restitution_tables import DAMPING, restitution_table
-from ._status import Status
+from .._curves.shapes import curve_key
+from .._curves.similarity import beta_for_restitution, curve_values
+from .._curves.store import curves_for
+from .._laws.law import AbstractLaw, shape_of
+from .._solve.impact import CURVES_RTOL, ImpactOptions, similarity_reason, solve_impact
+from .._status import Status
+from .forward_jacobian import value_and_jacobian, with_forward_jacobian
+from .restitution_tables import DAMPING, restitution_table
 
 OPTIMIZERS = ("lbfgs", "lm")
 

@@ -7,9 +7,9 @@ import jax.numpy as jnp
 import numpy as np
 from jax.scipy.special import gammaln
 
-from ._calibrate import DAMPING, Fit, calibrate
-from ._laws import LAWS, law
-from ._progress import Progress
+from .._laws.law import LAWS, law
+from .._progress import Progress
+from .calibrate import DAMPING, Fit, calibrate
 
 PAPER_LAWS = tuple(name for name, spec in LAWS.items() if spec.equation != "-")
 

@@ -2,7 +2,7 @@
 
 from pathlib import Path
 
-from ._cli import CLIError, add_output_arguments, command_parser, emit
+from .common import CLIError, add_output_arguments, command_parser, emit
 
 
 def add_paper(subparsers):
@@ -39,7 +39,7 @@ def add_paper(subparsers):
 def _run_paper(args):
     import sys
 
-    from ._paper import _select, reproduce_paper
+    from .._paper.reproduce import _select, reproduce_paper
 
     if args.out.exists() and not args.out.is_dir():
         raise CLIError(f"--out {args.out}: exists and is not a directory")
@@ -53,7 +53,7 @@ def _run_paper(args):
 
 
 def _paper_text(result) -> str:
-    from ._paper import _COLUMNS
+    from .._paper.reproduce import _COLUMNS
 
     lines = [
         "fig.   law                      printed  Euler(paper)  converged(force)  "

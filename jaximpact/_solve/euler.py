@@ -25,8 +25,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._checks import check_nonnegative, check_positive
-from ._laws import AbstractLaw
+from .._checks import check_nonnegative, check_positive
+from .._laws.law import AbstractLaw
 
 SCHEMES = ("paper", "euler")
 

@@ -29,9 +29,15 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._bounce import BounceResult, _chain, _solve_bounce, bounce_options, trajectory_from_records
-from ._calibrate import DAMPING, _from_unbounded, _law_with, _to_unbounded
-from ._laws import AbstractLaw
+from .._laws.law import AbstractLaw
+from .._solve.bounce import (
+    BounceResult,
+    _chain,
+    _solve_bounce,
+    bounce_options,
+    trajectory_from_records,
+)
+from .calibrate import DAMPING, _from_unbounded, _law_with, _to_unbounded
 
 KINDS = ("impacts", "trajectory")
 Y_AXES = ("up", "down")

@@ -17,7 +17,7 @@ import numpy as np
 import optimistix as optx
 from jax.scipy.special import gammaln
 
-from ._status import Status
+from .._status import Status
 
 
 def _series_near_zero(u, coefficients):

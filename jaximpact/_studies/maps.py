@@ -9,10 +9,10 @@ c from 2e6 to 2e7 N/m, b from 200 to 1000 N s/m) and for Maxwell (its Fig. 7);
 import equinox as eqx
 import numpy as np
 
-from . import _closed_forms, _hysteresis_damping
-from ._batch import impact_batch
-from ._laws import LAW_NAMES, LAWS
-from ._status import Status
+from .._batch.batch import impact_batch
+from .._laws import closed_forms as _closed_forms, hunt_crossley_variants as _hysteresis_damping
+from .._laws.law import LAW_NAMES, LAWS
+from .._status import Status
 
 # law -> (damping parameter, its default range, other parameters held fixed); the ranges hold
 # the seed paper's parameter set (m = 1 kg, v0 = 2.5 m/s, c = 2e6) inside, and reach from

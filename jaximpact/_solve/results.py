@@ -3,7 +3,7 @@
 import equinox as eqx
 from jaxtyping import Array
 
-from ._status import Status
+from .._status import Status
 
 
 class ImpactResult(eqx.Module):

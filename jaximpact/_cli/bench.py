@@ -9,18 +9,17 @@ on; `--json` for the numbers, `--plot` for a bar chart of the ratios against the
 import math
 import sys
 
-from ._bench import LAWS, TARGETS, require_scipy, run_bench, steps
-from ._cli import (
+from .._bench import LAWS, TARGETS, require_scipy, run_bench, steps
+from .._format import format_number
+from .._plotting import new_figure, save_figure
+from .._progress import Progress
+from .common import (
     CLIError,
     add_output_arguments,
     check_plot_path,
     command_parser,
     emit,
-    format_number,
-    new_figure,
-    save_figure,
 )
-from ._progress import Progress
 
 
 def add_bench(subparsers):

@@ -1,0 +1,83 @@
+"""The `jaximpact` command line: one module per subcommand, each with a function
+`add(subparsers)` that builds its parser with `common.command_parser` and sets its handler.
+
+Bad input is a `ValueError` (the library's), a `CLIError` (the command line's) or an `OSError`
+(a file that cannot be read or written), reported as one line `jaximpact: error: ...` on stderr
+with exit status 2, never a traceback. To add a command, write `jaximpact/_cli/NAME.py` with
+its `add_NAME` and append it to `COMMANDS`. The command modules import only argparse and the
+helpers at import time, so `jaximpact --help` stays quick.
+"""
+
+import argparse
+import os
+import sys
+
+from .bench import add_bench
+from .calibrate import add_calibrate
+from .common import DEBUG_ENV, PROG, CLIError, Parser, configure_jax, fail, wrap_paragraphs
+from .export import add_engine_e, add_export
+from .fit import add_fit
+from .laws import add_laws
+from .paper import add_paper
+from .simulate import add_simulate
+
+COMMANDS = [
+    ("laws", add_laws),
+    ("simulate", add_simulate),
+    ("fit", add_fit),
+    ("calibrate", add_calibrate),
+    ("paper", add_paper),
+    ("bench", add_bench),
+    ("export", add_export),
+    ("engine-e", add_engine_e),
+]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The `jaximpact` parser, with one subcommand per entry of `COMMANDS`."""
+    from .. import __version__
+
+    parser = Parser(
+        prog=PROG,
+        description=wrap_paragraphs(
+            "Impact force laws integrated with JAX and diffrax. All quantities in SI units."
+        ),
+        epilog="example:\n  jaximpact laws\n"
+        "  jaximpact simulate --law hertz_rate --param c=2e6 --param b1=800 --v0 2.5\n\n"
+        "'jaximpact COMMAND --help' describes each command.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for _, add in COMMANDS:
+        add(subparsers)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line on `argv` (default `sys.argv[1:]`); return 0 on success.
+
+    Bad input exits with status 2 after one line on stderr; an unexpected failure exits with
+    status 1 and one line (set `JAXIMPACT_DEBUG=1` for the traceback).
+    """
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    configure_jax()
+    try:
+        status = args.handler(args)
+    except (CLIError, ValueError, OSError) as error:
+        fail(str(error), status=2)
+    except KeyboardInterrupt:
+        fail("interrupted", status=130)
+    except BrokenPipeError:  # e.g. `jaximpact laws | head`: stop quietly
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        raise SystemExit(1) from None
+    except Exception as error:
+        if os.environ.get(DEBUG_ENV):
+            raise
+        fail(
+            f"internal error, {type(error).__name__}: {error} "
+            f"(run with {DEBUG_ENV}=1 for the traceback)",
+            status=1,
+        )
+    return 0 if status is None else int(status)

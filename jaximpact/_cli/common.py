@@ -1,0 +1,198 @@
+"""What the subcommands share: the one-line error (`CLIError`, `fail`), the parser factory
+and argument groups, reading `--param NAME=VALUE`, `--json` output (`emit`) and JAX's set-up
+(`configure_jax`). `--plot FILE` goes through `jaximpact._plotting` (matplotlib's Agg backend,
+imported only then); anything long draws a `jaximpact._progress.Progress` on stderr."""
+
+import argparse
+import json
+import os
+import sys
+import textwrap
+from collections.abc import Callable, Iterable
+from pathlib import Path
+
+from .._cache import enable_persistent_cache
+from .._format import jsonable
+
+PROG = "jaximpact"
+DEBUG_ENV = "JAXIMPACT_DEBUG"
+
+
+class CLIError(Exception):
+    """Bad input found by the command line: printed as one line, exit status 2."""
+
+
+class Parser(argparse.ArgumentParser):
+    """An ArgumentParser whose usage errors are one line (`jaximpact: error: ...`)."""
+
+    def error(self, message):
+        hint = f" (see '{self.prog} --help')"
+        fail(f"{message}{hint}", status=2)
+
+
+def fail(message: str, status: int):
+    """Print one line `jaximpact: error: message` on stderr and exit with `status`."""
+    line = " ".join(str(message).split())  # one line, whatever the message held
+    print(f"{PROG}: error: {line}", file=sys.stderr)
+    raise SystemExit(status)
+
+
+# --------------------------------------------------------------------------------------
+# Shared helpers for subcommands
+# --------------------------------------------------------------------------------------
+
+
+def wrap_paragraphs(text: str, width: int = 88) -> str:
+    """Fill each paragraph of `text` (the raw formatter keeps the epilog's layout as it is,
+    and would leave a description on one long line)."""
+    paragraphs = [" ".join(p.split()) for p in text.split("\n\n")]
+    return "\n\n".join(textwrap.fill(p, width) for p in paragraphs)
+
+
+def command_parser(
+    subparsers, name: str, *, help: str, description: str, example: str
+) -> argparse.ArgumentParser:
+    """Add the subcommand `name`, with its description and a runnable `example` (one or
+    more command lines) shown at the end of its `--help`."""
+    examples = "\n".join(f"  {line}" for line in example.strip().splitlines())
+    return subparsers.add_parser(
+        name,
+        help=help,
+        description=wrap_paragraphs(description),
+        epilog=f"example:\n{examples}",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+
+
+def add_law_arguments(parser, *, required: bool = True):
+    """`--law NAME` and `--param NAME=VALUE` (repeatable); read them with `law_from_args`."""
+    parser.add_argument(
+        "--law",
+        required=required,
+        metavar="NAME",
+        help="force law, one of those listed by 'jaximpact laws' (e.g. hertz_rate)",
+    )
+    parser.add_argument(
+        "--param",
+        action="extend",
+        nargs="+",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a law parameter in SI units, e.g. --param c=2e6 --param b1=800 "
+        "(or --param c=2e6 b1=800)",
+    )
+
+
+def add_impact_arguments(parser):
+    """`--mass`, `--v0`, `--separation` and `--gravity`, the conditions of one impact."""
+    parser.add_argument(
+        "--mass", type=float, default=1.0, metavar="KG", help="mass, kg (default 1)"
+    )
+    parser.add_argument(
+        "--v0", type=float, required=True, metavar="M/S", help="impact speed, m/s (> 0)"
+    )
+    parser.add_argument(
+        "--separation",
+        choices=("force", "penetration"),
+        default="force",
+        help="end of contact: when the force returns to zero (force, the default) or when "
+        "the penetration does (penetration)",
+    )
+    parser.add_argument(
+        "--gravity",
+        type=float,
+        default=0.0,
+        metavar="M/S^2",
+        help="gravity along the inward normal, m/s^2 (default 0; 9.81 for a ball on a floor)",
+    )
+
+
+def add_output_arguments(parser, *, plot: bool = True):
+    """`--json` (one JSON object on stdout) and, if `plot`, `--plot FILE`."""
+    parser.add_argument(
+        "--json", action="store_true", help="print one JSON object (SI units) instead of text"
+    )
+    if plot:
+        parser.add_argument(
+            "--plot",
+            metavar="FILE",
+            type=Path,
+            help="also write a figure to FILE (.png, .pdf, .svg ...)",
+        )
+
+
+def parse_params(items: Iterable[str]) -> dict[str, float]:
+    """`["c=2e6", "b1=800"]` -> `{"c": 2e6, "b1": 800.0}`; a `CLIError` for anything else."""
+    params = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        name, value = name.strip(), value.strip()
+        if not sep or not name or not value:
+            raise CLIError(f"--param {item!r} must be NAME=VALUE, e.g. --param c=2e6")
+        if not name.isidentifier():
+            raise CLIError(f"--param {item!r}: {name!r} is not a parameter name")
+        try:
+            number = float(value)
+        except ValueError:
+            raise CLIError(f"--param {item!r}: {value!r} is not a number") from None
+        if name in params:
+            raise CLIError(f"--param {name} is given twice")
+        params[name] = number
+    return params
+
+
+def free_names(items) -> tuple[str, ...] | None:
+    """`--free c,b1` or `--free c b1` -> `("c", "b1")`; None when not given."""
+    if not items:
+        return None
+    names = [name.strip() for item in items for name in item.split(",") if name.strip()]
+    if not names:
+        raise CLIError("--free names no parameter, e.g. --free c,b1")
+    if len(set(names)) != len(names):
+        raise CLIError("--free names a parameter twice")
+    return tuple(names)
+
+
+def law_from_args(args):
+    """The law of `--law` and `--param` (the library checks the name and the values)."""
+    from .._laws.law import law
+
+    return law(args.law, **parse_params(args.param))
+
+
+def check_plot_path(path: Path | None):
+    """Fail early (before any computation) on a `--plot` file that cannot be written."""
+    if path is None:
+        return
+    if not path.suffix:
+        raise CLIError(f"--plot {path}: give the file an extension such as .png")
+    if path.parent != Path("") and not path.parent.is_dir():
+        raise CLIError(f"--plot {path}: directory {str(path.parent)!r} does not exist")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    formats = FigureCanvasAgg.get_supported_filetypes()
+    if path.suffix[1:].lower() not in formats:
+        raise CLIError(
+            f"--plot {path}: unknown figure format {path.suffix!r}; "
+            f"use one of {', '.join('.' + f for f in sorted(formats))}"
+        )
+
+
+def emit(args, data: dict, text: str | Callable[[], str]):
+    """Print `data` as one JSON object under `--json`, else `text` (or `text()`)."""
+    if getattr(args, "json", False):
+        print(json.dumps(jsonable(data), indent=2, allow_nan=False))
+    else:
+        print(text() if callable(text) else text)
+
+
+def configure_jax():
+    """float64, and the persistent compilation cache (`_cache`) for every program, however
+    small."""
+    # XLA's CPU compiler logs harmless "algebraic simplifier ... circular" notes at error
+    # level for diffrax's loops; keep them off the user's terminal unless asked for
+    os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "3")
+    import jax
+
+    jax.config.update("jax_enable_x64", True)
+    enable_persistent_cache(min_compile_time_secs=0.0)
