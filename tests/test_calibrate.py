@@ -24,7 +24,7 @@ from reference import reference_impact
 
 import jaximpact as ji
 from jaximpact._fit import calibrate as _calibrate
-from jaximpact._fit.restitution_tables import DAMPING, restitution_table
+from jaximpact._fit.restitution_tables import TABLE_LAWS, restitution_table
 from jaximpact._laws.hunt_crossley_variants import FORMULAS
 
 SPEEDS = (0.5, 1.0, 2.5, 5.0, 10.0)  # m/s, the several-speed data sets
@@ -433,7 +433,7 @@ TABLE_DEFECTS: dict[tuple[str, str], str] = {}
 
 
 @pytest.mark.parametrize("separation", ("force", "penetration"))
-@pytest.mark.parametrize("name", tuple(DAMPING))
+@pytest.mark.parametrize("name", TABLE_LAWS)
 def test_restitution_tables_against_fresh_impacts(name, separation, request):
     """The shipped nondimensional tables (e and T/t* against the damping group at unit
     scales) agree with fresh impacts by the scipy integrator to 1e-6, at five nodes spread
@@ -443,7 +443,7 @@ def test_restitution_tables_against_fresh_impacts(name, separation, request):
     groups, e_table, tau_table = restitution_table(name, separation)
     nodes = np.flatnonzero((e_table >= 0.01) & (e_table <= 0.9999))
     assert len(nodes) >= 20, f"{name}/{separation}: the table misses measurable e"
-    damping = DAMPING[name]
+    damping = ji.LAWS[name].damping
     reference_separation = "penetration" if name in SAME_AS_PENETRATION else separation
     for i in nodes[np.linspace(0, len(nodes) - 1, 5).astype(int)]:
         value = groups[i] / 1.5 if name == "hunt_crossley" else groups[i]

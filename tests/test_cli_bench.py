@@ -12,8 +12,7 @@ import math
 
 import pytest
 
-from jaximpact._cli import bench as _cli_bench
-from jaximpact._cli import main
+from jaximpact._cli import bench as _cli_bench, main
 
 
 def run(argv):

@@ -9,8 +9,7 @@ import numpy as np
 import pytest
 
 import jaximpact as ji
-from jaximpact._engines import lammps as lammps_engine
-from jaximpact._engines import mujoco as mujoco_engine
+from jaximpact._engines import lammps as lammps_engine, mujoco as mujoco_engine
 from jaximpact._engines.export import engine_response
 
 # ------------------------------------------------------------------ materials (hand values)

@@ -11,7 +11,7 @@ from helpers import assert_rel
 from reference import reference_impact
 
 import jaximpact as ji
-from jaximpact._studies.maps import MAP_DEFAULTS, plot_map, restitution_map
+from jaximpact._studies.maps import plot_map, restitution_map
 
 matplotlib.use("Agg")
 
@@ -41,9 +41,9 @@ def test_figure_7_maxwell_takes_the_paper_formulas_when_under_damped():
     assert np.all(rmap.status == ji.Status.separated)
 
 
-def test_integrated_map_matches_scipy():
+def test_curves_map_matches_scipy():
     rmap = restitution_map("hertz_rate", **GRID)
-    assert rmap.path == "integrated" and rmap.damping_name == "b1" and rmap.e.shape == (8, 8)
+    assert rmap.path == "similarity" and rmap.damping_name == "b1" and rmap.e.shape == (8, 8)
     assert np.all(np.diff(rmap.e, axis=0) < 0)  # more b1, less restitution
     for i, j in ((0, 0), (3, 5), (7, 7)):
         ref = reference_impact(
@@ -64,10 +64,10 @@ def test_plot_map_draws_two_contour_panels(tmp_path):
 
 
 def test_every_law_has_a_default_map():
-    assert set(MAP_DEFAULTS) == set(ji.LAW_NAMES)
-    for name, (damping, (lo, hi), fixed) in MAP_DEFAULTS.items():
-        assert damping in ji.LAWS[name].parameters and 0 <= lo < hi
-        assert set(fixed) <= set(ji.LAWS[name].parameters)
+    for name, spec in ji.LAWS.items():
+        lo, hi = spec.map_range
+        assert spec.damping in spec.parameters and 0 <= lo < hi, name
+        assert set(spec.map_fixed) <= set(spec.parameters), name
 
 
 def test_restitution_map_rejects_bad_inputs():

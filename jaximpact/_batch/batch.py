@@ -460,6 +460,25 @@ def _fix_shape(skeleton, params):
     return (*skeleton, fixed), {k: v for k, v in params.items() if k not in shape}
 
 
+def batch_path(
+    law, separation, *, method="auto", rtol=1e-11, g_is_zero=True, **impact_options
+) -> str:
+    """The path every row of a batch of `law`'s impacts takes: `"closed_form"`,
+    `"similarity"` (the universal curves) or `"integrated"` (the same choice as `impact`'s
+    `method="auto"`, made once for the batch)."""
+    if g_is_zero and method != "integrate" and closed_form_for(law, separation) is not None:
+        return "closed_form"
+    if (
+        g_is_zero
+        and method in ("auto", "similarity")
+        and rtol >= CURVES_RTOL
+        and "solver" not in impact_options
+        and similarity_reason(law, separation) is None
+    ):
+        return "similarity"
+    return "integrated"
+
+
 def prepare_rows(law, params, *, m, v0, g=0.0):
     """Check a batch of impacts once, eagerly, and lay it out as rows.
 
@@ -569,15 +588,10 @@ def impact_batch(
         member = _impact_member.__wrapped__(skeleton, tuple(fields), tuple(options.items()))
     cost = None
     first = _build_law(skeleton, {k: v[:1] for k, v in law_params.items()})
-    closed = (
-        zero_gravity and method != "integrate" and closed_form_for(first, separation) is not None
-    ) or (
-        zero_gravity
-        and method in ("auto", "similarity")
-        and rtol >= CURVES_RTOL
-        and "solver" not in impact_options
-        and similarity_reason(first, separation) is None
+    path = batch_path(
+        first, separation, method=method, rtol=rtol, g_is_zero=zero_gravity, **impact_options
     )
+    closed = path != "integrated"
     if order == "cost" and not closed:
         cost = _cost_key(skeleton, law_params, **kinematics)
     label = skeleton[1] if skeleton[0] == "law" else "custom law"

@@ -325,8 +325,9 @@ def _fit_kwargs(args, data):
 def _run_one(args, data):
     import jax
 
-    from .._fit.calibrate import _default_free, calibrate
+    from .._fit.calibrate import calibrate
     from .._fit.model_choice import starting_law
+    from .._fit.parameters import default_free
     from .._laws.law import LAW_NAMES, LAWS
 
     if args.law not in LAWS:
@@ -344,7 +345,7 @@ def _run_one(args, data):
     if given:
         start = start.replace(**given)
     free = free_names(args.free)
-    fitted_names = free or _default_free(start, data["T"] is not None)
+    fitted_names = free or default_free(start, stiffness=data["T"] is not None)
     init = args.init or ("given" if set(given) & set(fitted_names) else "auto")
     with _Ticker(1, f"calibrating {args.law}", _progress_enabled()) as bar:
         fit = calibrate(start, free=free, init=init, **_fit_kwargs(args, data))

@@ -1,8 +1,12 @@
 """The engines people run (MuJoCo, Drake, LAMMPS): material inputs, and exports of a law to
 an engine's own contact parameters with the e and T the engine realises (docs/engines.md)."""
 
-from .export import ENGINES as ENGINES, Export as Export, engine_response as engine_response
-from .export import export as export
+from .export import (
+    ENGINES as ENGINES,
+    Export as Export,
+    engine_response as engine_response,
+    export as export,
+)
 from .materials import (
     effective_mass as effective_mass,
     effective_radius as effective_radius,

@@ -27,8 +27,7 @@ SCENE = (
 def _tau(alpha: float) -> float:
     """The duration of `m x'' = -k x (1 + D v)` at `k = m = v0 = 1`, `D = alpha` (units of
     `sqrt(m/k)`), from jaximpact's solver."""
-    from .. import impact
-    from .. import law
+    from .. import impact, law
 
     return float(impact(law("point_contact", c=1.0, d=alpha), m=1.0, v0=1.0).T)
 
@@ -133,7 +132,10 @@ def simulate(parameters, *, m, v0, radius=0.01, time_step=0.0, accuracy=1e-10):
     )
     plant.RegisterCollisionGeometry(body, RigidTransform(), Sphere(radius), "ball", props)
     plant.RegisterCollisionGeometry(
-        plant.world_body(), HalfSpace.MakePose([0, 0, 1], [0, 0, 0]), HalfSpace(), "ground",
+        plant.world_body(),
+        HalfSpace.MakePose([0, 0, 1], [0, 0, 0]),
+        HalfSpace(),
+        "ground",
         props,
     )
     plant.mutable_gravity_field().set_gravity_vector([0, 0, 0])

@@ -58,10 +58,14 @@ class Export:
 
     def to_dict(self) -> dict:
         out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "law"}
-        out["law"] = None if self.law is None else {
-            "name": self.law.name,
-            "parameters": {k: float(v) for k, v in self.law.parameters.items()},
-        }
+        out["law"] = (
+            None
+            if self.law is None
+            else {
+                "name": self.law.name,
+                "parameters": {k: float(v) for k, v in self.law.parameters.items()},
+            }
+        )
         return out
 
 
@@ -164,8 +168,13 @@ def export(
         if target_T is None:
             raise ValueError("LAMMPS needs a contact duration: pass T= (s) or a law")
         out = lammps.design(
-            target_e, target_T, m=m, v0=v0, radius=radius,
-            poisson=0.3 if poisson is None else poisson, timestep=timestep,
+            target_e,
+            target_T,
+            m=m,
+            v0=v0,
+            radius=radius,
+            poisson=0.3 if poisson is None else poisson,
+            timestep=timestep,
             limit_damping=limit_damping,
         )
         separation = out["separation"]

@@ -34,8 +34,7 @@ _E_RANGE_TOL = 0.002
 def _impact(e_coefficient: float, separation: str):
     """`(e, tau)` of the Tsuji-form law at `c = m_eff = v0 = 1` (tau: T in units of
     `t* = (m_eff v0^2/c)^(2/5) / v0`), from jaximpact's solver."""
-    from .. import impact
-    from .. import law
+    from .. import impact, law
 
     result = impact(
         law("tsuji_restitution", c=1.0, e_nominal=e_coefficient, m_eff=1.0),

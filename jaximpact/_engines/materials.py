@@ -62,7 +62,9 @@ def effective_radius(R1, R2=math.inf) -> float:
     R1 = _positive("R1", R1, "m", infinite_ok=True)
     R2 = _positive("R2", R2, "m", infinite_ok=True)
     if math.isinf(R1) and math.isinf(R2):
-        raise ValueError("effective_radius: two flats have no Hertz contact; give a finite radius (m)")
+        raise ValueError(
+            "effective_radius: two flats have no Hertz contact; give a finite radius (m)"
+        )
     if math.isinf(R2):
         return R1
     if math.isinf(R1):

@@ -124,7 +124,7 @@ def design(e: float, T: float, v0: float, timestep: float | None = None):
             f"timeconst {solref[0]:.4g} s is below two time steps ({2 * h:.4g} s): MuJoCo's "
             "refsafe raises it, so solref is given in its direct form, which is not raised"
         )
-        solref = (-w0**2, -2.0 * zeta * w0)
+        solref = (-(w0**2), -2.0 * zeta * w0)
         es, Ts = replica(solref, h, v0)
     half_spread = float((es.max() - es.min()) / 2 / es.mean()) if es.mean() > 0 else 0.0
     if half_spread > 0.005:
@@ -186,8 +186,17 @@ def law(parameters, m: float):
     return make_law("kelvin_voigt", c=m * stiffness, b=m * damping)
 
 
-def simulate(parameters, v0: float, *, m: float = 0.05, radius: float = 0.01, phases=(0.5,),
-             condim: int = 1, cone: str = "pyramidal", integrator: str = "Euler"):
+def simulate(
+    parameters,
+    v0: float,
+    *,
+    m: float = 0.05,
+    radius: float = 0.01,
+    phases=(0.5,),
+    condim: int = 1,
+    cone: str = "pyramidal",
+    integrator: str = "Euler",
+):
     """Run MuJoCo: a sphere of mass `m` (kg), radius `radius` (m) moving at `v0` (m/s) onto a
     plane, gravity off, first touch `phase * timestep` after a step's start. Returns arrays
     `(e, T)`, T the number of steps with a non-zero contact force times the step."""

@@ -12,11 +12,12 @@ from jaxtyping import Array
 from .._curves.shapes import curve_key
 from .._curves.similarity import beta_for_restitution, curve_values
 from .._curves.store import curves_for
-from .._laws.law import AbstractLaw, shape_of
+from .._laws.law import AbstractLaw, damping_parameter, shape_of
 from .._solve.impact import CURVES_RTOL, ImpactOptions, similarity_reason, solve_impact
 from .._status import Status
 from .forward_jacobian import value_and_jacobian, with_forward_jacobian
-from .restitution_tables import DAMPING, restitution_table
+from .parameters import default_free, law_with, to_unbounded
+from .restitution_tables import restitution_table
 
 OPTIMIZERS = ("lbfgs", "lm")
 
@@ -102,43 +103,22 @@ def _check_targets(m, v0, e, T, sigma_e, sigma_T):
         raise ValueError("give e, T or both to calibrate against")
 
 
-# ----------------------------------------------------------------------------- transforms
-
-
-def _to_unbounded(name, value):
-    if name == "e_nominal":
-        return jnp.log(value) - jnp.log1p(-jnp.minimum(value, 1 - 1e-12))
-    return jnp.log(value)
-
-
-def _from_unbounded(name, theta):
-    if name == "e_nominal":
-        return jax.nn.sigmoid(theta)
-    return jnp.exp(theta)
-
-
-def _law_with(law, free, theta):
-    """`law` with its free parameters set from `theta` (physical by construction, so no
-    value checks, which would put host callbacks in the compiled fit)."""
-    params = dict(law.params)
-    params.update({k: _from_unbounded(k, theta[i]) for i, k in enumerate(free)})
-    return eqx.tree_at(lambda item: item.params, law, params)
-
-
 # ------------------------------------------------------------------- initial values
 
 
 def _initial_law(law, free, *, m, v0, e, T, separation):
     """Start from one dimensionless damping group: `e` sets it (through a table of the
     law's nondimensional impact), `T` then sets the time scale and so the stiffness."""
-    name = getattr(law, "name", None)
-    damping = DAMPING.get(name)
-    if damping is None or damping not in free or e is None:
+    spec = getattr(law, "spec", None)
+    if spec is None or not spec.restitution_table:
+        return law
+    damping = spec.damping
+    if damping not in free or e is None:
         return law
     if isinstance(law.params.get("n", 0.0), jax.core.Tracer):
         return law
-    n = float(law.params.get("n", 1.5)) if name == "hunt_crossley" else 1.5
-    groups, e_table, tau_table = restitution_table(name, separation, n)
+    n = float(law.params.get("n", 1.5))  # a law with an exponent parameter: one table per n
+    groups, e_table, tau_table = restitution_table(spec.name, separation, n)
     # 1 - e is nearly proportional to the group at light damping: interpolate logarithms
     loss_table = np.log(np.maximum(1.0 - e_table, 1e-300))
     order = np.argsort(loss_table)  # e rises or falls with the group, depending on the law
@@ -149,20 +129,20 @@ def _initial_law(law, free, *, m, v0, e, T, separation):
     log_group = jnp.interp(loss_row, loss_table, np.log(groups))
     group = jnp.exp(log_group)
     tau = jnp.interp(loss_row, loss_table, tau_table)
-    if name == "maxwell":
+    if spec.coefficients is None:  # Maxwell: group b / sqrt(m c), tau = T / sqrt(m / c)
         c = law.params["c"]
         if T is not None and "c" in free:
             c = jnp.where(jnp.isfinite(T[row]), m * (tau / T[row]) ** 2, c)
         return law.replace(**({"c": c} if "c" in free else {}), b=group * jnp.sqrt(m * c))
-    _, n_law, _, p, _, _ = law.spec.coefficients(law.params, v_row)
+    _, n_law, _, p, _, _ = spec.coefficients(law.params, v_row)
     c = law.params["c"]
     if T is not None and "c" in free:
         x_star = v_row * T[row] / tau
         c = jnp.where(jnp.isfinite(T[row]), m * v_row**2 / x_star ** (n_law + 1.0), c)
     x_star = (m * v_row**2 / c) ** (1.0 / (n_law + 1.0))
     b = group * m * v_row / x_star ** (p + 1.0)
-    value = b / (1.5 * c) if name == "hunt_crossley" else b
-    return law.replace(**({"c": c} if "c" in free else {}), **{damping: value})
+    b_per_unit = spec.coefficients({**law.params, "c": c, damping: 1.0}, v_row)[2]
+    return law.replace(**({"c": c} if "c" in free else {}), **{damping: b / b_per_unit})
 
 
 def _start_on_curves(law, free, *, m, v0, e, T, has_T, key):
@@ -170,7 +150,7 @@ def _start_on_curves(law, free, *, m, v0, e, T, has_T, key):
     median speed by inverting `e(beta)`, then `T/t* = tau(beta)` gives `t*` and so the
     stiffness, and `beta` the damping (linear in the damping parameter at fixed `c`). At
     one speed with `e` and `T` this is the fit itself, to the curves' accuracy."""
-    damping = _damping_parameter(law)
+    damping = damping_parameter(law)
     if damping not in free or damping == "e_nominal":
         return law
     curves = curves_for(key)
@@ -189,23 +169,7 @@ def _start_on_curves(law, free, *, m, v0, e, T, has_T, key):
     return eqx.tree_at(lambda item: item.params, law, params)
 
 
-def _damping_parameter(law):
-    params = list(law.parameters)
-    return DAMPING.get(getattr(law, "name", None)) or next(
-        (k for k in ("b", "b1", "a", "d", "e_nominal", "P") if k in params), None
-    )
-
-
 # ------------------------------------------------------------------------------ the fit
-
-
-def _default_free(law, has_T):
-    params = list(law.parameters)
-    damping = _damping_parameter(law)
-    free = [damping] if damping else []
-    if has_T and "c" in params:
-        free = ["c"] + free
-    return tuple(free) or tuple(params[:1])
 
 
 def _residual_function(law, free, *, m, separation, g, rtol, has_e, has_T, curves=None):
@@ -228,7 +192,7 @@ def _residual_function(law, free, *, m, separation, g, rtol, has_e, has_T, curve
 
     def residuals(theta, data):
         v0, e, T, s_e, s_T = data
-        fitted = _law_with(law, free, theta)
+        fitted = law_with(law, free, theta)
         result = jax.vmap(lambda v: solve_impact(fitted, m, v, g, None, options))(v0)
         parts = []
         predictions = (result.e, result.T, result.status)
@@ -362,7 +326,7 @@ def calibrate(
     _check_targets(m, v0, e, T, sigma_e, sigma_T)
     m = jnp.asarray(m, dtype=float) if isinstance(m, jax.core.Tracer) else np.float64(m)
     has_sigma = sigma_e is not None or sigma_T is not None
-    free = _default_free(law, T is not None) if free is None else tuple(free)
+    free = default_free(law, stiffness=T is not None) if free is None else tuple(free)
     unknown = [k for k in free if k not in law.parameters]
     if unknown:
         raise ValueError(
@@ -453,7 +417,7 @@ def _fit(law, data, m, g, target_tol, options):
         r = residuals(theta, data)
         return 0.5 * jnp.sum(r**2)
 
-    theta0 = jnp.stack([_to_unbounded(k, law.parameters[k]) for k in free])
+    theta0 = jnp.stack([to_unbounded(k, law.parameters[k]) for k in free])
     # one speed, e and T, stiffness and damping free: the start read off the curves is the
     # solution itself (two equations, two unknowns), so no optimiser runs
     exact = (
@@ -461,8 +425,8 @@ def _fit(law, data, m, g, target_tol, options):
         and rows == 1
         and options.has_e
         and options.has_T
-        and set(free) == {"c", _damping_parameter(law)}
-        and _damping_parameter(law) != "e_nominal"  # not read off the curves (a formula)
+        and set(free) == {"c", damping_parameter(law)}
+        and damping_parameter(law) != "e_nominal"  # not read off the curves (a formula)
     )
     if exact:
         theta, iterations, stopped, history = theta0, jnp.asarray(0), jnp.asarray(True), None
@@ -488,7 +452,7 @@ def _fit(law, data, m, g, target_tol, options):
     else:
         filled = jnp.arange(history.shape[0]) < iterations
         history = jnp.where(filled, history, final_loss)
-    fitted = _law_with(law, free, theta)
+    fitted = law_with(law, free, theta)
     converged = jnp.all(jnp.abs(r) <= target_tol) & jnp.all(status == Status.separated)
     stderr = None
     if options.has_sigma:

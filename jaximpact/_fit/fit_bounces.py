@@ -29,7 +29,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._laws.law import AbstractLaw
+from .._laws.law import AbstractLaw, damping_parameter
 from .._solve.bounce import (
     BounceResult,
     _chain,
@@ -37,7 +37,7 @@ from .._solve.bounce import (
     bounce_options,
     trajectory_from_records,
 )
-from .calibrate import DAMPING, _from_unbounded, _law_with, _to_unbounded
+from .parameters import default_free, from_unbounded, law_with, to_unbounded
 
 KINDS = ("impacts", "trajectory")
 Y_AXES = ("up", "down")
@@ -224,7 +224,7 @@ class _Spec(eqx.Module):
 
 def _unpack(theta, law, data, spec):
     nf = len(spec.free)
-    fitted = _law_with(law, spec.free, theta[:nf])
+    fitted = law_with(law, spec.free, theta[:nf])
     q = {name: theta[nf + i] for i, name in enumerate(spec.nuisance)}
     t1 = data["t1"] + q["t_impact"] * data["t_unit"]
     v1 = data["v1"] * jnp.exp(q["v_impact"])
@@ -378,17 +378,6 @@ class BounceFit(eqx.Module):
         return self.nuisance["floor"] + self.y_sign * self.nuisance["length_scale"] * height
 
 
-def _default_free(law):
-    """The damping parameter of a law of the table; a custom law: its last parameter."""
-    damping = DAMPING.get(getattr(law, "name", None))
-    if damping in law.parameters:
-        return (damping,)
-    for name in ("b", "b1", "a", "e_nominal"):
-        if name in law.parameters:
-            return (name,)
-    return tuple(law.parameters)[-1:]
-
-
 def _first_stage(law, free, nuisance):
     """What a first fit frees: the nuisance and the damping alone (a stiffness freed from the
     start can wander to a distant local minimum before the damping has settled)."""
@@ -397,7 +386,7 @@ def _first_stage(law, free, nuisance):
 
 
 def _damping_name(law, free):
-    name = DAMPING.get(getattr(law, "name", None))
+    name = damping_parameter(law)
     return name if name in free else None
 
 
@@ -577,7 +566,7 @@ def fit_bounces(
         raise ValueError("fit_drag needs a starting value: drag=k (1/m)")
     if drag is not None and not (np.isfinite(drag) and drag > 0):
         raise ValueError(f"drag must be a finite number > 0 (1/m), got {drag}")
-    free = _default_free(law) if free is None else tuple(free)
+    free = default_free(law, stiffness=False) if free is None else tuple(free)
     unknown = [k for k in free if k not in law.parameters]
     if unknown:
         raise ValueError(
@@ -658,7 +647,7 @@ def _run(law, free, nuisance, m, g, data, kind, y_sign, options, active, max_ite
         )
 
     theta0 = np.concatenate(
-        [[float(_to_unbounded(k, law.parameters[k])) for k in free], np.zeros(len(nuisance))]
+        [[float(to_unbounded(k, law.parameters[k])) for k in free], np.zeros(len(nuisance))]
     )
     result = _levenberg_marquardt(evaluate, theta0, active, max_iter=max_iter, tol=tol)
     log.append(result[6])
@@ -686,7 +675,7 @@ def _tune_damping(law, free, nuisance, m, g, data, kind, y_sign, options, e_targ
         _, e, _, _, J_e = _evaluate(theta, law, jnp.asarray(m), jnp.asarray(g), jdata, spec)
         return float(e[0]), float(J_e[0, 0])
 
-    x = float(_to_unbounded(damping, law.parameters[damping]))
+    x = float(to_unbounded(damping, law.parameters[damping]))
     for _ in range(30):
         e, slope = first_e(x)
         if abs(e - e_target) < 1e-4 or not np.isfinite(slope) or slope == 0:
@@ -695,7 +684,7 @@ def _tune_damping(law, free, nuisance, m, g, data, kind, y_sign, options, e_targ
         if e == 0.0:  # captured: far too much damping
             step = -2.0
         x += float(step)
-    return law.replace(**{damping: float(_from_unbounded(damping, x))})
+    return law.replace(**{damping: float(from_unbounded(damping, x))})
 
 
 def _statistics(theta, r, J, extra, names, sigma_given, n_data, log_params):
@@ -745,7 +734,7 @@ def _finish(
     **extra_fields,
 ):
     nf = len(free)
-    fitted_law = _law_with(law, free, jnp.asarray(theta[:nf]))
+    fitted_law = law_with(law, free, jnp.asarray(theta[:nf]))
     log_params = [True] * nf + [
         name in ("v_impact", "length_scale", "drag") for name in nuisance_names
     ]
@@ -1126,4 +1115,4 @@ def _rebase(data, law, free, nuisance, theta):
         data["scale"] = np.asarray(float(data["scale"]) * math.exp(q["length_scale"]))
     if "drag" in q:
         data["drag"] = np.asarray(float(data["drag"]) * math.exp(q["drag"]))
-    return data, _law_with(law, free, jnp.asarray(theta[:nf]))
+    return data, law_with(law, free, jnp.asarray(theta[:nf]))

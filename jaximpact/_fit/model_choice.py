@@ -7,9 +7,10 @@ import jax.numpy as jnp
 import numpy as np
 from jax.scipy.special import gammaln
 
-from .._laws.law import LAWS, law
+from .._laws.law import LAWS, exponents, law
 from .._progress import Progress
-from .calibrate import DAMPING, Fit, calibrate
+from .calibrate import Fit, calibrate
+from .parameters import default_free
 
 PAPER_LAWS = tuple(name for name, spec in LAWS.items() if spec.equation != "-")
 
@@ -26,45 +27,35 @@ def starting_law(name: str, *, m: float, v0: float, e: float, T: float | None):
     undamped contact time sets `c`, an equivalent linear damping ratio sets the rest
     (`calibrate` then refines them)."""
     spec = LAWS[name]
-    n = 1.5 if "hertz" in name or spec.gap == "x" else 1.0
     T = 1e-3 if T is None or not np.isfinite(T) else T
-    x_star = v0 * T / _undamped_tau(n)
-    c = m * v0**2 / x_star ** (n + 1.0)
     log_e = math.log(min(max(e, 1e-6), 0.999999))
     zeta = -log_e / math.sqrt(math.pi**2 + log_e**2)
+    if spec.coefficients is None:  # Maxwell: a spring of period 2 T in series with a dashpot
+        omega = math.pi / T
+        return law(name, c=m * omega**2, b=m * omega / max(zeta, 1e-3))
+    n, p = exponents(spec)
+    x_star = v0 * T / _undamped_tau(n)
+    c = m * v0**2 / x_star ** (n + 1.0)
     b_linear = 2.0 * zeta * math.sqrt(m * m * v0**2 / x_star**2)  # 2 zeta sqrt(m c_linear)
-    params = {"c": c}
+    params = {"c": c, "n": n, "p": p}
     for key in spec.parameters:
         if key in ("b", "b1"):
-            p = (
-                1.0
-                if name in ("kelvin_voigt_modified", "bingham_modified", "hertz_modified")
-                else 0.0
-            )
-            p = 0.5 if name == "hertz_rate" else p
             params[key] = b_linear / x_star**p
         elif key == "a":
             params[key] = max(1.0 - e, 1e-3) / v0
         elif key == "P":
-            x_max = e * x_star
-            params[key] = (
-                0.5
-                * m
-                * v0**2
-                * max(1.0 - e**2, 1e-3)
-                / x_max
-                / (2.0 if name != "bingham_compression" else 1.0)
-            )
+            energy = 0.5 * m * v0**2 * max(1.0 - e**2, 1e-3)
+            params[key] = energy / (e * x_star) / (2.0 if _dry_both_ways(spec, v0) else 1.0)
         elif key == "e_nominal":
             params[key] = min(max(e, 0.05), 0.999)
-        elif key == "n":
-            params[key] = 1.5
-    if name == "maxwell":
-        params = {
-            "c": m * (math.pi / T) ** 2,
-            "b": math.sqrt(m * m * (math.pi / T) ** 2) / max(zeta, 1e-3),
-        }
-    return law(name, **params)
+    return law(name, **{k: v for k, v in params.items() if k in spec.parameters})
+
+
+def _dry_both_ways(spec, v0) -> bool:
+    """The dry force acts in restitution too (Bingham), so it dissipates about twice per
+    contact what it does in compression alone (law 9)."""
+    unit = {"c": 1.0, "b": 0.0, "b1": 0.0, "P": 1.0}
+    return float(spec.coefficients(unit, v0)[5]) != 0.0
 
 
 @dataclasses.dataclass
@@ -150,11 +141,6 @@ def compare_laws(
 
 
 def _free_for(name, *, has_T, n_data):
-    params = LAWS[name].parameters
-    damping = DAMPING.get(name) or next(
-        k for k in ("b", "b1", "a", "e_nominal", "P") if k in params
-    )
-    free = (["c"] if has_T or n_data > 1 else []) + [damping]
-    if "P" in params and "P" not in free and n_data > len(free):
-        free.append("P")
-    return tuple(free)
+    stiffness = has_T or n_data > 1
+    free = default_free(LAWS[name], stiffness=stiffness)
+    return default_free(LAWS[name], stiffness=stiffness, dry=n_data > len(free))

@@ -3,7 +3,8 @@
 For a law whose restitution depends on one dimensionless damping group `d` (the power-law
 family `F = c x^n + b x^p v`: `d = b x*^(p+1)/(m v0)`; Maxwell: `d = b/sqrt(m c)`), an impact at
 unit scales (`c = m = v0 = 1`, so `x* = t* = 1`) gives `e(d)` and `tau(d) = T/t*` once and for
-all. The tables are computed by this module's `main()` (`python -m jaximpact._fit.restitution_tables`)
+all. The tables are computed by this module's `main()`
+(`python -m jaximpact._fit.restitution_tables`)
 and shipped in `_restitution_tables.npz`, so a first calibration does not pay their compile;
 `tests/test_calibrate.py` checks them against fresh impacts.
 """
@@ -15,32 +16,29 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._laws.law import Law
+from .._laws.law import LAWS, Law
 from .._solve.impact import impact
 from .._status import Status
 
-# the damping parameter of each law whose restitution depends on one dimensionless group
-DAMPING = {
-    "kelvin_voigt": "b",
-    "kelvin_voigt_modified": "b1",
-    "hertz_viscous": "b",
-    "hertz_modified": "b",
-    "hertz_rate": "b1",
-    "hunt_crossley": "a",
-    "maxwell": "b",
-}
+# the laws whose rows ask for a table (`LawSpec.restitution_table`)
+TABLE_LAWS = tuple(name for name, spec in LAWS.items() if spec.restitution_table)
 GROUPS = np.logspace(-4, 2.5, 209)
 _FILE = Path(__file__).with_name("_restitution_tables.npz")
 
 
 def compute_table(name: str, separation: str, n: float = 1.5):
     """`(groups, e, tau)` from impacts at unit scales, separated members only."""
-    damping = DAMPING[name]
+    spec = LAWS[name]
 
     def one(group):
-        params = {"c": 1.0, damping: group / 1.5 if name == "hunt_crossley" else group}
-        if name == "hunt_crossley":
-            params["n"] = n
+        params = {"c": 1.0, **({"n": n} if "n" in spec.parameters else {})}
+        # the damping that makes the family's b (or Maxwell's b / sqrt(m c)) equal the group
+        per_unit = (
+            1.0
+            if spec.coefficients is None
+            else spec.coefficients({**params, spec.damping: 1.0}, 1.0)[2]
+        )
+        params[spec.damping] = group / per_unit
         law = Law(name, {k: jnp.asarray(v, float) for k, v in params.items()})
         result = impact(law, m=1.0, v0=1.0, separation=separation, peaks=False, rtol=1e-10)
         return result.e, result.T, result.status
@@ -71,7 +69,7 @@ def restitution_table(name: str, separation: str, n: float = 1.5):
 def main():
     jax.config.update("jax_enable_x64", True)
     arrays = {}
-    for name in DAMPING:
+    for name in TABLE_LAWS:
         for separation in ("force", "penetration"):
             groups, e, tau = compute_table(name, separation)
             key = f"{name}/{separation}"

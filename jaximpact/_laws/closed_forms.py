@@ -332,6 +332,20 @@ def closed_form_for(law, separation):
     return None
 
 
+def exact_batch(name: str, params: dict, *, m, v0, separation: str) -> dict | None:
+    """`e`, `T` (s) and `status` of a batch of law `name`'s impacts from an exact solution
+    that holds for every member, or `None`: Maxwell under the force criterion when every
+    member is under-damped (`4 b^2 > m c`); Kelvin-Voigt goes through `impact_batch`'s
+    closed-form path instead."""
+    if name != "maxwell" or separation != "force":
+        return None
+    c, b = np.asarray(params["c"], float), np.asarray(params["b"], float)
+    if not np.all(4.0 * b**2 > m * c):
+        return None
+    out = maxwell(c, b, m, v0)
+    return {k: np.asarray(out[k]) for k in ("e", "T", "status")}
+
+
 def _finish(fields, m, v0):
     e = fields["e"]
     separated = fields["status"] == Status.separated

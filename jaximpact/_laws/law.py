@@ -45,6 +45,13 @@ class LawSpec:
     it (`shape_parameters`: those names, which must be known numbers, not traced values,
     for the curves to serve). `closed_form`: `impact` has an
     exact solution for every parameter value (`_closed_forms.closed_form_for`).
+    `damping`: the parameter that sets the dissipation (what `restitution_map` varies and a
+    fit frees first); `map_range`, `map_fixed`: the map's default range of it and the other
+    parameters held (the seed paper's set m = 1 kg, v0 = 2.5 m/s, c = 2e6 lies inside, from
+    light to heavy damping over c = 2e6 to 2e7); `restitution_table`: a table of e and T/t*
+    against the one group ships for start values (`_fit.restitution_tables`); `nominal`:
+    the formula `D(e, v0)` (s/m) of a Hunt-Crossley variant whose damping is set from a
+    nominal restitution, so that its impact is `hunt_crossley`'s with `a = D / 1.5`.
     """
 
     name: str
@@ -61,6 +68,11 @@ class LawSpec:
     one_group: bool = False
     closed_form: bool = False
     shape: tuple = ()
+    damping: str | None = None
+    map_range: tuple[float, float] | None = None
+    map_fixed: dict[str, float] = dataclasses.field(default_factory=dict)
+    restitution_table: bool = False
+    nominal: Callable | None = None
 
     @property
     def shape_parameters(self) -> tuple[str, ...]:
@@ -87,116 +99,148 @@ def _family(c, n, b, p, p_in=0.0, p_out=0.0):
 
 _SPECS = [
     LawSpec(
-        "kelvin_voigt",
-        "1",
-        "c x + b v",
-        ("c", "b"),
-        _UNITS,
-        f"{_PAPER}, eq. 1",
-        lambda q, v0: _family(q["c"], 1, q["b"], 0),
+        name="kelvin_voigt",
+        damping="b",
+        map_range=(200.0, 1000.0),
+        restitution_table=True,  # the paper's Fig. 1
+        equation="1",
+        formula="c x + b v",
+        parameters=("c", "b"),
+        units=_UNITS,
+        reference=f"{_PAPER}, eq. 1",
+        coefficients=lambda q, v0: _family(q["c"], 1, q["b"], 0),
         gap=1,
         shape=(1.0, 0.0),
         one_group=True,
         closed_form=True,
     ),
     LawSpec(
-        "kelvin_voigt_modified",
-        "6",
-        "c x + b1 x v",
-        ("c", "b1"),
-        _UNITS,
-        f"{_PAPER}, eq. 6",
-        lambda q, v0: _family(q["c"], 1, q["b1"], 1),
+        name="kelvin_voigt_modified",
+        damping="b1",
+        map_range=(5e4, 1e6),
+        restitution_table=True,
+        equation="6",
+        formula="c x + b1 x v",
+        parameters=("c", "b1"),
+        units=_UNITS,
+        reference=f"{_PAPER}, eq. 6",
+        coefficients=lambda q, v0: _family(q["c"], 1, q["b1"], 1),
         gap=0,
         shape=(1.0, 1.0),
         one_group=True,
     ),
     LawSpec(
-        "bingham",
-        "7",
-        "c x + b v + P sgn(v)",
-        ("c", "b", "P"),
-        _UNITS,
-        f"{_PAPER}, eq. 7",
-        lambda q, v0: _family(q["c"], 1, q["b"], 0, q["P"], -q["P"]),
+        name="bingham",
+        damping="b",
+        map_range=(100.0, 1000.0),
+        map_fixed={"P": 400.0},
+        shape=(1.0, 0.0),
+        equation="7",
+        formula="c x + b v + P sgn(v)",
+        parameters=("c", "b", "P"),
+        units=_UNITS,
+        reference=f"{_PAPER}, eq. 7",
+        coefficients=lambda q, v0: _family(q["c"], 1, q["b"], 0, q["P"], -q["P"]),
         split=True,
         dry=True,
     ),
     LawSpec(
-        "bingham_modified",
-        "8",
-        "c x + b1 x v + P sgn(v)",
-        ("c", "b1", "P"),
-        _UNITS,
-        f"{_PAPER}, eq. 8",
-        lambda q, v0: _family(q["c"], 1, q["b1"], 1, q["P"], -q["P"]),
+        name="bingham_modified",
+        damping="b1",
+        map_range=(1e4, 1e6),
+        map_fixed={"P": 400.0},
+        shape=(1.0, 1.0),
+        equation="8",
+        formula="c x + b1 x v + P sgn(v)",
+        parameters=("c", "b1", "P"),
+        units=_UNITS,
+        reference=f"{_PAPER}, eq. 8",
+        coefficients=lambda q, v0: _family(q["c"], 1, q["b1"], 1, q["P"], -q["P"]),
         split=True,
         dry=True,
     ),
     LawSpec(
-        "bingham_compression",
-        "9",
-        "c x + P while v > 0, c x after",
-        ("c", "P"),
-        _UNITS,
-        f"{_PAPER}, eq. 9",
-        lambda q, v0: _family(q["c"], 1, 0.0, 0, q["P"], 0.0),
+        name="bingham_compression",
+        damping="P",
+        map_range=(100.0, 2000.0),
+        shape=(1.0, 0.0),  # the dry force dissipates
+        equation="9",
+        formula="c x + P while v > 0, c x after",
+        parameters=("c", "P"),
+        units=_UNITS,
+        reference=f"{_PAPER}, eq. 9",
+        coefficients=lambda q, v0: _family(q["c"], 1, 0.0, 0, q["P"], 0.0),
         gap=1,
         split=True,
     ),
     LawSpec(
-        "maxwell",
-        "10-11",
-        "spring c in series with dashpot b: dF/dt = c (v - F/b)",
-        ("c", "b"),
-        {"c": "N/m", "b": "N s/m"},
-        f"{_PAPER}, eqs. 10-11",
-        None,
+        name="maxwell",
+        damping="b",
+        map_range=(3000.0, 20000.0),
+        restitution_table=True,  # Fig. 7: 4 b^2 > m c
+        equation="10-11",
+        formula="spring c in series with dashpot b: dF/dt = c (v - F/b)",
+        parameters=("c", "b"),
+        units={"c": "N/m", "b": "N s/m"},
+        reference=f"{_PAPER}, eqs. 10-11",
+        coefficients=None,
     ),
     LawSpec(
-        "hertz_viscous",
-        "12",
-        "c x^1.5 + b v",
-        ("c", "b"),
-        _UNITS,
-        f"{_PAPER}, eq. 12",
-        lambda q, v0: _family(q["c"], 1.5, q["b"], 0),
+        name="hertz_viscous",
+        damping="b",
+        map_range=(10.0, 200.0),
+        restitution_table=True,
+        equation="12",
+        formula="c x^1.5 + b v",
+        parameters=("c", "b"),
+        units=_UNITS,
+        reference=f"{_PAPER}, eq. 12",
+        coefficients=lambda q, v0: _family(q["c"], 1.5, q["b"], 0),
         gap=1.5,
         shape=(1.5, 0.0),
         one_group=True,
     ),
     LawSpec(
-        "hertz_modified",
-        "13",
-        "c x^1.5 + b x v",
-        ("c", "b"),
-        _UNITS,
-        f"{_PAPER}, eq. 13",
-        lambda q, v0: _family(q["c"], 1.5, q["b"], 1),
+        name="hertz_modified",
+        damping="b",
+        map_range=(5e3, 1e5),
+        restitution_table=True,
+        equation="13",
+        formula="c x^1.5 + b x v",
+        parameters=("c", "b"),
+        units=_UNITS,
+        reference=f"{_PAPER}, eq. 13",
+        coefficients=lambda q, v0: _family(q["c"], 1.5, q["b"], 1),
         gap=0.5,
         shape=(1.5, 1.0),
         one_group=True,
     ),
     LawSpec(
-        "hertz_rate",
-        "14",
-        "c x^1.5 + b1 x^0.5 v",
-        ("c", "b1"),
-        _UNITS,
-        f"{_PAPER}, eq. 14 (the paper's proposal; Kuwabara & Kono 1987)",
-        lambda q, v0: _family(q["c"], 1.5, q["b1"], 0.5),
+        name="hertz_rate",
+        damping="b1",
+        map_range=(200.0, 2000.0),
+        restitution_table=True,
+        equation="14",
+        formula="c x^1.5 + b1 x^0.5 v",
+        parameters=("c", "b1"),
+        units=_UNITS,
+        reference=f"{_PAPER}, eq. 14 (the paper's proposal; Kuwabara & Kono 1987)",
+        coefficients=lambda q, v0: _family(q["c"], 1.5, q["b1"], 0.5),
         gap=1,
         shape=(1.5, 0.5),
         one_group=True,
     ),
     LawSpec(
-        "hunt_crossley",
-        "15-16",
-        "c x^n (1 + 1.5 a v)",
-        ("c", "a", "n"),
-        _UNITS,
-        f"{_PAPER}, eqs. 15-16; Hunt & Crossley, J. Appl. Mech. 42 (1975) 440",
-        lambda q, v0: _family(q["c"], q["n"], 1.5 * q["a"] * q["c"], q["n"]),
+        name="hunt_crossley",
+        damping="a",
+        map_range=(0.02, 0.4),
+        restitution_table=True,
+        equation="15-16",
+        formula="c x^n (1 + 1.5 a v)",
+        parameters=("c", "a", "n"),
+        units=_UNITS,
+        reference=f"{_PAPER}, eqs. 15-16; Hunt & Crossley, J. Appl. Mech. 42 (1975) 440",
+        coefficients=lambda q, v0: _family(q["c"], q["n"], 1.5 * q["a"] * q["c"], q["n"]),
         gap="x",
         defaults={"n": 1.5},
         shape=("n", "n"),
@@ -211,13 +255,16 @@ def _nominal_spec(name, formula):
         return _family(q["c"], q["n"], damping * q["c"], q["n"])
 
     return LawSpec(
-        name,
-        "-",
-        f"c x^n (1 + D v), {formula.__doc__.split(':')[-1].strip().strip('`.')}",
-        ("c", "e_nominal", "n"),
-        _UNITS,
-        formula.__doc__.split(":")[0].strip(),
-        coefficients,
+        name=name,
+        damping="e_nominal",
+        map_range=(0.3, 0.99),
+        nominal=formula,
+        equation="-",
+        formula=f"c x^n (1 + D v), {formula.__doc__.split(':')[-1].strip().strip('`.')}",
+        parameters=("c", "e_nominal", "n"),
+        units=_UNITS,
+        reference=formula.__doc__.split(":")[0].strip(),
+        coefficients=coefficients,
         gap="x",
         defaults={"n": 1.5},
         shape=("n", "n"),
@@ -229,13 +276,16 @@ _SPECS += [_nominal_spec(name, formula) for name, formula in _hysteresis_damping
 
 _SPECS.append(
     LawSpec(
-        "power",
-        "-",
-        "c x^n + b x^p v",
-        ("c", "n", "b", "p"),
-        _UNITS,
-        "the family of eqs. 1, 6, 12-16 with the user's own exponents (0 <= p <= n)",
-        lambda q, v0: _family(q["c"], q["n"], q["b"], q["p"]),
+        name="power",
+        damping="b",
+        map_range=(200.0, 2000.0),
+        map_fixed={"n": 1.5, "p": 0.5},  # law 14's shape
+        equation="-",
+        formula="c x^n + b x^p v",
+        parameters=("c", "n", "b", "p"),
+        units=_UNITS,
+        reference="the family of eqs. 1, 6, 12-16 with the user's own exponents (0 <= p <= n)",
+        coefficients=lambda q, v0: _family(q["c"], q["n"], q["b"], q["p"]),
         gap="power",
         shape=("n", "p"),
         one_group=True,
@@ -255,27 +305,32 @@ def _log_damping(e):
 
 _SPECS += [
     LawSpec(
-        "tsuji",
-        "-",
-        "c x^1.5 + b x^0.25 v",
-        ("c", "b"),
-        _ENGINE_UNITS,
-        "Tsuji, Tanaka & Ishida, Powder Technol. 71 (1992) 239; LAMMPS pair granular "
+        name="tsuji",
+        damping="b",
+        map_range=(50.0, 1000.0),
+        equation="-",
+        formula="c x^1.5 + b x^0.25 v",
+        parameters=("c", "b"),
+        units=_ENGINE_UNITS,
+        reference="Tsuji, Tanaka & Ishida, Powder Technol. 71 (1992) 239; LAMMPS pair granular "
         "hertz/material with damping coeff_restitution or tsuji, LIGGGHTS, Chrono SMC Hertz",
-        lambda q, v0: _family(q["c"], 1.5, q["b"], 0.25),
+        coefficients=lambda q, v0: _family(q["c"], 1.5, q["b"], 0.25),
         gap=1.25,
         one_group=True,
         shape=(1.5, 0.25),
     ),
     LawSpec(
-        "tsuji_restitution",
-        "-",
-        "c x^1.5 + b x^0.25 v, b = sqrt(5) (-ln e) / sqrt(pi^2 + ln^2 e) sqrt(m_eff c)",
-        ("c", "e_nominal", "m_eff"),
-        _ENGINE_UNITS,
-        "LAMMPS pair granular, damping coeff_restitution (src/GRANULAR/"
+        name="tsuji_restitution",
+        damping="e_nominal",
+        map_range=(0.3, 0.99),
+        map_fixed={"m_eff": 1.0},
+        equation="-",
+        formula="c x^1.5 + b x^0.25 v, b = sqrt(5) (-ln e) / sqrt(pi^2 + ln^2 e) sqrt(m_eff c)",
+        parameters=("c", "e_nominal", "m_eff"),
+        units=_ENGINE_UNITS,
+        reference="LAMMPS pair granular, damping coeff_restitution (src/GRANULAR/"
         "gran_sub_mod_damping.cpp); LIGGGHTS model hertz; Chrono ChContactSMC Hertz",
-        lambda q, v0: _family(
+        coefficients=lambda q, v0: _family(
             q["c"],
             1.5,
             jnp.sqrt(5.0) * _log_damping(q["e_nominal"]) * jnp.sqrt(q["m_eff"] * q["c"]),
@@ -286,14 +341,17 @@ _SPECS += [
         shape=(1.5, 0.25),
     ),
     LawSpec(
-        "spring_dashpot_restitution",
-        "-",
-        "c x + b v, b = 2 (-ln e) / sqrt(pi^2 + ln^2 e) sqrt(m_eff c)",
-        ("c", "e_nominal", "m_eff"),
-        _ENGINE_UNITS,
-        "LAMMPS pair granular hooke, damping coeff_restitution; a MuJoCo dampratio set "
+        name="spring_dashpot_restitution",
+        damping="e_nominal",
+        map_range=(0.3, 0.99),
+        map_fixed={"m_eff": 1.0},
+        equation="-",
+        formula="c x + b v, b = 2 (-ln e) / sqrt(pi^2 + ln^2 e) sqrt(m_eff c)",
+        parameters=("c", "e_nominal", "m_eff"),
+        units=_ENGINE_UNITS,
+        reference="LAMMPS pair granular hooke, damping coeff_restitution; a MuJoCo dampratio set "
         "from e the same way; exact under separation='penetration' only",
-        lambda q, v0: _family(
+        coefficients=lambda q, v0: _family(
             q["c"], 1, 2.0 * _log_damping(q["e_nominal"]) * jnp.sqrt(q["m_eff"] * q["c"]), 0
         ),
         gap=1,
@@ -301,14 +359,16 @@ _SPECS += [
         shape=(1.0, 0.0),
     ),
     LawSpec(
-        "point_contact",
-        "-",
-        "c x (1 + d v)",
-        ("c", "d"),
-        _ENGINE_UNITS,
-        "Drake MultibodyPlant point contact (point_contact_stiffness c, "
+        name="point_contact",
+        damping="d",
+        map_range=(0.02, 0.4),
+        equation="-",
+        formula="c x (1 + d v)",
+        parameters=("c", "d"),
+        units=_ENGINE_UNITS,
+        reference="Drake MultibodyPlant point contact (point_contact_stiffness c, "
         "hunt_crossley_dissipation d); Hunt & Crossley with n = 1",
-        lambda q, v0: _family(q["c"], 1, q["c"] * q["d"], 1),
+        coefficients=lambda q, v0: _family(q["c"], 1, q["c"] * q["d"], 1),
         gap="x",
         one_group=True,
         shape=(1.0, 1.0),
@@ -459,6 +519,25 @@ def shape_of(law) -> tuple[float, float] | None:
         return tuple(float(law.params[q]) if isinstance(q, str) else float(q) for q in spec.shape)
     except (TypeError, jax.errors.ConcretizationTypeError, jax.errors.TracerArrayConversionError):
         return None
+
+
+_DAMPING_NAMES = ("b", "b1", "a", "d", "e_nominal", "P")
+
+
+def damping_parameter(law) -> str | None:
+    """The parameter that sets a law's (or a row's) dissipation: the row's `damping`; for a
+    user's own law, the first of b, b1, a, d, e_nominal, P that it has (None: none)."""
+    spec = law if isinstance(law, LawSpec) else getattr(law, "spec", None)
+    if spec is not None and spec.damping is not None:
+        return spec.damping
+    return next((k for k in _DAMPING_NAMES if k in law.parameters), None)
+
+
+def exponents(spec, params=None) -> tuple[float, float]:
+    """The exponents `(n, p)` of a family law's row, a name read from `params` (else the
+    row's defaults, else law 14's 1.5 and 0.5)."""
+    params = {**{"n": 1.5, "p": 0.5}, **spec.defaults, **(params or {})}
+    return tuple(float(params[q]) if isinstance(q, str) else float(q) for q in spec.shape)
 
 
 def _as_arrays(params, numbers=()):

@@ -23,10 +23,10 @@ import optax
 from jaxtyping import Array
 
 from .._batch.batch import _build_law, _cost_key, prepare_rows, run_batch
-from .._laws.law import law as make_law
+from .._laws.law import LAWS, law as make_law
 from .._solve.impact import impact
 from .._status import Status
-from .maps import C_RANGE, MAP_DEFAULTS, _axis
+from .maps import C_RANGE, _axis
 
 # ----------------------------------------------------------------------------- bumper
 
@@ -322,14 +322,16 @@ def sensitivity_map(
     **batch_options,
 ) -> SensitivityMap:
     """`de/dc`, `de/d(damping)`, `dT/dc`, `dT/d(damping)` of `law_name` over the grid
-    `damping x c`; the grid's defaults are those of `restitution_map` (`MAP_DEFAULTS`).
+    `damping x c`; the grid's defaults are those of `restitution_map` (the law's row:
+    `damping`, `map_range`, `map_fixed`).
 
     **Example**: `s = sensitivity_map("hertz_rate"); s.elasticity("e", "damping")`.
     """
-    damping_name, default_range, default_fixed = MAP_DEFAULTS[law_name]
-    fixed = dict(default_fixed if fixed is None else fixed)
+    spec = LAWS[law_name]
+    damping_name = spec.damping
+    fixed = dict(spec.map_fixed if fixed is None else fixed)
     c = _axis(c, C_RANGE, num, log=True)
-    damping = _axis(damping, default_range, num, log=False)
+    damping = _axis(damping, spec.map_range, num, log=False)
     d_grid, c_grid = np.meshgrid(damping, c, indexing="ij")
     params = {**fixed, "c": c_grid.ravel(), damping_name: d_grid.ravel()}
     out = jacobian_batch(

@@ -9,32 +9,12 @@ c from 2e6 to 2e7 N/m, b from 200 to 1000 N s/m) and for Maxwell (its Fig. 7);
 import equinox as eqx
 import numpy as np
 
-from .._batch.batch import impact_batch
-from .._laws import closed_forms as _closed_forms, hunt_crossley_variants as _hysteresis_damping
-from .._laws.law import LAW_NAMES, LAWS
+from .._batch.batch import batch_path, impact_batch
+from .._laws.closed_forms import exact_batch
+from .._laws.law import LAW_NAMES, LAWS, law
 from .._status import Status
 
-# law -> (damping parameter, its default range, other parameters held fixed); the ranges hold
-# the seed paper's parameter set (m = 1 kg, v0 = 2.5 m/s, c = 2e6) inside, and reach from
-# light to heavy damping over c from 2e6 to 2e7 (N/m^n).
-MAP_DEFAULTS = {
-    "kelvin_voigt": ("b", (200.0, 1000.0), {}),  # the paper's Fig. 1
-    "kelvin_voigt_modified": ("b1", (5e4, 1e6), {}),
-    "bingham": ("b", (100.0, 1000.0), {"P": 400.0}),
-    "bingham_modified": ("b1", (1e4, 1e6), {"P": 400.0}),
-    "bingham_compression": ("P", (100.0, 2000.0), {}),  # no damping: the dry force dissipates
-    "maxwell": ("b", (3000.0, 20000.0), {}),  # the paper's Fig. 7 (under-damped: 4 b^2 > m c)
-    "hertz_viscous": ("b", (10.0, 200.0), {}),
-    "hertz_modified": ("b", (5e3, 1e5), {}),
-    "hertz_rate": ("b1", (200.0, 2000.0), {}),
-    "hunt_crossley": ("a", (0.02, 0.4), {}),
-    **{name: ("e_nominal", (0.3, 0.99), {}) for name in _hysteresis_damping.FORMULAS},
-    "power": ("b", (200.0, 2000.0), {"n": 1.5, "p": 0.5}),  # law 14's shape
-    "tsuji": ("b", (50.0, 1000.0), {}),
-    "tsuji_restitution": ("e_nominal", (0.3, 0.99), {"m_eff": 1.0}),
-    "spring_dashpot_restitution": ("e_nominal", (0.3, 0.99), {"m_eff": 1.0}),
-    "point_contact": ("d", (0.02, 0.4), {}),
-}
+# the stiffness axis of every map (N/m^n); the damping axis is the law's row's `map_range`
 C_RANGE = (2e6, 2e7)
 
 
@@ -93,11 +73,13 @@ def restitution_map(
 
     - `c`: stiffnesses (N/m^n, 1-D); default `num` values log-spaced over 2e6 to 2e7.
     - `damping`: values of the law's damping parameter (1-D); default `num` values over the
-      range of `MAP_DEFAULTS` (for Kelvin-Voigt 200 to 1000 N s/m, the paper's Fig. 1).
-    - `damping_name`: which parameter varies along `damping` (default: `MAP_DEFAULTS`, e.g.
+      range of the law's row, `LAWS[name].map_range` (for Kelvin-Voigt 200 to 1000 N s/m,
+      the paper's Fig. 1).
+    - `damping_name`: which parameter varies along `damping` (default: the row's `damping`,
+      e.g.
       `b` for Kelvin-Voigt, `b1` for law 14, `a` for Hunt-Crossley, `P` for eq. 9,
       `e_nominal` for the published Hunt-Crossley variants).
-    - `fixed`: the law's other parameters (default: `MAP_DEFAULTS`, e.g. `P = 400 N` for
+    - `fixed`: the law's other parameters (default: the row's `map_fixed`, e.g. `P = 400 N` for
       Bingham); `m` (kg), `v0` (m/s), `separation` as in `impact`.
     - `method`: `"auto"` takes an exact closed form where it holds on the whole grid
       (Kelvin-Voigt; Maxwell when every point is under-damped, `4 b^2 > m c`, under the
@@ -114,10 +96,9 @@ def restitution_map(
     """
     if law_name not in LAWS:
         raise ValueError(f"unknown law {law_name!r}; choose one of: {', '.join(LAW_NAMES)}")
-    default_name, default_range, default_fixed = MAP_DEFAULTS[law_name]
-    damping_name = default_name if damping_name is None else damping_name
-    fixed = dict(default_fixed if fixed is None else fixed)
     spec = LAWS[law_name]
+    damping_name = spec.damping if damping_name is None else damping_name
+    fixed = dict(spec.map_fixed if fixed is None else fixed)
     if damping_name not in spec.parameters or damping_name == "c":
         raise ValueError(
             f"law {law_name!r} has no damping parameter {damping_name!r}; "
@@ -126,29 +107,22 @@ def restitution_map(
     if {"c", damping_name} & set(fixed):
         raise ValueError("fixed must not hold c or the damping parameter: they are the grid")
     c = _axis(c, C_RANGE, num, log=True)
-    damping = _axis(damping, default_range, num, log=False)
+    damping = _axis(damping, spec.map_range, num, log=False)
     m, v0 = float(m), float(v0)
 
     damping_grid, c_grid = np.meshgrid(damping, c, indexing="ij")
     flat = {"c": c_grid.ravel(), damping_name: damping_grid.ravel()}
     params = {**fixed, **flat}
     name = law_name
-    if law_name in _hysteresis_damping.FORMULAS and damping_name == "e_nominal":
+    if spec.nominal is not None and damping_name == "e_nominal":
         # the same equation as hunt_crossley, with a = D / 1.5: one compiled solve for all
-        factor = _hysteresis_damping.FORMULAS[law_name](params.pop("e_nominal"), v0)
+        factor = spec.nominal(params.pop("e_nominal"), v0)
         params["a"] = np.asarray(factor, dtype=float) / 1.5
         name = "hunt_crossley"
 
-    if (
-        method == "auto"
-        and law_name == "maxwell"
-        and separation == "force"
-        and np.all(4.0 * params["b"] ** 2 > m * params["c"])
-    ):
-        out = _closed_forms.maxwell(params["c"], params["b"], m, v0)
-        out = {k: np.asarray(out[k]) for k in ("e", "T", "status")}
-        path = "closed_form"
-    else:
+    out = exact_batch(name, params, m=m, v0=v0, separation=separation) if method == "auto" else None
+    path = "closed_form"
+    if out is None:
         out = impact_batch(
             name,
             params,
@@ -162,7 +136,8 @@ def restitution_map(
             progress=progress,
             **batch_options,
         )
-        path = "closed_form" if name == "kelvin_voigt" and method == "auto" else "integrated"
+        first = law(name, **{k: np.asarray(v).ravel()[0] for k, v in params.items()})
+        path = batch_path(first, separation, method=method, rtol=rtol, **batch_options)
     shape = damping_grid.shape
     return RestitutionMap(
         law=law_name,
