@@ -28,13 +28,13 @@ if os.path.basename(sys.argv[0]) == "jaximpact":
 # force laws, one impact, one drop, fitting, many impacts, studies, figures, the paper
 _PUBLIC = {
     # force laws
-    "LAW_NAMES": "_laws.law",
-    "LAWS": "_laws.law",
-    "AbstractLaw": "_laws.law",
-    "CustomLaw": "_laws.law",
-    "Law": "_laws.law",
-    "custom_law": "_laws.law",
-    "law": "_laws.law",
+    "LAW_NAMES": "_laws",
+    "LAWS": "_laws",
+    "AbstractLaw": "_laws",
+    "CustomLaw": "_laws",
+    "Law": "_laws",
+    "custom_law": "_laws",
+    "law": "_laws",
     "safe_pow": "_powers",
     # one impact
     "ImpactResult": "_solve.results",
@@ -47,12 +47,12 @@ _PUBLIC = {
     # fitting
     "Fit": "_fit.calibrate",
     "calibrate": "_fit.calibrate",
-    "BounceFit": "_fit.fit_bounces",
+    "BounceFit": "_fit.bounce_fit",
     "fit_bounces": "_fit.fit_bounces",
     "compare_laws": "_fit.model_choice",
-    "clean_impact_times": "_fit.fit_bounces",
-    "interval_restitution": "_fit.fit_bounces",
-    "read_recording": "_cli.fit",
+    "clean_impact_times": "_fit.impact_times",
+    "interval_restitution": "_fit.impact_times",
+    "read_recording": "_fit.recordings",
     "starting_law": "_fit.model_choice",
     # many impacts
     "impact_batch": "_batch.batch",

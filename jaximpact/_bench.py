@@ -277,7 +277,7 @@ def loosest_scipy(name, params, *, threshold=TARGET_ERROR, e_ref, m=M, v0=V0):
 def _solve_function(name, method):
     """`solve(params, v0) -> (e, T)` of jaximpact's `impact` with every default but `method`
     (the parameters are arguments, so XLA cannot fold a closed form into a constant)."""
-    from ._laws.law import law
+    from ._laws import law
     from ._solve.impact import impact
 
     def solve(params, v0):
@@ -295,7 +295,7 @@ def bench_case(case: str, *, batch: int = 1000, rounds: int = 5, min_round_s: fl
     import jax
     import jax.numpy as jnp
 
-    from ._laws.law import law
+    from ._laws import law
     from ._solve.impact import impact
 
     name, params, method = CASES[case]
@@ -369,7 +369,7 @@ def euler_row(name: str = EULER_LAW, dt: float = EULER_DT) -> dict:
     fixed step `dt` (s) for one impact of `CASES[name]` at v0 from first touch, against
     scipy DOP853 at 1e-13 under the same end of contact (x back to 0, as the paper's
     scheme has it), with the seconds per impact of the (compiled) call."""
-    from ._laws.law import law
+    from ._laws import law
     from ._solve.euler import euler_bounce
 
     _, params, _ = next(c for c in CASES.values() if c[0] == name)

@@ -15,7 +15,7 @@ import pytest
 from helpers import run_cli
 
 import jaximpact as ji
-from jaximpact._fit.fit_bounces import clean_impact_times, fit_bounces, interval_restitution
+from jaximpact import clean_impact_times, fit_bounces, interval_restitution
 from jaximpact._solve.bounce import bounce
 
 GOLF_M = 0.0415  # kg

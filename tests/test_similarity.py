@@ -19,7 +19,7 @@ from jaximpact._curves.check import scipy_impact
 from jaximpact._curves.curve import Curves
 from jaximpact._curves.shapes import curve_key
 from jaximpact._curves.similarity import beta_for_restitution, curve_values
-from jaximpact._laws.law import shape_of
+from jaximpact._laws import shape_of
 
 M, V0 = 1.0, 2.5
 # one law per shipped shape, with its damping parameter and a value giving beta ~ 1

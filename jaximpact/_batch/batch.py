@@ -41,8 +41,8 @@ import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec, SingleDeviceSharding
 
 from .._checks import check_nonnegative, check_positive
+from .._laws import LAW_NAMES, LAWS, CustomLaw, Law, custom_law, law as make_law
 from .._laws.closed_forms import closed_form_for
-from .._laws.law import LAW_NAMES, LAWS, CustomLaw, Law, custom_law, law as make_law
 from .._progress import Progress
 from .._solve.impact import CURVES_RTOL, impact, similarity_reason
 

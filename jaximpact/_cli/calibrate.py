@@ -328,7 +328,7 @@ def _run_one(args, data):
     from .._fit.calibrate import calibrate
     from .._fit.model_choice import starting_law
     from .._fit.parameters import default_free
-    from .._laws.law import LAW_NAMES, LAWS
+    from .._laws import LAW_NAMES, LAWS
 
     if args.law not in LAWS:
         raise CLIError(f"unknown law {args.law!r}; choose one of: {', '.join(LAW_NAMES)}, or {ALL}")
@@ -370,7 +370,7 @@ def _run_one(args, data):
 def _fit_record(name, fit, data):
     import numpy as np
 
-    from .._laws.law import LAWS
+    from .._laws import LAWS
 
     rows = []
     for i in range(data["rows"]):
@@ -463,7 +463,7 @@ MODEL_CHOICE_LAWS: tuple[str, ...] | None = None
 
 
 def _law_line(name):
-    from .._laws.law import LAWS
+    from .._laws import LAWS
 
     spec = LAWS[name]
     eq = f"eq. {spec.equation}: " if spec.equation != "-" else ""
@@ -471,7 +471,7 @@ def _law_line(name):
 
 
 def _units(name, params):
-    from .._laws.law import LAWS
+    from .._laws import LAWS
 
     return concrete_units(LAWS[name], params)
 

@@ -155,7 +155,7 @@ def free_names(items) -> tuple[str, ...] | None:
 
 def law_from_args(args):
     """The law of `--law` and `--param` (the library checks the name and the values)."""
-    from .._laws.law import law
+    from .._laws import law
 
     return law(args.law, **parse_params(args.param))
 

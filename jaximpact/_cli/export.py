@@ -62,7 +62,7 @@ def _run_export(args):
         raise CLIError("LAMMPS needs --radius (m) of the two spheres")
     source = None
     if args.law is not None:
-        from .._laws.law import law
+        from .._laws import law
 
         source = law(args.law, **parse_params(args.param))
     x = export(

@@ -11,11 +11,10 @@ Formats read (detected from the file unless `--format` says):
 - plain numbers: two columns are `t y`, one column is impact times.
 """
 
-import csv
-import io
 import math
 from pathlib import Path
 
+from .._fit.recordings import parse_number, read_recording
 from .._format import format_number
 from .._plotting import new_figure, save_figure
 from .common import (
@@ -30,10 +29,6 @@ from .common import (
 )
 
 FORMATS = ("auto", "trajectory", "impacts")
-_TIME_NAMES = ("t", "time", "time_s", "t_s", "times", "seconds", "frame")
-_IMPACT_NAMES = ("event_time_s", "impact_time", "impact_times", "impact_time_s", "event_time")
-_HEIGHT_NAMES = ("y", "height", "h", "z", "y_m", "height_m", "position", "y1")
-_IGNORED = ("impact_index", "index", "n")
 
 
 def add_fit(subparsers):
@@ -132,149 +127,6 @@ def add_fit(subparsers):
 # ----------------------------------------------------------------------------- reading
 
 
-class Recording:
-    """What a file held: `kind` ("trajectory" or "impacts"), and per group of rows (drop)
-    either `(t, y)` or the impact times; `video`: a pixel track (y down, scale unknown)."""
-
-    def __init__(self, kind, groups, video=False, columns=()):
-        self.kind, self.groups, self.video, self.columns = kind, groups, video, columns
-
-
-def _number(text):
-    try:
-        value = float(text)
-    except ValueError:
-        return None
-    return value if math.isfinite(value) else None
-
-
-def _read_mtrack(lines):
-    times, heights = [], []
-    for line in lines[1:]:
-        if line.lstrip().startswith("Track ") and times:
-            break  # the summary table MTrack2 appends ("Track Length Distance ...")
-        parts = line.replace(",", " ").split()
-        values = [_number(p) for p in parts[:3]]
-        if len(values) < 3 or any(v is None for v in values):
-            continue  # "Tracks 1 to 2" and the like
-        times.append(values[0])
-        heights.append(values[2])
-    if len(times) < 8:
-        raise CLIError("the MTrack2 file has fewer than 8 tracked frames")
-    return Recording("trajectory", {"track 1": (times, heights)}, video=True)
-
-
-def _read_plain(lines):
-    rows = []
-    for line in lines:
-        parts = line.replace(",", " ").split()
-        if not parts:
-            continue
-        values = [_number(p) for p in parts]
-        if any(v is None for v in values):
-            raise CLIError(f"cannot read {line.strip()!r} as numbers (a header needs names)")
-        rows.append(values)
-    widths = {len(r) for r in rows}
-    if len(widths) != 1 or not rows:
-        raise CLIError("every line must have the same number of columns")
-    width = widths.pop()
-    if width == 1:
-        return Recording("impacts", {"all": [r[0] for r in rows]})
-    if width == 2:
-        return Recording("trajectory", {"all": ([r[0] for r in rows], [r[1] for r in rows])})
-    raise CLIError(f"{width} unnamed columns: give the file a header (t, y) or (impact_time)")
-
-
-def _pick(columns, names):
-    lowered = {c.strip().lower(): c for c in columns}
-    for name in names:
-        if name in lowered:
-            return lowered[name]
-    return None
-
-
-def _read_csv(text, where, fmt):
-    reader = csv.DictReader(io.StringIO(text))
-    columns = reader.fieldnames or []
-    rows = list(reader)
-    for condition in where:
-        column, sep, value = condition.partition("=")
-        if not sep or column not in columns:
-            raise CLIError(
-                f"--where {condition!r}: need COLUMN=VALUE with COLUMN one of {', '.join(columns)}"
-            )
-        rows = [r for r in rows if r[column].strip() == value.strip()]
-    if not rows:
-        raise CLIError("no rows left after --where")
-    impact_column = _pick(columns, _IMPACT_NAMES)
-    time_column = _pick(columns, _TIME_NAMES)
-    height_column = _pick(columns, _HEIGHT_NAMES)
-    kind = fmt
-    if kind == "auto":
-        kind = "trajectory" if time_column and height_column and not impact_column else "impacts"
-    if kind == "trajectory":
-        if not (time_column and height_column):
-            raise CLIError(
-                f"a trajectory needs a time column ({', '.join(_TIME_NAMES)}) and a height "
-                f"column ({', '.join(_HEIGHT_NAMES)}); the file has {', '.join(columns)}"
-            )
-        used = {time_column, height_column}
-    else:
-        impact_column = impact_column or time_column
-        if impact_column is None:
-            raise CLIError(
-                "impact times need a column named one of "
-                f"{', '.join(_IMPACT_NAMES + _TIME_NAMES)}; the file has {', '.join(columns)}"
-            )
-        used = {impact_column}
-    group_by = [c for c in columns if c not in used and c.strip().lower() not in _IGNORED]
-    groups: dict = {}
-    for row in rows:
-        key = ", ".join(f"{c}={row[c]}" for c in group_by if c != "source_file") or "all"
-        groups.setdefault(key, []).append(row)
-
-    def numbers(group, column):
-        values = [_number(r[column]) for r in group]
-        if any(v is None for v in values):
-            raise CLIError(f"column {column!r} has a value that is not a number")
-        return values
-
-    if kind == "trajectory":
-        data = {k: (numbers(g, time_column), numbers(g, height_column)) for k, g in groups.items()}
-    else:
-        data = {k: numbers(g, impact_column) for k, g in groups.items()}
-    return Recording(kind, data, columns=tuple(columns))
-
-
-def read_recording(path: Path, fmt: str = "auto", where=()) -> Recording:
-    """Read FILE (see the module docstring); a `CLIError` for anything it cannot use."""
-    try:
-        text = path.read_text()
-    except OSError as error:
-        raise CLIError(f"cannot read {path}: {error.strerror or error}") from None
-    except UnicodeDecodeError:
-        raise CLIError(f"{path} is not a text file") from None
-    lines = [line for line in text.splitlines() if line.strip()]
-    if not lines:
-        raise CLIError(f"{path} is empty")
-    head = lines[0].replace(",", " ").split()
-    if head[:1] == ["Frame"] and "Y1" in head:
-        if fmt == "impacts":
-            raise CLIError(f"{path} is a video track (MTrack2), not impact times")
-        if where:
-            raise CLIError("--where applies to CSV files with named columns")
-        return _read_mtrack(lines)
-    if all(_number(p) is not None for p in head):
-        recording = _read_plain(lines)
-        if where:
-            raise CLIError("--where applies to CSV files with named columns")
-    else:
-        recording = _read_csv(text, where, fmt)
-    if fmt != "auto" and recording.kind != fmt:
-        raise CLIError(f"{path} holds {recording.kind}, not {fmt}")
-    return recording
-
-
 # ----------------------------------------------------------------------------- fitting
 
 
@@ -284,7 +136,7 @@ def _options(args, recording):
     elif args.length_scale == "fit":
         length_scale = "fit"
     else:
-        length_scale = _number(args.length_scale)
+        length_scale = parse_number(args.length_scale)
         if length_scale is None or length_scale <= 0:
             raise CLIError(
                 f"--length-scale must be a number > 0 or 'fit', got {args.length_scale!r}"

@@ -50,7 +50,7 @@ def concrete_units(spec, params: dict | None = None) -> dict[str, str]:
 
 
 def _law_rows():
-    from .._laws.law import LAWS
+    from .._laws import LAWS
 
     rows = []
     for spec in LAWS.values():

@@ -91,7 +91,7 @@ def _run_simulate(args):
 
 
 def _simulate_text(law, data) -> str:
-    from .._laws.law import LAWS
+    from .._laws import LAWS
 
     spec = LAWS.get(law.name)
     units = concrete_units(spec, data["params"]) if spec is not None else {}

@@ -12,7 +12,7 @@ from jaxtyping import Array
 from .._curves.shapes import curve_key
 from .._curves.similarity import beta_for_restitution, curve_values
 from .._curves.store import curves_for
-from .._laws.law import AbstractLaw, damping_parameter, shape_of
+from .._laws import AbstractLaw, damping_parameter, shape_of
 from .._solve.impact import CURVES_RTOL, ImpactOptions, similarity_reason, solve_impact
 from .._status import Status
 from .forward_jacobian import value_and_jacobian, with_forward_jacobian

@@ -7,7 +7,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax.scipy.special import gammaln
 
-from .._laws.law import LAWS, exponents, law
+from .._laws import LAWS, exponents, law
 from .._progress import Progress
 from .calibrate import Fit, calibrate
 from .parameters import default_free

@@ -6,7 +6,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
-from .._laws.law import damping_parameter
+from .._laws import damping_parameter
 
 
 def to_unbounded(name: str, value):

@@ -16,7 +16,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._laws.law import LAWS, Law
+from .._laws import LAWS, Law
 from .._solve.impact import impact
 from .._status import Status
 

@@ -1,2 +1,13 @@
 """What a contact is: the force laws, their table of per-law facts, their dynamics and exact
 solutions. The bottom layer: imports nothing of jaximpact but the leaf helpers."""
+
+from .base import (
+    AbstractLaw as AbstractLaw,
+    LawSpec as LawSpec,
+    damping_parameter as damping_parameter,
+    exponents as exponents,
+    shape_of as shape_of,
+)
+from .custom import CustomLaw as CustomLaw, custom_law as custom_law
+from .named_law import Law as Law, law as law
+from .table import LAW_NAMES as LAW_NAMES, LAWS as LAWS

@@ -106,7 +106,7 @@ def _euler_impact(law, scheme: str):
 def _loop_row(case: PaperCase, with_history: bool) -> dict:
     """Printed, Euler and converged `e` and `T` of one single-impact case, and the histories
     for its figure (the converged one only `with_history`)."""
-    from .._laws.law import law as make_law
+    from .._laws import law as make_law
     from .._solve.impact import impact
 
     law = make_law(case.law, **case.params)
@@ -184,7 +184,7 @@ def _plot_loop(row, law, histories, path: Path):
 
 def _bounce_row(case: PaperCase) -> tuple[dict, dict]:
     """First-contact `e` and `T` of a section-7 drop: printed, Euler, converged."""
-    from .._laws.law import law as make_law
+    from .._laws import law as make_law
     from .._solve.bounce import bounce
     from .._solve.euler import euler_bounce
 
@@ -390,9 +390,8 @@ def hunt_crossley_variants_markdown(nominal=HC_NOMINAL, *, check: bool = True) -
     so each row holds for every `c`, `n`, `m` and `v0`; `check` also integrates three
     formulas at three nominal values and states the largest difference.
     """
-    from .._laws import hunt_crossley_variants as _hysteresis_damping
+    from .._laws import hunt_crossley_variants as _hysteresis_damping, law as make_law
     from .._laws.closed_forms import hunt_crossley_restitution
-    from .._laws.law import law as make_law
     from .._solve.impact import impact
 
     names = list(_hysteresis_damping.FORMULAS)

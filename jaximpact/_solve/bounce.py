@@ -1,8 +1,8 @@
 """A ball dropped on a floor: free flights in closed form, one impact solve per contact.
 
 The seed paper's system (17) (Polukoshko et al. 2007, section 7) integrates the whole motion,
-flight and contact, with explicit Euler at a fixed step (`jaximpact._solve.euler`). Here the free
-flight is a parabola (or, with quadratic air drag, its closed form: `jaximpact._solve.flight`), never
+flight and contact, with explicit Euler at a fixed step (`_solve.euler`). Here the free flight
+is a parabola (or, with quadratic air drag, its closed form: `_solve.flight`), never
 integrated, and each contact is one event-terminated impact solve with gravity inside it (the
 same solve as `jaximpact.impact(..., g=g)`). The contacts run in a `lax.scan` of static
 length `max_impacts`; contacts after the end are masked, so the whole drop is one compiled
@@ -20,7 +20,7 @@ import numpy as np
 from jaxtyping import Array
 
 from .._checks import check_nonnegative, check_positive, check_values
-from .._laws.law import AbstractLaw
+from .._laws import AbstractLaw
 from .._status import Status
 from .adjoint import auto_adjoint
 from .flight import Flight
@@ -85,7 +85,7 @@ def _contact(law, m, v_in, g, ts_local, options: ImpactOptions):
     return result, x_end
 
 
-def _chain(law, m, g, drag, start, t_end, min_flight, ts, options: BounceOptions):
+def chain(law, m, g, drag, start, t_end, min_flight, ts, options: BounceOptions):
     """The scan over contacts. `start = (t0, y0, u0)`: the first flight's state (s, m, m/s,
     upward velocity). Returns the per-contact records (unmasked: a record whose `valid` is
     False comes from a dummy solve at unit speed and must not be used), the first flight,
@@ -252,7 +252,7 @@ class BounceResult(eqx.Module):
 
 @eqx.filter_jit
 def _histories(result: BounceResult, ts):
-    records, flight0, carry = _chain(
+    records, flight0, carry = chain(
         result.law,
         result.m,
         result.g,
@@ -302,8 +302,8 @@ def trajectory_from_records(records, flight0, carry, ts, m, g, drag):
 
 
 @eqx.filter_jit
-def _solve_bounce(law, m, g, drag, start, t_end, min_flight, options: BounceOptions):
-    records, flight0, carry = _chain(law, m, g, drag, start, t_end, min_flight, None, options)
+def solve_bounce(law, m, g, drag, start, t_end, min_flight, options: BounceOptions):
+    records, flight0, carry = chain(law, m, g, drag, start, t_end, min_flight, None, options)
     valid = records["valid"]
     num = jnp.sum(valid)
     code, t_rest = carry[4], carry[5]
@@ -544,7 +544,7 @@ def bounce(
         peaks=peaks,
     )
     start = (jnp.zeros(()), h0, -v_drop)
-    result = _solve_bounce(law, m, g, drag, start, t_end, min_flight, options)
+    result = solve_bounce(law, m, g, drag, start, t_end, min_flight, options)
     if throw:
         result = eqx.error_if(
             result,

@@ -26,7 +26,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._checks import check_nonnegative, check_positive
-from .._laws.law import AbstractLaw
+from .._laws import AbstractLaw
 
 SCHEMES = ("paper", "euler")
 

@@ -7,7 +7,7 @@ import jax.numpy as jnp
 from .._checks import check_nonnegative, check_positive
 from .._curves.shapes import CurveKey, curve_key
 from .._curves.similarity import serves, similarity_fields
-from .._laws.law import AbstractLaw, shape_of
+from .._laws import AbstractLaw, shape_of
 from .._status import Status
 from .precision import resolvable_tolerances
 from .results import ImpactResult

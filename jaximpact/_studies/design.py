@@ -23,7 +23,8 @@ import optax
 from jaxtyping import Array
 
 from .._batch.batch import _build_law, _cost_key, prepare_rows, run_batch
-from .._laws.law import LAWS, law as make_law
+from .._fit.least_squares import levenberg_marquardt
+from .._laws import LAWS, law as make_law
 from .._solve.impact import impact
 from .._status import Status
 from .maps import C_RANGE, _axis
@@ -530,7 +531,8 @@ class DropDesign(eqx.Module):
     - `h0` (m), `m` (kg): the drop height and mass found.
     - `target`, `apexes` (m): the wanted and the achieved apex heights after each contact.
     - `residuals`: `ln(apexes / target)`; `loss`: half their sum of squares.
-    - `converged`: the relative step and the gradient fell below `tol`.
+    - `converged`: the scaled gradient, the relative decrease or the step fell below `tol`
+      (`_fit.least_squares`).
     - `iterations`; `history`: the loss at each accepted iterate.
     """
 
@@ -598,55 +600,28 @@ def drop_design(
     if not (h0_guess > target[0] and m_guess > 0):
         raise ValueError("h0_guess must be above the first apex and m_guess > 0")
     count = int(target.size)
-    theta = jnp.log(jnp.array([h0_guess, m_guess], dtype=float))
-    evaluate = functools.partial(
+    apex_residuals = functools.partial(
         _apex_residuals, law=law, target=jnp.asarray(target), g=float(g), count=count, rtol=rtol
     )
 
-    def loss_of(r):
-        return 0.5 * float(np.sum(np.asarray(r) ** 2))
+    def evaluate(theta):
+        return tuple(np.asarray(out) for out in apex_residuals(jnp.asarray(theta)))
 
-    r, jac, achieved = evaluate(theta)
-    if not np.all(np.isfinite(np.asarray(r))):
+    theta0 = np.log([h0_guess, m_guess])
+    fit = levenberg_marquardt(evaluate, theta0, max_iter=max_iterations, tol=tol)
+    if not np.all(np.isfinite(fit.residuals)):
         raise ValueError(
             f"the starting guess (h0 = {h0_guess} m, m = {m_guess} kg) does not give {count} "
             "bounces: start higher or heavier"
         )
-    loss, damping, converged = loss_of(r), 1e-3, False
-    history = [loss]
-    iterations = 0
-    while iterations < max_iterations:
-        iterations += 1
-        J, res = np.asarray(jac), np.asarray(r)
-        gradient = J.T @ res
-        if np.max(np.abs(gradient)) < tol:
-            converged = True
-            break
-        normal, accepted = J.T @ J, False
-        while damping < 1e12:
-            step = -np.linalg.solve(normal + damping * np.diag(np.diag(normal)), gradient)
-            r_new, jac_new, achieved_new = evaluate(theta + step)
-            loss_new = loss_of(r_new)
-            if np.isfinite(loss_new) and loss_new < loss:
-                theta, r, jac, achieved = theta + step, r_new, jac_new, achieved_new
-                loss, damping, accepted = loss_new, damping / 3, True
-                break
-            damping *= 4
-        if not accepted:  # no step lowers the loss: a minimum, to machine precision
-            converged = True
-            break
-        history.append(loss)
-        if np.max(np.abs(step)) < tol:
-            converged = True
-            break
     return DropDesign(
-        h0=float(jnp.exp(theta[0])),
-        m=float(jnp.exp(theta[1])),
+        h0=float(np.exp(fit.theta[0])),
+        m=float(np.exp(fit.theta[1])),
         target=target,
-        apexes=np.asarray(achieved),
-        residuals=np.asarray(r),
-        loss=loss,
-        converged=converged,
-        iterations=iterations,
-        history=np.asarray(history),
+        apexes=np.asarray(fit.extra),
+        residuals=fit.residuals,
+        loss=float(fit.history[-1]),
+        converged=bool(fit.converged),
+        iterations=fit.iterations,
+        history=fit.history,
     )

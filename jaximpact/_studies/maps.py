@@ -10,8 +10,8 @@ import equinox as eqx
 import numpy as np
 
 from .._batch.batch import batch_path, impact_batch
+from .._laws import LAW_NAMES, LAWS, law
 from .._laws.closed_forms import exact_batch
-from .._laws.law import LAW_NAMES, LAWS, law
 from .._status import Status
 
 # the stiffness axis of every map (N/m^n); the damping axis is the law's row's `map_range`

@@ -1,0 +1,257 @@
+"""`BounceFit`, the result of `fit_bounces`, and the statistics it reports: standard errors
+from the Jacobian at the optimum, undetermined parameters, outliers."""
+
+import math
+
+import equinox as eqx
+import jax.numpy as jnp
+import numpy as np
+
+from .._laws import AbstractLaw
+from .._solve.bounce import BounceResult, bounce_options, solve_bounce
+from .bounce_model import round_up
+from .parameters import law_with
+
+
+class BounceFit(eqx.Module):
+    """A law fitted to a bouncing ball, and how well it reproduces the measurements.
+
+    Like `jaximpact.Fit`: `law`, `params` (SI), `stderr` (standard errors of the fitted
+    parameters, law and nuisance, by name; `inf` for an undetermined one), `free` (the law
+    parameters fitted), `residuals` (`(model - data) / sigma` for the data used, with the
+    reported `sigma`),
+    `loss` (half their sum of squares), `converged`, `iterations`, `history` (loss per
+    accepted step of the last fit; `iterations` counts the steps of every stage). And:
+
+    - `undetermined`: parameters the data cannot fix (see the module docstring); their
+      values are the ones given, not estimates.
+    - `nuisance`: `t_impact` (s, first impact), `v_impact` (m/s, its speed), `drop_height`
+      (m, `v_impact^2 / 2g`, or its drag equivalent), `release_time` (s, when the ball was at
+      that apex), and for a trajectory `floor` (y units) and `length_scale` (y units per
+      metre); `drag` (1/m) when it was given or fitted.
+    - `e`, `e_stderr`, `impact_speeds` (m/s), `impact_times` (s), `T` (s): the fitted
+      chain, one entry per modelled impact (`num_impacts` of them).
+    - `sigma`: the measurement noise used (s or y units), given or estimated from the
+      residuals (then `stderr` includes that estimate, and with few data the errors
+      `(estimate - truth) / stderr` follow Student's t with `dof` degrees of freedom rather
+      than a normal law); `dof`: data minus parameters.
+    - impact times: `times`, `index` (impact number of each used detection), `dropped`
+      (positions in the input of detections not used: double, inconsistent, or
+      outliers of the first fit), `missed` (impact numbers with no detection).
+    - trajectory: `t`, `y`, `y_fit` (the data used and the model there), `dropped` (sample
+      positions not used: before the release, or outliers).
+    """
+
+    kind: str = eqx.field(static=True)
+    law: AbstractLaw
+    params: dict
+    stderr: dict
+    free: tuple = eqx.field(static=True)
+    undetermined: tuple = eqx.field(static=True)
+    nuisance: dict
+    e: np.ndarray
+    e_stderr: np.ndarray
+    impact_speeds: np.ndarray
+    impact_times: np.ndarray
+    T: np.ndarray
+    num_impacts: int = eqx.field(static=True)
+    residuals: np.ndarray
+    loss: float = eqx.field(static=True)
+    sigma: float = eqx.field(static=True)
+    dof: int = eqx.field(static=True)
+    converged: bool = eqx.field(static=True)
+    iterations: int = eqx.field(static=True)
+    history: np.ndarray
+    times: np.ndarray | None = None
+    index: np.ndarray | None = None
+    missed: np.ndarray | None = None
+    t: np.ndarray | None = None
+    y: np.ndarray | None = None
+    y_fit: np.ndarray | None = None
+    dropped: np.ndarray | None = None
+    m: float = eqx.field(static=True, default=1.0)
+    g: float = eqx.field(static=True, default=9.81)
+    separation: str = eqx.field(static=True, default="force")
+    y_sign: float = eqx.field(static=True, default=1.0)
+
+    def bounce(self, t_end=None, max_impacts: int | None = None) -> BounceResult:
+        """The fitted drop as a `BounceResult`, from the first modelled impact on (its
+        `height(ts)` gives the fitted motion at any times, in metres)."""
+        drag = self.nuisance.get("drag")
+        options = bounce_options(
+            separation=self.separation,
+            max_impacts=max_impacts or round_up(self.num_impacts + 1, 16),
+        )
+        t1, v1 = self.nuisance["t_impact"], self.nuisance["v_impact"]
+        if t_end is None:  # just past the last modelled impact
+            times = self.impact_times[: self.num_impacts]
+            t_end = float(times[-1]) + (
+                0.5 * float(times[-1] - times[-2]) if times.size > 1 else 1e-3
+            )
+            if self.t is not None:
+                t_end = max(t_end, float(np.max(self.t)))
+        return solve_bounce(
+            self.law,
+            jnp.asarray(self.m, float),
+            jnp.asarray(self.g, float),
+            None if drag is None else jnp.asarray(drag, float),
+            (jnp.asarray(t1, float), jnp.zeros(()), -jnp.asarray(v1, float)),
+            jnp.asarray(t_end, float),
+            jnp.asarray(0.0, float),
+            options,
+        )
+
+    def predict(self, ts) -> np.ndarray:
+        """The fitted trajectory at times `ts` (s), in the data's units (trajectory fits)."""
+        if self.kind != "trajectory":
+            raise ValueError("predict is for trajectory fits; an impact-time fit has impact_times")
+        ts = np.asarray(ts, dtype=float)
+        height = np.asarray(self.bounce(t_end=float(np.max(ts))).height(ts))
+        height = np.where(np.isfinite(height), height, 0.0)
+        return self.nuisance["floor"] + self.y_sign * self.nuisance["length_scale"] * height
+
+
+def statistics(theta, r, J, extra, names, sigma_given, n_data, log_params):
+    """Covariance from the Jacobian at the optimum; undetermined parameters; e errors."""
+    p = theta.size
+    dof = max(n_data - p, 1)
+    s2 = 1.0 if sigma_given else float(r @ r) / dof
+    U, S, Vt = np.linalg.svd(J, full_matrices=False)
+    cutoff = S.max(initial=0.0) * 1e-8
+    good = S > cutoff
+    inv = np.where(good, 1.0 / np.where(good, S, 1.0) ** 2, 0.0)
+    cov = s2 * (Vt.T * inv) @ Vt
+    null = Vt[~good]
+    se_theta = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    undetermined = []
+    for i, name in enumerate(names):
+        in_null = null.size and np.max(np.abs(null[:, i])) > 1e-3
+        if in_null or (log_params[i] and se_theta[i] > 1.0):
+            undetermined.append(name)
+            se_theta[i] = np.inf
+    e, J_e, _ = extra
+    cov_e = np.einsum("ki,ij,kj->k", J_e, cov, J_e)
+    return dof, s2, se_theta, undetermined, e, np.sqrt(np.maximum(cov_e, 0.0))
+
+
+def finish(
+    *,
+    kind,
+    law,
+    free,
+    nuisance_names,
+    theta,
+    r,
+    J,
+    extra,
+    history,
+    converged,
+    iterations,
+    data,
+    sigma_used,
+    sigma_given,
+    n_data,
+    m,
+    g,
+    separation,
+    y_sign,
+    used,
+    **extra_fields,
+):
+    """The `BounceFit` of a finished fit: statistics at the optimum `theta` (law parameters
+    `free`, then `nuisance_names`), the fitted chain's e and impacts from `extra`."""
+    nf = len(free)
+    fitted_law = law_with(law, free, jnp.asarray(theta[:nf]))
+    log_params = [True] * nf + [
+        name in ("v_impact", "length_scale", "drag") for name in nuisance_names
+    ]
+    names = list(free) + list(nuisance_names)
+    dof, s2, se_theta, undetermined, e, e_se = statistics(
+        theta, r, J, extra, names, sigma_given, n_data, log_params
+    )
+    params = {k: float(v) for k, v in fitted_law.parameters.items()}
+    stderr = {}
+    for i, name in enumerate(free):
+        stderr[name] = float(params[name] * se_theta[i]) if np.isfinite(se_theta[i]) else math.inf
+    q = dict(zip(nuisance_names, theta[nf:], strict=True))
+    t1 = float(data["t1"] + q["t_impact"] * data["t_unit"])
+    v1 = float(data["v1"] * math.exp(q["v_impact"]))
+    nuisance = {"t_impact": t1, "v_impact": v1}
+    se_q = dict(zip(nuisance_names, se_theta[nf:], strict=True))
+    stderr["t_impact"] = float(se_q["t_impact"] * data["t_unit"])
+    stderr["v_impact"] = float(v1 * se_q["v_impact"])
+    drag = None
+    if "drag" in data:
+        drag = float(data["drag"] * math.exp(q.get("drag", 0.0)))
+        nuisance["drag"] = drag
+        stderr["drag"] = float(drag * se_q["drag"]) if "drag" in se_q else 0.0
+    # the apex the first impact fell from
+    if drag is None:
+        height, fall = v1**2 / (2 * g), v1 / g
+    else:
+        v_t = math.sqrt(g / drag)
+        w = min(v1 / v_t, 1 - 1e-15)
+        height, fall = -(v_t**2) / (2 * g) * math.log1p(-(w**2)), v_t / g * math.atanh(w)
+    nuisance["drop_height"] = height
+    nuisance["release_time"] = t1 - fall
+    stderr["drop_height"] = float(2 * height * se_q["v_impact"])
+    if kind == "trajectory":
+        nuisance["floor"] = float(data["floor"] + q["floor"] * data["y_unit"])
+        stderr["floor"] = float(se_q["floor"] * data["y_unit"])
+        scale = float(data["scale"] * math.exp(q.get("length_scale", 0.0)))
+        nuisance["length_scale"] = scale
+        stderr["length_scale"] = (
+            float(scale * se_q["length_scale"]) if "length_scale" in se_q else 0.0
+        )
+    aux = extra[2]
+    valid = aux["valid"]
+    count = int(np.sum(valid))
+    if kind == "impacts":  # the impacts the detections cover
+        count = min(count, int(np.max(extra_fields["index"])) + 1)
+    else:
+        count = min(count, int(np.sum(aux["t_land"][:count] <= np.max(extra_fields["t"]))))
+    sigma = float(sigma_used * math.sqrt(s2))
+    return BounceFit(
+        kind=kind,
+        law=fitted_law,
+        params=params,
+        stderr=stderr,
+        free=tuple(free),
+        undetermined=tuple(undetermined),
+        nuisance=nuisance,
+        e=np.where(valid, extra[0], np.nan)[:count],
+        e_stderr=np.where(valid, e_se, np.nan)[:count],
+        impact_speeds=aux["v_in"][:count],
+        impact_times=aux["t_land"][:count],
+        T=aux["T"][:count],
+        num_impacts=count,
+        residuals=r[used] / math.sqrt(s2),
+        loss=float(0.5 * r @ r),
+        sigma=sigma,
+        dof=int(dof),
+        converged=bool(converged),
+        iterations=int(iterations),
+        history=history,
+        m=m,
+        g=g,
+        separation=separation,
+        y_sign=y_sign,
+        **extra_fields,
+    )
+
+
+def find_outliers(r, used, threshold, sigma_given):
+    """Data more than `threshold` robust standard deviations (1.4826 times the median
+    absolute deviation; with a given noise, at least the given one) off the fit, at most a
+    fifth of them, the worst first."""
+    values = r[used]
+    spread = 1.4826 * np.median(np.abs(values - np.median(values)))
+    if sigma_given:
+        spread = max(spread, 1.0)  # residuals are in units of the given noise
+    bad = used & (np.abs(r) > threshold * max(spread, 1e-12))
+    limit = max(1, int(used.sum()) // 5)
+    if bad.sum() > limit:
+        worst = np.argsort(-np.abs(np.where(bad, r, 0.0)))[:limit]
+        bad = np.zeros_like(bad)
+        bad[worst] = True
+    return bad
