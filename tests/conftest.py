@@ -5,6 +5,9 @@
   time on (about a third less wall time measured). Results agree with the optimised build
   to rounding (LLVM's contraction of multiply-adds differs), so a test that compares two
   processes bit for bit gives both the same flags (test_batch.py).
+- Strict about shapes: implicit rank promotion raises (`jax_numpy_rank_promotion`), so a
+  broadcast that was not meant fails here. Dtype promotion stays standard: strict promotion
+  fails inside optax's L-BFGS, whose counters mix int32 and int64 under float64.
 - The command line's progress reports (on stderr, also when it is not a terminal) are turned
   off for the tests, which check stderr line by line; tests of the progress turn it on.
 """
@@ -18,6 +21,7 @@ os.environ.setdefault("JAXIMPACT_PROGRESS", "off")
 import jax  # noqa: E402
 
 jax.config.update("jax_enable_x64", True)
+jax.config.update("jax_numpy_rank_promotion", "raise")
 
 _TESTS = os.path.dirname(os.path.abspath(__file__))
 if _TESTS not in sys.path:

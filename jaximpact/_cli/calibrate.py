@@ -9,12 +9,12 @@ its nondimensional restitution table (`calibrate(..., init="auto")`).
 
 import csv
 import math
-import threading
+import sys
 from pathlib import Path
 
 from .._format import format_number, format_quantity
 from .._plotting import new_figure, save_figure
-from .._progress import Progress, progress_enabled
+from .._progress import Progress, is_terminal, progress_enabled
 from .common import (
     CLIError,
     add_law_arguments,
@@ -239,52 +239,20 @@ def _middle(data):
 # --------------------------------------------------------------------- progress bar
 
 
-class _Ticker:
-    """A `Progress` bar redrawn every 0.2 s while the work runs (a first fit compiles for
-    tens of seconds without other sign of life), shown only once it has taken `delay` s."""
-
-    def __init__(self, total, what, enabled, delay=None):
-        # lines when stderr is not a terminal: one per 10 s, none for work under 3 s
-        self.bar = Progress(total, what, enabled=False, delay=0.0, interval=10.0)
-        if delay is None:
-            delay = 0.5 if self.bar.terminal else 3.0
-        self.enabled, self.delay, self.label = enabled, delay, ""
-        self._lock, self._stop = threading.Lock(), threading.Event()
-        self._thread = threading.Thread(target=self._run, daemon=True)
-
-    def __enter__(self):
-        if self.enabled:
-            self._thread.start()
-        return self
-
-    def _run(self):
-        if self._stop.wait(self.delay):
-            return
-        with self._lock:
-            self.bar.enabled = True
-        while True:
-            with self._lock:
-                self.bar._draw(self.label)
-            if self._stop.wait(0.2):
-                return
-
-    def update(self, label=""):
-        with self._lock:
-            self.label = label
-            self.bar.done += 1
-
-    def __exit__(self, *exc):
-        self._stop.set()
-        if self._thread.is_alive():
-            self._thread.join()
-        if self.bar.enabled:
-            self.bar._draw(self.label)
-            self.bar.__exit__(*exc)
-        return False
-
-
-def _progress_enabled():
-    return progress_enabled()  # on a terminal a bar, elsewhere a line every 10 s
+def _progress(total, what, delay=None):
+    """A bar redrawn every 0.2 s while the fits run (a first fit compiles for tens of seconds
+    without other sign of life): after 0.5 s on a terminal; elsewhere a line every 10 s,
+    none for work under 3 s."""
+    if delay is None:
+        delay = 0.5 if is_terminal(sys.stderr) else 3.0
+    return Progress(
+        total,
+        what,
+        enabled=progress_enabled(),
+        interval=10.0,
+        delay=delay,
+        heartbeat=0.2,
+    )
 
 
 # ------------------------------------------------------------------------- running
@@ -347,7 +315,7 @@ def _run_one(args, data):
     free = free_names(args.free)
     fitted_names = free or default_free(start, stiffness=data["T"] is not None)
     init = args.init or ("given" if set(given) & set(fitted_names) else "auto")
-    with _Ticker(1, f"calibrating {args.law}", _progress_enabled()) as bar:
+    with _progress(1, f"calibrating {args.law}") as bar:
         fit = calibrate(start, free=free, init=init, **_fit_kwargs(args, data))
         jax.block_until_ready(fit)
         bar.update("done")
@@ -412,7 +380,7 @@ def _run_all(args, data):
     has_sigma = data["sigma_e"] is not None
     kwargs = _fit_kwargs(args, data)
     rankings, failed = [], {}
-    with _Ticker(len(laws), "fitting laws", _progress_enabled()) as bar:
+    with _progress(len(laws), "fitting laws") as bar:
         for name in laws:
             bar.label = name
             try:
