@@ -27,7 +27,7 @@ jax.config.update("jax_enable_x64", True)
 import numpy as np  # noqa: E402
 
 import jaximpact as ji  # noqa: E402
-from jaximpact._batch.batch import _cost_key, impact_batch  # noqa: E402
+from jaximpact._batch import cost_key, impact_batch  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "tests"))
@@ -146,7 +146,7 @@ def cost_ordering(n, repeat):
         for order in result:
             sequence = steps if order == "given" else np.sort(steps)  # approximate cost order
             if order == "cost":
-                key = _cost_key(("law", name), params, m, v0, np.zeros(n))
+                key = cost_key(("law", name), params, m, v0, np.zeros(n))
                 sequence = steps[np.lexsort(key[::-1])]
             blocks = sequence[: len(sequence) // 1024 * 1024].reshape(-1, 1024)
             useful[order] = blocks.sum() / (blocks.max(axis=1).sum() * 1024)
@@ -180,7 +180,7 @@ import json, resource, sys, time
 import jax, numpy as np
 jax.config.update("jax_enable_x64", True)
 import jaximpact as ji
-from jaximpact._batch.batch import impact_batch
+from jaximpact._batch import impact_batch
 
 
 def peak_rss_mib():  # the high-water mark of this process since the last reset (Linux)
@@ -247,7 +247,7 @@ _SHARDED_CHILD = r"""
 import json, sys, time
 import jax, numpy as np
 jax.config.update("jax_enable_x64", True)
-from jaximpact._batch.batch import impact_batch
+from jaximpact._batch import impact_batch
 n, repeat, spread = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
 rng = np.random.default_rng(0)
 lu = lambda a, b, k: np.exp(rng.uniform(np.log(a), np.log(b), k))

@@ -8,7 +8,6 @@ The first use also turns on JAX's persistent compilation cache (`_cache`; opt ou
 """
 
 import importlib
-import importlib.metadata
 import os
 import sys
 
@@ -55,15 +54,15 @@ _PUBLIC = {
     "read_recording": "_fit.recordings",
     "starting_law": "_fit.model_choice",
     # many impacts
-    "impact_batch": "_batch.batch",
-    "run_batch": "_batch.batch",
-    "write_table": "_batch.batch",
+    "impact_batch": "_batch",
+    "run_batch": "_batch",
+    "write_table": "_batch",
     # studies
-    "bumper_design": "_studies.design",
-    "drop_design": "_studies.design",
-    "propagate_uncertainty": "_studies.design",
-    "sensitivity_map": "_studies.design",
-    "plot_sensitivity": "_studies.design",
+    "bumper_design": "_studies.bumper",
+    "drop_design": "_studies.drop",
+    "propagate_uncertainty": "_studies.uncertainty",
+    "sensitivity_map": "_studies.sensitivity",
+    "plot_sensitivity": "_studies.sensitivity",
     "plot_map": "_studies.maps",
     "restitution_map": "_studies.maps",
     # figures, the seed paper
@@ -104,7 +103,4 @@ def __dir__():
     return sorted([*globals(), *_PUBLIC, *_SUBMODULES])
 
 
-try:
-    __version__ = importlib.metadata.version("jaximpact")
-except importlib.metadata.PackageNotFoundError:  # running from a source tree
-    __version__ = "0.0.0"
+from ._version import __version__ as __version__  # noqa: E402

@@ -19,7 +19,7 @@ from helpers import assert_rel
 from reference import reference_impact
 
 import jaximpact as ji
-from jaximpact._batch.batch import block_length, impact_batch, run_batch, write_table
+from jaximpact._batch import block_length, impact_batch, run_batch, write_table
 
 BLOCK = 64  # rows per device per call in every impact batch of these tests
 ET = dict(peaks=False, fields=("e", "T", "status"), chunk_size=BLOCK, progress=False)
@@ -40,7 +40,7 @@ import numpy as np
 jax.config.update("jax_enable_x64", True)
 sys.path.insert(0, {tests!r})
 from test_batch import ET, N_SHARDED, wide_population
-from jaximpact._batch.batch import impact_batch
+from jaximpact._batch import impact_batch
 assert len(jax.local_devices()) == 4, jax.local_devices()
 params, m, v0 = wide_population(N_SHARDED)
 out = impact_batch("hertz_rate", params, m=m, v0=v0, exact={exact}, **ET)

@@ -21,10 +21,8 @@ from helpers import assert_one_line_error, run_cli  # noqa: E402
 
 import jaximpact as ji  # noqa: E402
 from jaximpact import _cli, _format  # noqa: E402
-from jaximpact._cli import (
-    common,  # noqa: E402
-    laws as cli_laws,  # noqa: E402
-)
+from jaximpact._cli import common  # noqa: E402
+from jaximpact._cli import laws as cli_laws  # noqa: E402
 from jaximpact._plotting import plot_impact  # noqa: E402
 
 LAW = dict(c=2e6, b1=800.0)

@@ -12,13 +12,8 @@ import pytest
 from helpers import assert_rel
 
 import jaximpact as ji
-from jaximpact._batch.batch import impact_batch
-from jaximpact._studies.design import (
-    bumper_design,
-    jacobian_batch,
-    propagate_uncertainty,
-    sensitivity_map,
-)
+from jaximpact import bumper_design, impact_batch, propagate_uncertainty, sensitivity_map
+from jaximpact._studies.sensitivity import jacobian_batch
 
 ET = dict(peaks=False, fields=("e", "T", "status"), chunk_size=64, progress=False)
 C, B1, M, V0 = 2e6, 800.0, 1.0, 2.5  # the seed paper's Fig. 10
@@ -117,8 +112,8 @@ def test_bumper_design_meets_the_constraints_and_scales():
 @pytest.mark.slow
 def test_drop_design_recovers_height_and_mass():
     """Apexes of a known drop (from `bounce`) give back its height and mass."""
+    from jaximpact import drop_design
     from jaximpact._solve.bounce import bounce
-    from jaximpact._studies.design import drop_design
 
     law = ji.law("hertz_rate", c=1e6, b1=1350.0)
     h0, m = 0.6, 0.8

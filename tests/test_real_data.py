@@ -13,8 +13,7 @@ import numpy as np
 import pytest
 
 import jaximpact as ji
-from jaximpact import read_recording
-from jaximpact import clean_impact_times, fit_bounces, interval_restitution
+from jaximpact import clean_impact_times, fit_bounces, interval_restitution, read_recording
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 ACOUSTIC = DATA / "giiulia_phyphox_bounce_impact_times.csv"

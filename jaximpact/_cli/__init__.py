@@ -35,7 +35,7 @@ COMMANDS = [
 
 def build_parser() -> argparse.ArgumentParser:
     """The `jaximpact` parser, with one subcommand per entry of `COMMANDS`."""
-    from .. import __version__
+    from .._version import __version__
 
     parser = Parser(
         prog=PROG,

@@ -9,7 +9,7 @@ c from 2e6 to 2e7 N/m, b from 200 to 1000 N s/m) and for Maxwell (its Fig. 7);
 import equinox as eqx
 import numpy as np
 
-from .._batch.batch import batch_path, impact_batch
+from .._batch import batch_path, impact_batch
 from .._laws import LAW_NAMES, LAWS, law
 from .._laws.closed_forms import exact_batch
 from .._status import Status
@@ -43,7 +43,7 @@ class RestitutionMap(eqx.Module):
     path: str = eqx.field(static=True)
 
 
-def _axis(values, default, num, log):
+def axis(values, default, num, log):
     if values is None:
         lo, hi = default
         return np.geomspace(lo, hi, num) if log else np.linspace(lo, hi, num)
@@ -106,8 +106,8 @@ def restitution_map(
         )
     if {"c", damping_name} & set(fixed):
         raise ValueError("fixed must not hold c or the damping parameter: they are the grid")
-    c = _axis(c, C_RANGE, num, log=True)
-    damping = _axis(damping, spec.map_range, num, log=False)
+    c = axis(c, C_RANGE, num, log=True)
+    damping = axis(damping, spec.map_range, num, log=False)
     m, v0 = float(m), float(v0)
 
     damping_grid, c_grid = np.meshgrid(damping, c, indexing="ij")
