@@ -11,7 +11,7 @@ import jax
 
 jax.config.update("jax_enable_x64", True)
 
-from jaximpact._paper.reproduce import hunt_crossley_variants_markdown  # noqa: E402
+from jaximpact._paper.tables import hunt_crossley_variants_markdown  # noqa: E402
 
 if __name__ == "__main__":
     text = hunt_crossley_variants_markdown()

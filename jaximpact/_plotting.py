@@ -9,7 +9,7 @@ import numpy as np
 _MM, _MS = 1e3, 1e3
 
 
-def _elastic_part(law, x):
+def elastic_part(law, x):
     """The elastic part `c x^n` (N) of a law of the power family over the penetrations
     `x` (m) reached, as `(x grid, force, legend label)`; `None` for laws without one
     (Maxwell, a user's own law)."""
@@ -78,7 +78,7 @@ def plot_impact(result, law=None, *, fig=None, axes=None, title: str | None = No
     # 1. force-displacement loop over the contact
     contact = (ts >= 0.0) & (ts <= T)
     ax_loop.plot(x[contact] * _MM, force[contact], color="C0", lw=1.8, label="contact force $F$")
-    elastic = None if law is None else _elastic_part(law, x[contact])
+    elastic = None if law is None else elastic_part(law, x[contact])
     if elastic is not None:
         x_el, f_el, label = elastic
         ax_loop.plot(x_el * _MM, f_el, "--", color="C1", lw=1.4, label=label)

@@ -11,25 +11,16 @@ import jax.numpy as jnp
 import numpy as np
 
 import jaximpact as ji
+from jaximpact._paper.cases import LOOPS, V0, M  # noqa: F401 (M, V0: for the tests)
 
-M, V0 = 1.0, 2.5  # the seed paper's mass (kg) and impact speed (m/s) in every figure
-
-# (law name, parameters, e printed in the paper or None, figure), Polukoshko et al. 2007.
+# (law name, parameters, e printed in the paper or None, figure), from the library's one copy
+# of the paper's conditions (Polukoshko et al. 2007), plus one under-damped point of fig. 7,
+# a map of T(b, c), e(b, c) with no single parameter set
 PAPER_SETS = [
-    ("kelvin_voigt", dict(c=2e6, b=400.0), 0.69, "2"),
-    ("kelvin_voigt_modified", dict(c=2e6, b1=4e5), 0.78, "3"),
-    # the text of fig. 3 says b = 4 (printed e is the same 0.78, which b1 = 4 cannot give)
-    ("kelvin_voigt_modified", dict(c=2e6, b1=4.0), 0.78, "3 (text)"),
-    ("bingham", dict(c=2e6, b=200.0, P=400.0), 0.66, "4"),
-    ("bingham_modified", dict(c=2e6, b1=200.0, P=400.0), 0.79, "5"),
-    ("bingham_compression", dict(c=2e6, P=800.0), 0.80, "6"),
-    # fig. 7 is a map of T(b, c), e(b, c) with no single parameter set: one under-damped point
-    ("maxwell", dict(c=2e6, b=2000.0), None, "7"),
-    ("hertz_viscous", dict(c=2e6, b=40.0), 0.86, "8"),
-    ("hertz_modified", dict(c=2e6, b=2e4), 0.79, "9"),
-    ("hertz_rate", dict(c=2e6, b1=800.0), 0.85, "10"),
-    ("hunt_crossley", dict(c=2e6, a=0.1), 0.80, "11"),
+    (case.law, case.params, case.printed, case.figure + (" (text)" if "text" in case.note else ""))
+    for case in LOOPS
 ]
+PAPER_SETS.insert(6, ("maxwell", dict(c=2e6, b=2000.0), None, "7"))
 
 
 def paper_id(row) -> str:

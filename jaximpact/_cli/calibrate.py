@@ -185,7 +185,7 @@ def measurements(args) -> dict:
     NaN where a row has none, sigma_T 1 there)."""
     import numpy as np
 
-    from .._fit.calibrate import _check_targets
+    from .._fit.calibrate import check_targets
 
     flags = [f"--{k}" for k in ("v0", "e", "T") if getattr(args, k) is not None]
     flags += [
@@ -219,7 +219,7 @@ def measurements(args) -> dict:
         )
     if sigma_e is None and sigma_T is not None:
         raise CLIError("give sigma_e with sigma_T")
-    _check_targets(
+    check_targets(
         args.mass,
         np.asarray(columns["v0"]),
         np.asarray(columns["e"]),

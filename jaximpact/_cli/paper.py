@@ -39,13 +39,14 @@ def add_paper(subparsers):
 def _run_paper(args):
     import sys
 
-    from .._paper.reproduce import _select, reproduce_paper
+    from .._paper.cases import select_cases
+    from .._paper.reproduce import reproduce_paper
 
     if args.out.exists() and not args.out.is_dir():
         raise CLIError(f"--out {args.out}: exists and is not a directory")
     if not args.out.parent.is_dir() and args.out.parent != Path(""):
         raise CLIError(f"--out {args.out}: directory {str(args.out.parent)!r} does not exist")
-    _select(args.figures)  # a bad figure number fails before any work
+    select_cases(args.figures)  # a bad figure number fails before any work
     result = reproduce_paper(
         args.out, only=args.figures, figures=not args.no_plots, progress=sys.stderr.isatty()
     )
@@ -53,7 +54,7 @@ def _run_paper(args):
 
 
 def _paper_text(result) -> str:
-    from .._paper.reproduce import _COLUMNS
+    from .._paper.cases import COLUMNS
 
     lines = [
         "fig.   law                      printed  Euler(paper)  converged(force)  "
@@ -64,7 +65,7 @@ def _paper_text(result) -> str:
         lines.append(
             f"{row['figure']:<6} {row['law']:<24} {printed:>7}  {row['e_paper']:>12.4f}  "
             f"{row['e_force']:>15.4f}  {row['e_penetration']:>15.4f}  "
-            f"{_COLUMNS.get(row['nearest'], '-')}"
+            f"{COLUMNS.get(row['nearest'], '-')}"
         )
     lines.append("")
     lines += [f"wrote {path}" for path in result["files"]]

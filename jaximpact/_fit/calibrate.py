@@ -73,7 +73,7 @@ def _as_rows(name, value, rows, allow_missing=False):
     return xp.broadcast_to(value, (rows,)) if rows is not None else value
 
 
-def _check_targets(m, v0, e, T, sigma_e, sigma_T):
+def check_targets(m, v0, e, T, sigma_e, sigma_T):
     """One-line ValueErrors for impossible targets (only for concrete inputs)."""
     concrete = not any(isinstance(a, jax.core.Tracer) for a in (m, v0, e, T, sigma_e, sigma_T))
     if not concrete:
@@ -323,7 +323,7 @@ def calibrate(
     T = _as_rows("T", T, rows, allow_missing=True)
     sigma_e = _as_rows("sigma_e", sigma_e, rows)
     sigma_T = _as_rows("sigma_T", sigma_T, rows)
-    _check_targets(m, v0, e, T, sigma_e, sigma_T)
+    check_targets(m, v0, e, T, sigma_e, sigma_T)
     m = jnp.asarray(m, dtype=float) if isinstance(m, jax.core.Tracer) else np.float64(m)
     has_sigma = sigma_e is not None or sigma_T is not None
     free = default_free(law, stiffness=T is not None) if free is None else tuple(free)
