@@ -122,7 +122,8 @@ def test_stress_full_float64(name, separation):
 def test_stress_full_float32(name, tmp_path):
     """float32 (x64 off, in a subprocess): no NaN, no lost impact, e to ~1e-5."""
     out = tmp_path / "rows.json"
-    script = os.path.join(os.path.dirname(os.path.dirname(__file__)), "benchmarks", "stress.py")
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    script = os.path.join(root, "benchmarks", "stress.py")
     cmd = [sys.executable, script, "--worker32", str(out), "--n", "16", "--laws", name]
     cmd += ["--gradients", "jacfwd"]
     env = dict(os.environ, JAX_ENABLE_X64="0")

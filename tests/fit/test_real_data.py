@@ -15,7 +15,7 @@ import pytest
 import jaximpact as ji
 from jaximpact import clean_impact_times, fit_bounces, interval_restitution, read_recording
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+DATA = Path(__file__).resolve().parents[3] / "shared" / "data"
 ACOUSTIC = DATA / "giiulia_phyphox_bounce_impact_times.csv"
 VIDEO = DATA / "marble_on_paper_video"
 

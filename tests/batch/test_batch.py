@@ -38,7 +38,7 @@ import sys
 import jax
 import numpy as np
 jax.config.update("jax_enable_x64", True)
-sys.path.insert(0, {tests!r})
+sys.path[:0] = [{tests!r}, {root!r}]
 from test_batch import ET, N_SHARDED, wide_population
 from jaximpact._batch import impact_batch
 assert len(jax.local_devices()) == 4, jax.local_devices()
@@ -51,7 +51,8 @@ np.savez({path!r}, **out, **{{"single_" + k: v for k, v in single.items()}})
 
 def _start_sharded(tmp_path, exact):
     path = str(tmp_path / f"sharded_{exact}.npz")
-    code = _CHILD.format(tests=os.path.dirname(__file__), exact=exact, path=path)
+    here = os.path.dirname(__file__)
+    code = _CHILD.format(tests=here, root=os.path.dirname(here), exact=exact, path=path)
     # XLA's default optimisation (not conftest's level 0, under which the arithmetic of a
     # block depends on its shape), four host devices; the one-device run in the same child
     flags = os.environ.get("XLA_FLAGS", "").replace("--xla_backend_optimization_level=0", "")
