@@ -85,16 +85,37 @@ def _contact(law, m, v_in, g, ts_local, options: ImpactOptions):
     return result, x_end
 
 
+class ChainState(eqx.Module):
+    """What the scan over contacts carries from one contact to the next: the apex of the
+    current flight (`t_apex` s, `y_apex` m), when that flight began (`t_release`, s),
+    whether the drop goes on (`active`), its `BounceStatus` code so far, and where and when
+    it came to rest (`t_rest` s, `y_rest` m; NaN and 0 until then)."""
+
+    t_apex: Array
+    y_apex: Array
+    t_release: Array
+    active: Array
+    code: Array
+    t_rest: Array
+    y_rest: Array
+
+
 def chain(law, m, g, drag, start, t_end, min_flight, ts, options: BounceOptions):
     """The scan over contacts. `start = (t0, y0, u0)`: the first flight's state (s, m, m/s,
     upward velocity). Returns the per-contact records (unmasked: a record whose `valid` is
     False comes from a dummy solve at unit speed and must not be used), the first flight,
-    and the final carry."""
+    and the final `ChainState`."""
     flight0 = Flight.from_state(*start, g=g, drag=drag)
     zero = jnp.zeros_like(flight0.t_apex)
 
-    def body(carry, k):
-        t_apex, y_apex, t_release, active, code, t_rest, y_rest = carry
+    def body(state: ChainState, k):
+        t_apex, y_apex, t_release, active = (
+            state.t_apex,
+            state.y_apex,
+            state.t_release,
+            state.active,
+        )
+        code, t_rest, y_rest = state.code, state.t_rest, state.y_rest
         t_land, v_in = Flight(t_apex, y_apex, g, drag).landing()
         too_late = t_land > t_end
         too_short = ((k > 0) & (t_land - t_release < min_flight)) | (v_in <= 0)
@@ -114,14 +135,14 @@ def chain(law, m, g, drag, start, t_end, min_flight, ts, options: BounceOptions)
         code = jnp.where(held, jnp.where(failed, BounceStatus.failed, BounceStatus.at_rest), code)
         t_rest = jnp.where(rests, t_land, jnp.where(held & ~failed, t_out, t_rest))
         y_rest = jnp.where(held & ~failed, -x_end, y_rest)
-        carry = (
-            jnp.where(go_on, after.t_apex, t_apex),
-            jnp.where(go_on, after.y_apex, y_apex),
-            jnp.where(go_on, t_out, t_release),
-            go_on,
-            code,
-            t_rest,
-            y_rest,
+        state = ChainState(
+            t_apex=jnp.where(go_on, after.t_apex, t_apex),
+            y_apex=jnp.where(go_on, after.y_apex, y_apex),
+            t_release=jnp.where(go_on, t_out, t_release),
+            active=go_on,
+            code=code,
+            t_rest=t_rest,
+            y_rest=y_rest,
         )
         record = dict(
             valid=hit,
@@ -142,19 +163,19 @@ def chain(law, m, g, drag, start, t_end, min_flight, ts, options: BounceOptions)
         )
         if ts is not None:
             record.update(x=contact.x, v=contact.v, F=contact.F)
-        return carry, record
+        return state, record
 
-    carry0 = (
-        flight0.t_apex,
-        flight0.y_apex,
-        zero + start[0],
-        jnp.asarray(True),
-        jnp.asarray(_RUNNING),
-        zero + jnp.nan,
-        zero,
+    state0 = ChainState(
+        t_apex=flight0.t_apex,
+        y_apex=flight0.y_apex,
+        t_release=zero + start[0],
+        active=jnp.asarray(True),
+        code=jnp.asarray(_RUNNING),
+        t_rest=zero + jnp.nan,
+        y_rest=zero,
     )
-    carry, records = jax.lax.scan(body, carry0, jnp.arange(options.max_impacts))
-    return records, flight0, carry
+    state, records = jax.lax.scan(body, state0, jnp.arange(options.max_impacts))
+    return records, flight0, state
 
 
 class BounceResult(eqx.Module):
@@ -282,8 +303,8 @@ def trajectory_from_records(records, flight0, carry, ts, m, g, drag):
     t_apex = jnp.concatenate([flight0.t_apex[None], records["t_apex"]])[k + 1]
     y_apex = jnp.concatenate([flight0.y_apex[None], records["y_apex"]])[k + 1]
     t_next = jnp.concatenate([t_land, jnp.asarray([jnp.inf])])[k + 1]
-    final_apex, final_height = carry[0], carry[1]
-    code, t_rest, y_rest = carry[4], carry[5], carry[6]
+    final_apex, final_height = carry.t_apex, carry.y_apex
+    code, t_rest, y_rest = carry.code, carry.t_rest, carry.y_rest
     next_landing = Flight(final_apex, final_height, g, drag).landing()[0]
     last_flight = ~jnp.isfinite(t_next)
     resting = code == BounceStatus.at_rest
@@ -306,10 +327,10 @@ def solve_bounce(law, m, g, drag, start, t_end, min_flight, options: BounceOptio
     records, flight0, carry = chain(law, m, g, drag, start, t_end, min_flight, None, options)
     valid = records["valid"]
     num = jnp.sum(valid)
-    code, t_rest = carry[4], carry[5]
+    code, t_rest = carry.code, carry.t_rest
     # still bouncing after the last contact: was there time for another one?
-    next_landing = Flight(carry[0], carry[1], g, drag).landing()[0]
-    long_enough = (next_landing - carry[2]) >= min_flight
+    next_landing = Flight(carry.t_apex, carry.y_apex, g, drag).landing()[0]
+    long_enough = (next_landing - carry.t_release) >= min_flight
     ran_out = (code == _RUNNING) & (next_landing <= t_end) & long_enough
     code = jnp.where(
         code == _RUNNING,
