@@ -25,24 +25,44 @@ def check_values(value, bad, message: str):
     return eqx.error_if(value, jnp.any(~jnp.isfinite(array) | bad(array)), message)
 
 
+def invalid_entries(value, bad) -> np.ndarray:
+    """Where a concrete `value` is not finite or `bad(value)` holds (a boolean array)."""
+    array = np.asarray(value, dtype=float)
+    with np.errstate(invalid="ignore"):
+        return ~np.isfinite(array) | bad(array)
+
+
 def check_positive(name: str, value, unit: str = ""):
     """Require a finite value > 0."""
     unit = f" {unit}" if unit else ""
-    return check_values(
-        value, lambda a: a <= 0, f"{name} must be a finite number > 0{unit}, got {_show(value)}"
-    )
+    message = f"{name} must be a finite number > 0{unit}, got {_show(value, _not_positive)}"
+    return check_values(value, _not_positive, message)
 
 
 def check_nonnegative(name: str, value, unit: str = ""):
     """Require a finite value >= 0."""
     unit = f" {unit}" if unit else ""
-    return check_values(
-        value, lambda a: a < 0, f"{name} must be a finite number >= 0{unit}, got {_show(value)}"
-    )
+    message = f"{name} must be a finite number >= 0{unit}, got {_show(value, _negative)}"
+    return check_values(value, _negative, message)
 
 
-def _show(value) -> str:
-    if _is_concrete(value):
-        array = np.asarray(value)
-        return str(array.item()) if array.size == 1 else f"an array with {array.size} values"
-    return "a traced value"
+def _not_positive(a):
+    return a <= 0
+
+
+def _negative(a):
+    return a < 0
+
+
+def _show(value, bad) -> str:
+    """The value, or for an array its first bad entry and where it is."""
+    if not _is_concrete(value):
+        return "a traced value"
+    array = np.asarray(value)
+    if array.size == 1:
+        return str(array.item())
+    wrong = np.flatnonzero(invalid_entries(array, bad).ravel())
+    if not wrong.size:
+        return f"an array of {array.size} values"
+    i = int(wrong[0])
+    return f"{array.ravel()[i]} at index {i} (of {array.size} values; {wrong.size} bad)"

@@ -12,9 +12,13 @@ class Status(enum.IntEnum):
       criterion, or a body resting on the surface under gravity (e = 0; T is the time at
       which the integration gave up, see `impact`).
     - `out_of_steps`: the solver used `max_steps` before the contact ended.
+    - `invalid`: a row of a batch whose inputs were refused (not finite, or out of range:
+      a mass, speed or stiffness <= 0, a negative damping); it has no result (NaN) while
+      the other rows have theirs (`impact_batch`).
     """
 
     separated = 0
     stuck = 1
     captured = 2
     out_of_steps = 3
+    invalid = 4

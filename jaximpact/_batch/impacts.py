@@ -5,15 +5,18 @@ the integrated rows so that each chunk holds members of similar cost.
 """
 
 import functools
+import warnings
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._checks import check_nonnegative, check_positive
+from .._checks import check_nonnegative, check_positive, invalid_entries
 from .._laws import LAW_NAMES, LAWS, CustomLaw, Law, custom_law, law as make_law
 from .._laws.closed_forms import closed_form_for
+from .._laws.named_law import invalid_parameter_rows
 from .._solve.impact import CURVES_RTOL, impact, similarity_reason
+from .._status import Status
 from .runner import run_batch
 
 IMPACT_FIELDS = ("e", "T", "x_max", "F_max", "status")
@@ -135,13 +138,18 @@ def batch_path(
     return "integrated"
 
 
-def prepare_rows(law, params, *, m, v0, g=0.0):
+def prepare_rows(law, params, *, m, v0, g=0.0, invalid: str = "raise"):
     """Check a batch of impacts once, eagerly, and lay it out as rows.
 
-    Returns `(skeleton, params, kinematics)`: the law's hashable structure, its parameters
-    and `{"m", "v0", "g"}` as 1-D float arrays of one common length (numbers and arrays
-    broadcast). Raises a one-line `ValueError` naming the first bad value.
+    Returns `(skeleton, params, kinematics, bad)`: the law's hashable structure, its
+    parameters and `{"m", "v0", "g"}` as 1-D float arrays of one common length (numbers and
+    arrays broadcast), and the rows whose values were refused. `invalid="raise"`: a one-line
+    `ValueError` naming the first bad value (`bad` is all False); `"mark"`: bad rows are
+    filled with a good row's values (so that the batch runs) and flagged in `bad`; a batch
+    with no good row still raises.
     """
+    if invalid not in ("raise", "mark"):
+        raise ValueError(f"invalid must be 'raise' or 'mark', got {invalid!r}")
     skeleton = _law_skeleton(law)
     base = {} if isinstance(law, str) else dict(law.parameters)
     given = {**base, **(params or {})}
@@ -165,6 +173,13 @@ def prepare_rows(law, params, *, m, v0, g=0.0):
         raise ValueError(f"the inputs do not broadcast to one batch: {shapes}") from None
     arrays = {k: np.atleast_1d(np.ascontiguousarray(v)) for k, v in arrays.items()}
     kinematics = {k: arrays.pop(k) for k in ("m", "v0", "g")}
+    bad = np.zeros(kinematics["m"].shape, bool)
+    if invalid == "mark":
+        bad = _invalid_rows(skeleton, arrays, kinematics)
+        if bad.any() and not bad.all():
+            good = int(np.argmin(bad))
+            arrays = {k: np.where(bad, v[good], v) for k, v in arrays.items()}
+            kinematics = {k: np.where(bad, v[good], v) for k, v in kinematics.items()}
     if skeleton[0] == "law":
         make_law(skeleton[1], **arrays)
     else:
@@ -175,7 +190,20 @@ def prepare_rows(law, params, *, m, v0, g=0.0):
         ("g", "gravity g", "m/s^2", False),
     ):
         (check_positive if positive else check_nonnegative)(what, kinematics[key], unit)
-    return skeleton, arrays, kinematics
+    return skeleton, arrays, kinematics, bad
+
+
+def _invalid_rows(skeleton, params, kinematics) -> np.ndarray:
+    """Rows that `prepare_rows(invalid="raise")` would refuse."""
+    if skeleton[0] == "law":
+        bad = invalid_parameter_rows(skeleton[1], params)
+    else:  # a user's law: its parameters must be finite
+        bad = np.zeros(kinematics["m"].shape, bool)
+        for value in params.values():
+            bad |= ~np.isfinite(value)
+    bad |= invalid_entries(kinematics["m"], lambda a: a <= 0)
+    bad |= invalid_entries(kinematics["v0"], lambda a: a <= 0)
+    return bad | invalid_entries(kinematics["g"], lambda a: a < 0)
 
 
 def impact_batch(
@@ -195,6 +223,7 @@ def impact_batch(
     progress: bool = True,
     devices=None,
     exact: bool = True,
+    invalid: str = "mark",
     **impact_options,
 ) -> dict[str, np.ndarray]:
     """Impacts of many bodies at once: `impact` over a batch, in chunks, on all local devices.
@@ -216,8 +245,13 @@ def impact_batch(
       `progress`, `devices`, `exact`: as
       in `run_batch`.
 
+    - `invalid`: what a row with invalid inputs (NaN, infinite, a mass, speed or stiffness
+      <= 0, a negative damping) does: `"mark"` (default) gives it status `Status.invalid`
+      and NaN results, with a warning, while the other rows run; `"raise"` refuses the
+      batch with a `ValueError` naming the first bad value.
+
     Returns a dict of numpy arrays of length `n` (`status` as integers of `Status`).
-    Inputs are checked once for the whole batch (a `ValueError` names the first bad value).
+    Inputs are checked once for the whole batch, before any work.
 
     **Example**:
     ```python
@@ -231,7 +265,9 @@ def impact_batch(
     unknown = sorted(set(fields) - set(_ALL_FIELDS))
     if unknown:
         raise ValueError(f"unknown fields {unknown}; choose from {_ALL_FIELDS}")
-    skeleton, law_params, kinematics = prepare_rows(law, params, m=m, v0=v0, g=g)
+    skeleton, law_params, kinematics, bad = prepare_rows(
+        law, params, m=m, v0=v0, g=g, invalid=invalid
+    )
     skeleton, law_params = _fix_shape(skeleton, law_params)
     zero_gravity = bool(np.all(kinematics["g"] == 0.0))
     rows = {"params": law_params, "m": kinematics["m"], "v0": kinematics["v0"]}
@@ -261,4 +297,18 @@ def impact_batch(
         exact=exact,
         description=f"impacts ({label})",
     )
-    return {name: out[name] for name in fields if name in out}
+    out = {name: out[name] for name in fields if name in out}
+    if bad.any():
+        for name, values in out.items():
+            if name == "status":
+                out[name] = np.where(bad, int(Status.invalid), values)
+            elif np.issubdtype(values.dtype, np.floating):
+                out[name] = np.where(bad, np.nan, values)
+        rows = np.flatnonzero(bad)
+        warnings.warn(
+            f"{rows.size} of {bad.size} rows have invalid inputs (not finite, or out of "
+            f"range), the first at row {rows[0]}: their status is Status.invalid and their "
+            "results NaN",
+            stacklevel=2,
+        )
+    return out

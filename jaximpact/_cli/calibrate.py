@@ -366,6 +366,7 @@ def _fit_record(name, fit, data):
         free=list(fit.free),
         stderr=None if fit.stderr is None else {k: float(v) for k, v in fit.stderr.items()},
         converged=bool(fit.converged),
+        undetermined=list(fit.undetermined),
         iterations=int(fit.iterations),
         loss=float(fit.loss),
         max_residual=float(np.max(np.abs(residuals))) if residuals.size else 0.0,
@@ -480,6 +481,11 @@ def _rows_text(data, rows):
 
 
 def _status_text(record):
+    if record.get("undetermined"):
+        return (
+            f"{' and '.join(record['undetermined'])} NOT determined by these data (give T, "
+            "more speeds, or hold one with --free): their values are not estimates"
+        )
     if record["converged"]:
         return f"converged after {record['iterations']} iterations"
     return (

@@ -1,5 +1,8 @@
 """Fitting a law's parameters to measured restitution and contact duration."""
 
+import dataclasses
+import warnings
+
 import diffrax as dfx
 import equinox as eqx
 import jax
@@ -34,6 +37,10 @@ class Fit(eqx.Module):
       `target_tol` (a target the law cannot reach gives `False`, with the best fit).
     - `iterations`; `stderr`: standard errors of the free parameters (from the Jacobian,
       only when sigmas are given), `None` otherwise.
+    - `undetermined`: free parameters these data cannot fix (fewer data than free
+      parameters, or `e` alone for a one-group law, which fixes only the group `beta`
+      that stiffness and damping make together); their values are not estimates. A
+    warning says so when the fit is not traced.
     """
 
     law: AbstractLaw
@@ -51,6 +58,7 @@ class Fit(eqx.Module):
     stderr: dict[str, Array] | None
     free: tuple[str, ...] = eqx.field(static=True)
     optimizer: str = eqx.field(static=True)
+    undetermined: tuple[str, ...] = eqx.field(static=True, default=())
 
 
 def _as_rows(name, value, rows, allow_missing=False):
@@ -101,6 +109,21 @@ def check_targets(m, v0, e, T, sigma_e, sigma_T):
             raise ValueError(f"{name} must be finite and > 0")
     if e is None and T is None:
         raise ValueError("give e, T or both to calibrate against")
+    if T is not None:
+        span = np.asarray(v0) * np.asarray(T)  # the contact's reach: x_max < v0 T
+        worst = int(np.nanargmax(span)) if np.any(np.isfinite(span)) else None
+        if worst is not None and span[worst] > MAX_REACH:
+            warnings.warn(
+                f"T = {np.asarray(T)[worst]:g} s at v0 = {np.asarray(v0)[worst]:g} m/s lets "
+                f"the body travel up to v0 T = {span[worst]:.3g} m into the surface: a "
+                "compliant contact law is for small deformations; is T in seconds and v0 "
+                "in m/s?",
+                stacklevel=3,
+            )
+
+
+# the reach v0 T (m) above which a target is flagged as implausible for a compliant contact
+MAX_REACH = 1.0
 
 
 # ------------------------------------------------------------------- initial values
@@ -335,6 +358,7 @@ def calibrate(
     if not free:
         raise ValueError("free names no parameter to fit")
     g_is_zero = isinstance(g, (int, float)) and g == 0
+    undetermined, undetermined_why = _undetermined(law, free, e=e, T=T, g_is_zero=g_is_zero)
     curves = None
     if method in ("auto", "similarity"):
         reason = similarity_reason(law, separation, g_is_zero=g_is_zero)
@@ -369,8 +393,39 @@ def calibrate(
         curves=curves,
         start_on_curves=init == "auto" and curves is not None,
     )
-    return _fit(law, data, m, np.float64(g) if g_is_zero else jnp.asarray(g, dtype=float),
-                np.float64(target_tol), options)  # fmt: skip
+    fit = _fit(law, data, m, np.float64(g) if g_is_zero else jnp.asarray(g, dtype=float),
+               np.float64(target_tol), options)  # fmt: skip
+    if not undetermined:
+        return fit
+    if not isinstance(fit.loss, jax.core.Tracer):
+        warnings.warn(
+            f"{' and '.join(undetermined)} not determined by these data ({undetermined_why}): "
+            "their values are not estimates; give T (or more data), or hold one of them "
+            "(free=...)",
+            stacklevel=2,
+        )
+    return dataclasses.replace(fit, undetermined=undetermined)
+
+
+def _undetermined(law, free, *, e, T, g_is_zero) -> tuple[tuple[str, ...], str]:
+    """The free parameters the targets cannot fix, and why: fewer targets than free
+    parameters; or, for a one-group law without gravity and no `T`, the stiffness and the
+    damping together (`e` depends on the group `beta` alone, whatever the speeds)."""
+
+    def count(values):
+        if values is None:
+            return 0
+        if isinstance(values, jax.core.Tracer):
+            return values.shape[0]
+        return int(np.sum(np.isfinite(np.asarray(values))))
+
+    n_data = count(e) + count(T)
+    if n_data < len(free):
+        return tuple(free), f"{n_data} target value(s) for {len(free)} free parameters"
+    damping = damping_parameter(law)
+    if T is None and g_is_zero and shape_of(law) is not None and {"c", damping} <= set(free):
+        return ("c", damping), f"e alone fixes only the group beta that c and {damping} make"
+    return (), ""
 
 
 class _Options(eqx.Module):

@@ -141,6 +141,7 @@ def compare_laws(
 
 
 def _free_for(name, *, has_T, n_data):
-    stiffness = has_T or n_data > 1
+    # without T, a one-group law's e depends on beta alone: c and the damping never both
+    stiffness = has_T or (n_data > 1 and not LAWS[name].one_group)
     free = default_free(LAWS[name], stiffness=stiffness)
     return default_free(LAWS[name], stiffness=stiffness, dry=n_data > len(free))

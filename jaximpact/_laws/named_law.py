@@ -7,7 +7,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array
 
-from .._checks import check_nonnegative, check_positive, check_values
+from .._checks import check_nonnegative, check_positive, check_values, invalid_entries
 from .._powers import contact_pow
 from .base import AbstractLaw, LawSpec
 from .dynamics import maxwell_dynamics, power_dynamics
@@ -105,6 +105,15 @@ def as_arrays(params, numbers=()):
     return arrays
 
 
+def _parameter_rule(key):
+    """What makes a law parameter's value invalid, besides not being finite."""
+    if key in ("c", "n"):
+        return lambda a: a <= 0
+    if key == "e_nominal":
+        return lambda a: (a <= 0) | (a > 1)
+    return lambda a: a < 0
+
+
 def _check_law_parameters(name, params):
     """The parameters, each passed through its value check (eager `ValueError`, or
     `eqx.error_if` under `jit`, whose result must be used)."""
@@ -116,13 +125,24 @@ def _check_law_parameters(name, params):
             checked[key] = check_positive(f"{name}: exponent n", value)
         elif key == "e_nominal":
             checked[key] = check_values(
-                value,
-                lambda a: (a <= 0) | (a > 1),
-                f"{name}: e_nominal must lie in (0, 1], got {value}",
+                value, _parameter_rule(key), f"{name}: e_nominal must lie in (0, 1], got {value}"
             )
         else:
             checked[key] = check_nonnegative(f"{name}: {key}", value, units.get(key, ""))
     return checked
+
+
+def invalid_parameter_rows(name: str, params: dict) -> np.ndarray:
+    """Rows of 1-D parameter arrays that `law(name, ...)` would refuse: not finite, out of
+    range (c, n > 0; e_nominal in (0, 1]; the rest >= 0), or free exponents with p > n."""
+    spec = LAWS[name]
+    rows = np.zeros(np.shape(next(iter(params.values()))), bool)
+    for key, value in params.items():
+        rows |= invalid_entries(value, _parameter_rule(key))
+    n, p = (params[q] if isinstance(q, str) else q for q in spec.shape or (1.0, 0.0))
+    with np.errstate(invalid="ignore"):
+        rows |= ~(np.asarray(p, float) <= np.asarray(n, float))
+    return rows
 
 
 def _concrete_numbers(*values) -> bool:

@@ -66,7 +66,7 @@ def jacobian_batch(
     Forward mode (`jax.jacfwd` with diffrax's `ForwardMode`), about 2-4 solves per row.
     """
     wrt = tuple(wrt)
-    skeleton, law_params, kinematics = prepare_rows(law, params, m=m, v0=v0, g=g)
+    skeleton, law_params, kinematics, _ = prepare_rows(law, params, m=m, v0=v0, g=g)
     for name in wrt:
         if name not in law_params and name not in ("m", "v0"):
             raise ValueError(

@@ -77,7 +77,7 @@ def propagate_uncertainty(
     sigma = np.asarray([float(scatter[k]) for k in names])
     if np.any(~np.isfinite(sigma)) or np.any(sigma < 0):
         raise ValueError("standard deviations in scatter must be finite and >= 0")
-    skeleton, params, kinematics = prepare_rows(law, None, m=m, v0=v0)
+    skeleton, params, kinematics, _ = prepare_rows(law, None, m=m, v0=v0)
     nominal_inputs = {**{k: v[0] for k, v in params.items()}, "m": kinematics["m"][0]}
     nominal_inputs["v0"] = kinematics["v0"][0]
     unknown = [k for k in names if k not in nominal_inputs]

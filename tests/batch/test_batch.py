@@ -203,14 +203,39 @@ def test_impact_batch_rejects_bad_inputs():
         impact_batch("no_such_law", {"c": 1.0}, m=1.0, v0=1.0)
     with pytest.raises(ValueError, match="needs b1"):
         impact_batch("hertz_rate", {"c": 2e6}, m=1.0, v0=1.0)
-    with pytest.raises(ValueError, match="mass m"):
-        impact_batch("hertz_rate", {"c": 2e6, "b1": 800.0}, m=np.array([1.0, -1.0]), v0=1.0)
+    with pytest.raises(ValueError, match=r"mass m .* got -1.0 at index 1"):
+        impact_batch(
+            "hertz_rate", {"c": 2e6, "b1": 800.0}, m=np.array([1.0, -1.0]), v0=1.0, invalid="raise"
+        )
+    with pytest.raises(ValueError, match="impact speed v0"):  # no good row to run
+        impact_batch("hertz_rate", {"c": 2e6, "b1": 800.0}, m=1.0, v0=np.array([np.nan, -1.0]))
+    with pytest.raises(ValueError, match="invalid must be"):
+        impact_batch("hertz_rate", {"c": 2e6, "b1": 800.0}, m=1.0, v0=1.0, invalid="skip")
     with pytest.raises(ValueError, match="broadcast"):
         impact_batch("hertz_rate", {"c": np.ones(3), "b1": np.ones(4)}, m=1.0, v0=1.0)
     with pytest.raises(ValueError, match="unknown fields"):
         impact_batch("hertz_rate", {"c": 2e6, "b1": 800.0}, m=1.0, v0=1.0, fields=("E",))
     with pytest.raises(TypeError, match="law name"):
         impact_batch(42, {}, m=1.0, v0=1.0)
+
+
+def test_a_bad_row_gets_its_own_status_and_the_others_their_results():
+    """A NaN speed, a negative mass and a zero stiffness among good rows: those rows are
+    `Status.invalid` with NaN results (and a warning that names the first), the others
+    equal a batch of the good rows alone."""
+    n = 64
+    v0 = np.linspace(1.0, 3.0, n)
+    m = np.ones(n)
+    c = np.full(n, 2e6)
+    v0[5], m[17], c[40] = np.nan, -1.0, 0.0
+    with pytest.warns(UserWarning, match="3 of 64 rows .* first at row 5"):
+        out = impact_batch("hertz_rate", {"c": c, "b1": 800.0}, m=m, v0=v0, **ET)
+    bad = np.isin(np.arange(n), [5, 17, 40])
+    assert np.all(out["status"][bad] == ji.Status.invalid)
+    assert np.all(np.isnan(out["e"][bad])) and np.all(np.isnan(out["T"][bad]))
+    good = impact_batch("hertz_rate", {"c": c[~bad], "b1": 800.0}, m=m[~bad], v0=v0[~bad], **ET)
+    for key in ("e", "T", "status"):
+        np.testing.assert_array_equal(out[key][~bad], good[key], err_msg=key)
 
 
 # ----------------------------------------------------------------------------- devices

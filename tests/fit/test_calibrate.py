@@ -454,3 +454,25 @@ def test_restitution_tables_against_fresh_impacts(name, separation, request):
         assert ref["status"] == "separated", what
         assert_rel(e_table[i], ref["e"], 1e-6, f"{what}: e", atol=1e-8)
         assert_rel(tau_table[i], ref["T"], 1e-6, f"{what}: tau")
+
+
+def test_e_alone_cannot_fix_stiffness_and_damping_together():
+    """e of a one-group law depends on beta alone: with c and b1 both free and no T, at one
+    speed or at three, both are reported undetermined (with a warning), never as results."""
+    law = ji.law("hertz_rate", c=2e6, b1=800.0)
+    with pytest.warns(UserWarning, match="c and b1 not determined .*1 target value"):
+        one = ji.calibrate(law, m=1.0, v0=2.5, e=0.85, free=("c", "b1"))
+    assert one.undetermined == ("c", "b1")
+    with pytest.warns(UserWarning, match="fixes only the group beta"):
+        three = ji.calibrate(law, m=1.0, v0=[1.5, 2.5, 3.5], e=[0.86, 0.85, 0.84], free=("c", "b1"))
+    assert three.undetermined == ("c", "b1")
+    # the same data with T, or with one parameter held, determine the fit
+    assert ji.calibrate(law, m=1.0, v0=2.5, e=0.85, T=7.8e-3).undetermined == ()
+    assert ji.calibrate(law, m=1.0, v0=2.5, e=0.85).undetermined == ()
+
+
+def test_a_target_that_reaches_metres_into_the_surface_is_flagged():
+    """T = 10 s at 2.5 m/s (a unit slip: ms meant) would put the body metres deep: warned."""
+    law = ji.law("hertz_rate", c=2e6, b1=800.0)
+    with pytest.warns(UserWarning, match="v0 T = 25 m .* is T in seconds"):
+        ji.calibrate(law, m=1.0, v0=2.5, e=0.5, T=10.0)
