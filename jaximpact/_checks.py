@@ -18,7 +18,7 @@ def check_values(value, bad, message: str):
     """
     if _is_concrete(value):
         array = np.asarray(value, dtype=float)
-        if np.any(~np.isfinite(array)) or np.any(bad(array)):
+        if array.size == 0 or np.any(~np.isfinite(array)) or np.any(bad(array)):
             raise ValueError(message)
         return value
     array = jnp.asarray(value)
@@ -59,6 +59,8 @@ def _show(value, bad) -> str:
     if not _is_concrete(value):
         return "a traced value"
     array = np.asarray(value)
+    if array.size == 0:
+        return "an empty array"
     if array.size == 1:
         return str(array.item())
     wrong = np.flatnonzero(invalid_entries(array, bad).ravel())

@@ -10,6 +10,7 @@ the power law of its last piece (`ln f` linear in `ln beta`).
 
 import functools
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 
@@ -65,7 +66,11 @@ def similarity_fields(dynamics, key: CurveKey, *, m, v0, peaks: bool) -> dict:
     curves = curves_for(key)
     outputs = (0, 1, 2, 3, 4) if peaks else (0, 1)
     values = curve_values(curves, dynamics.beta, outputs)
-    e, tau = values[0], values[1]
+    # a damping that only dissipates gives e <= 1; near the elastic limit the series' own
+    # error (<= 3e-12) could put e just above it: clamped, with the slope kept (at b = 0
+    # the derivative is the elastic limit's)
+    excess = jax.lax.stop_gradient(jnp.maximum(values[0] - 1.0, 0.0))
+    e, tau = values[0] - excess, values[1]
     fields = dict(
         e=e,
         T=tau * dynamics.t_star,
@@ -89,8 +94,11 @@ def beta_for_restitution(curves: Curves, e):
     the power-law tail beyond the table."""
     import optimistix as optx
 
-    log_e = jnp.log(jnp.clip(e, 1e-300, 1.0))
     lower, upper = np.log(BETA_MIN), float(curves.breaks[-1]) + 20.0
+    # an `e` below the curve's far end has no root: take that end (the fit then reports
+    # the target unmet) instead of leaving the bisection without a bracket
+    log_floor = jnp.log(curve_values(curves, jnp.exp(upper), (0,))[0])
+    log_e = jnp.clip(jnp.log(jnp.clip(e, 1e-300, 1.0)), log_floor * (1 - 1e-9), 0.0)
 
     def excess(s, target):
         return jnp.log(curve_values(curves, jnp.exp(s), (0,))[0]) - target

@@ -27,7 +27,8 @@ SCENE = (
 def _tau(alpha: float) -> float:
     """The duration of `m x'' = -k x (1 + D v)` at `k = m = v0 = 1`, `D = alpha` (units of
     `sqrt(m/k)`), from jaximpact's solver."""
-    from .. import impact, law
+    from .._laws import law
+    from .._solve.impact import impact
 
     return float(impact(law("point_contact", c=1.0, d=alpha), m=1.0, v0=1.0).T)
 
@@ -92,7 +93,7 @@ def snippet(parameters) -> str:
 
 
 def law(parameters, m: float):
-    from .. import law as make_law
+    from .._laws import law as make_law
 
     return make_law(
         "point_contact",
@@ -150,7 +151,7 @@ def simulate(parameters, *, m, v0, radius=0.01, time_step=0.0, accuracy=1e-10):
     plant.SetFreeBodySpatialVelocity(plant_context, body, SpatialVelocity(np.zeros(3), [0, 0, -v0]))
     integrator = simulator.get_mutable_integrator()
     integrator.set_target_accuracy(accuracy)
-    k, d = parameters["point_contact_stiffness"], parameters["hunt_crossley_dissipation"]
+    k = parameters["point_contact_stiffness"]
     t_scale = math.sqrt(m / k)
     integrator.set_maximum_step_size(t_scale / 200)
     integrator.request_initial_step_size_target(t_scale / 1000)

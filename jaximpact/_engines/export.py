@@ -70,7 +70,7 @@ class Export:
 
 
 def _law_of(law_or_fit):
-    from .. import AbstractLaw
+    from .._laws import AbstractLaw
 
     if isinstance(law_or_fit, AbstractLaw):
         return law_or_fit
@@ -84,7 +84,7 @@ def _law_of(law_or_fit):
 
 
 def _curve(law, m, speeds, separation):
-    from .. import impact
+    from .._solve.impact import impact
 
     es, Ts = [], []
     for v in speeds:
@@ -129,9 +129,9 @@ def export(
     if timestep is not None:
         timestep = check_positive("timestep", timestep, "s")
     if poisson is not None:
-        from .materials import _poisson
+        from .materials import check_poisson
 
-        poisson = _poisson("poisson", poisson)
+        poisson = check_poisson("poisson", poisson)
     source = None
     if law_or_fit is None:
         if e is None:
@@ -142,7 +142,7 @@ def export(
         if e is not None or T is not None:
             raise ValueError("give either a law (or fit) or the targets e= and T=, not both")
         source = _law_of(law_or_fit)
-        from .. import impact
+        from .._solve.impact import impact
 
         result = impact(source, m=m, v0=v0)
         if int(result.status) != 0:
@@ -243,13 +243,13 @@ def engine_response(engine: str, parameters: dict, *, m, speeds, radius=None):
             raise ValueError("LAMMPS needs the spheres' radius: pass radius= (m)")
         radius = check_positive("radius", radius, "m")
         E = check_positive("E", parameters["E"], "Pa")
-        from .materials import _poisson, hertz_stiffness
+        from .materials import check_poisson, hertz_stiffness
 
-        nu = _poisson("poisson", parameters.get("poisson", 0.3))
+        nu = check_poisson("poisson", parameters.get("poisson", 0.3))
         coefficient = check_restitution(parameters["coeff_restitution"], "coeff_restitution")
         c = hertz_stiffness(E, nu, radius, R2=radius)
         b = lammps._damp(coefficient) * math.sqrt(m / 2.0 * c) if coefficient < 1 else 0.0
-        from .. import law as make_law
+        from .._laws import law as make_law
 
         law = make_law("tsuji", c=c, b=b)
         separation = "force" if parameters.get("limit_damping") else "penetration"

@@ -34,7 +34,8 @@ _E_RANGE_TOL = 0.002
 def _impact(e_coefficient: float, separation: str):
     """`(e, tau)` of the Tsuji-form law at `c = m_eff = v0 = 1` (tau: T in units of
     `t* = (m_eff v0^2/c)^(2/5) / v0`), from jaximpact's solver."""
-    from .. import impact, law
+    from .._laws import law
+    from .._solve.impact import impact
 
     result = impact(
         law("tsuji_restitution", c=1.0, e_nominal=e_coefficient, m_eff=1.0),
@@ -111,7 +112,8 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Fal
     if (es.max() - es.min()) / 2 > 0.005 * es.mean() or abs(es.mean() / e - 1) > 0.005:
         warnings.append(
             f"timestep {h:.3g} s gives {Ts.mean() / h:.0f} steps per contact: LAMMPS realises "
-            f"e = {es.min():.4g} to {es.max():.4g} (asked {e:.4g}); use {_nice_down(T / 400):.3g} s "
+            f"e = {es.min():.4g} to {es.max():.4g} (asked {e:.4g}); "
+            f"use {_nice_down(T / 400):.3g} s "
             "or less"
         )
     extra = " limit_damping" if limit_damping else ""
@@ -159,7 +161,7 @@ def snippet(parameters) -> str:
 
 def law(parameters, m: float):
     """The continuous law LAMMPS realises between the two spheres (effective mass `m/2`)."""
-    from .. import law as make_law
+    from .._laws import law as make_law
 
     return make_law("tsuji", c=parameters["k"], b=parameters["b"])
 

@@ -24,7 +24,8 @@ def _positive(name: str, value, unit: str, *, infinite_ok: bool = False) -> floa
     return number
 
 
-def _poisson(name: str, value) -> float:
+def check_poisson(name: str, value) -> float:
+    """`value` as a Poisson ratio, which must lie in (-1, 0.5); a one-line ValueError if not."""
     try:
         number = float(value)
     except (TypeError, ValueError):
@@ -79,9 +80,9 @@ def effective_modulus(E, nu, E2=None, nu2=None) -> float:
     counterpart (then `E* = E / (1 - nu^2)`).
     """
     E = _positive("E", E, "Pa")
-    nu = _poisson("nu", nu)
+    nu = check_poisson("nu", nu)
     E2 = E if E2 is None else _positive("E2", E2, "Pa", infinite_ok=True)
-    nu2 = nu if nu2 is None else _poisson("nu2", nu2)
+    nu2 = nu if nu2 is None else check_poisson("nu2", nu2)
     compliance = (1.0 - nu**2) / E + (0.0 if math.isinf(E2) else (1.0 - nu2**2) / E2)
     return 1.0 / compliance
 

@@ -180,7 +180,7 @@ def snippet(parameters) -> str:
 def law(parameters, m: float):
     """The continuous law MuJoCo realises for a body of mass `m` (kg), as a jaximpact law
     (`kelvin_voigt`, to be used with `separation="force"`)."""
-    from .. import law as make_law
+    from .._laws import law as make_law
 
     stiffness, damping = effective(parameters["solref"], parameters["timestep"])
     return make_law("kelvin_voigt", c=m * stiffness, b=m * damping)

@@ -395,16 +395,37 @@ def calibrate(
     )
     fit = _fit(law, data, m, np.float64(g) if g_is_zero else jnp.asarray(g, dtype=float),
                np.float64(target_tol), options)  # fmt: skip
+    return _reported(fit, undetermined, undetermined_why)
+
+
+def _reported(fit, undetermined, why):
+    """`fit` with what the data leave undetermined (a warning too), after refusing one that
+    left float64's range; under a transformation only the record."""
+    concrete = not isinstance(fit.loss, jax.core.Tracer)
+    if concrete:
+        _check_finite(fit)
     if not undetermined:
         return fit
-    if not isinstance(fit.loss, jax.core.Tracer):
+    if concrete:
         warnings.warn(
-            f"{' and '.join(undetermined)} not determined by these data ({undetermined_why}): "
+            f"{' and '.join(undetermined)} not determined by these data ({why}): "
             "their values are not estimates; give T (or more data), or hold one of them "
             "(free=...)",
-            stacklevel=2,
+            stacklevel=3,
         )
     return dataclasses.replace(fit, undetermined=undetermined)
+
+
+def _check_finite(fit):
+    """A fit whose parameters left float64's range (targets no law of this kind meets, e.g.
+    T = 1e-300 s) is refused with the values it reached, not returned."""
+    bad = {k: float(v) for k, v in fit.params.items() if not np.all(np.isfinite(v))}
+    if bad:
+        shown = ", ".join(f"{k} = {v:g}" for k, v in bad.items())
+        raise ValueError(
+            f"the fit left the range of float64 ({shown}): no {type(fit.law).__name__} of "
+            "this kind meets these targets; check their values and units (e in (0, 1], T in s)"
+        )
 
 
 def _undetermined(law, free, *, e, T, g_is_zero) -> tuple[tuple[str, ...], str]:

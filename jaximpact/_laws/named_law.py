@@ -98,6 +98,10 @@ def as_arrays(params, numbers=()):
     law is built inside `jax.jit` (where `jnp.asarray` of a constant is a traced value)."""
     arrays = {}
     for key, value in params.items():
+        if isinstance(value, (str, bytes)) or value is None:
+            raise TypeError(
+                f"parameter {key} must be a number or an array of numbers, got {value!r}"
+            )
         if key in numbers and isinstance(value, (int, float, np.number, np.ndarray)):
             arrays[key] = np.asarray(value, dtype=jnp.result_type(float))
         else:

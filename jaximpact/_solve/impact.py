@@ -1,8 +1,12 @@
 """One impact: read off the universal curves, taken from a closed form, or integrated
 with diffrax and ended by events (`_integrate`, imported only when needed)."""
 
+import math
+
 import equinox as eqx
+import jax
 import jax.numpy as jnp
+import numpy as np
 
 from .._checks import check_nonnegative, check_positive
 from .._curves.shapes import CurveKey, curve_key
@@ -74,6 +78,20 @@ def solve_impact(law, m, v0, g, ts, options: ImpactOptions) -> ImpactResult:
     )
 
 
+def _check_representable(result, m, v0):
+    """A separated impact whose duration or restitution float64 cannot hold (its scales
+    under- or overflow, e.g. v0 = 1e-300 m/s) is refused, not returned as T = 0."""
+    if isinstance(result.T, jax.core.Tracer) or np.ndim(result.T) != 0:
+        return
+    separated = int(result.status) == Status.separated
+    if separated and not (float(result.T) > 0 and np.isfinite(float(result.T))
+                          and np.isfinite(float(result.e))):  # fmt: skip
+        raise ValueError(
+            f"m = {float(m):g} kg, v0 = {float(v0):g} m/s put the contact's scales outside "
+            f"float64's range (T = {float(result.T):g} s): express the inputs in other units"
+        )
+
+
 def _check_options(*, rtol, atol, rest_tol, max_steps, tau_max):
     """One-line errors for options outside their range (before anything is traced)."""
     for name, value in (("rtol", rtol), ("atol", atol), ("rest_tol", rest_tol)):
@@ -83,8 +101,12 @@ def _check_options(*, rtol, atol, rest_tol, max_steps, tau_max):
             raise ValueError(f"{name} must be a number in (0, 1), got {value!r}")
     if isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps < 1:
         raise ValueError(f"max_steps must be a positive integer, got {max_steps!r}")
-    if isinstance(tau_max, bool) or not isinstance(tau_max, (int, float)) or not tau_max > 0:
-        raise ValueError(f"tau_max must be a number > 0 (units of t*), got {tau_max!r}")
+    if (
+        isinstance(tau_max, bool)
+        or not isinstance(tau_max, (int, float))
+        or not (tau_max > 0 and math.isfinite(tau_max))
+    ):
+        raise ValueError(f"tau_max must be a finite number > 0 (units of t*), got {tau_max!r}")
 
 
 def similarity_reason(law, separation: str, *, g_is_zero: bool = True, ts=None) -> str | None:
@@ -238,6 +260,7 @@ def impact(
         similarity=key,
     )
     result = solve_impact(law, m, v0, g, ts, options)
+    _check_representable(result, m, v0)
     if throw:
         result = eqx.error_if(
             result,
