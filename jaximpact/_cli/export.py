@@ -115,7 +115,10 @@ def add_engine_e(subparsers):
         '"coeff_restitution": e, "poisson": nu, "limit_damping": false} for '
         "hertz/material with damping coeff_restitution; Drake "
         '{"point_contact_stiffness": N/m, "hunt_crossley_dissipation": s/m}), the e and T '
-        "of the continuous law the engine integrates, at each --speed.",
+        "of the continuous law the engine integrates, at each --speed, and beside them what "
+        "the engine's time stepping realises (MuJoCo at its timestep; LAMMPS when "
+        '"timestep" is given; the mean over where first touch falls inside a step, with the '
+        "range of e). Drake's discrete solver is not modelled: its continuous plant only.",
         example="jaximpact engine-e --engine mujoco --params '{\"solref\": [0.02, 1]}' "
         "--mass 0.05 --speed 0.5 1 2",
     )
@@ -136,7 +139,7 @@ _NEEDED = {
 
 
 def _run_engine_e(args):
-    from .._engines import engine_response
+    from .._engines import engine_response, stepped_response
 
     if args.engine not in _ENGINES:
         raise CLIError(f"unknown engine {args.engine!r}; choose one of: {', '.join(_ENGINES)}")
@@ -158,6 +161,9 @@ def _run_engine_e(args):
     law, separation, e, T = engine_response(
         args.engine, params, m=args.mass, speeds=args.speed, radius=args.radius
     )
+    stepped = stepped_response(
+        args.engine, params, m=args.mass, speeds=args.speed, radius=args.radius
+    )
     data = {
         "engine": args.engine,
         "law": {"name": law.name, "parameters": {k: float(v) for k, v in law.parameters.items()}},
@@ -165,10 +171,26 @@ def _run_engine_e(args):
         "speeds": list(args.speed),
         "e": list(e),
         "T": list(T),
+        "stepped": None
+        if stepped is None
+        else dict(zip(("timestep", "e", "T", "e_min", "e_max"), stepped, strict=True)),
     }
-    lines = [f"{args.engine}: law {law.name} ({separation} criterion)", "speed (m/s)   e   T (s)"]
-    lines += [
-        f"  {format_number(v):>9}   {ei:.5g}   {Ti:.5g}"
-        for v, ei, Ti in zip(args.speed, e, T, strict=True)
-    ]
+    lines = [f"{args.engine}: law {law.name} ({separation} criterion)"]
+    if stepped is None:
+        lines.append("speed (m/s)   e   T (s)   (continuous law)")
+        lines += [
+            f"  {format_number(v):>9}   {ei:.5g}   {Ti:.5g}"
+            for v, ei, Ti in zip(args.speed, e, T, strict=True)
+        ]
+    else:
+        h, e_s, T_s, e_lo, e_hi = stepped
+        lines.append(
+            f"speed (m/s)   e   T (s)   (continuous law) | e   T (s)   e range   "
+            f"(stepped at {format_number(h)} s)"
+        )
+        lines += [
+            f"  {format_number(v):>9}   {e[i]:.5g}   {T[i]:.5g} | {e_s[i]:.5g}   {T_s[i]:.5g}   "
+            f"{e_lo[i]:.5g}-{e_hi[i]:.5g}"
+            for i, v in enumerate(args.speed)
+        ]
     emit(args, data, "\n".join(lines))

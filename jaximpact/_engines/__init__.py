@@ -6,6 +6,7 @@ from .export import (
     Export as Export,
     engine_response as engine_response,
     export as export,
+    stepped_response as stepped_response,
 )
 from .materials import (
     effective_mass as effective_mass,

@@ -263,3 +263,42 @@ def engine_response(engine: str, parameters: dict, *, m, speeds, radius=None):
         separation, m_engine = "force", m
     e, T = _curve(law, m_engine, speeds, separation)
     return law, separation, e, T
+
+
+def stepped_response(engine: str, parameters: dict, *, m, speeds, radius=None):
+    """What the engine's own time stepping realises with `parameters` at each speed (m/s):
+    `(timestep, e, T, e_min, e_max)`, e and T the mean over where the first touch falls
+    inside a step and `e_min`, `e_max` their extremes; `None` where the step is not known
+    or not modelled: LAMMPS without a `timestep`, and Drake (its continuous plant; the
+    discrete solver's own damping is not modelled)."""
+    m = check_positive("m", m, "kg")
+    speeds = [check_positive("speed", v, "m/s") for v in np.atleast_1d(speeds)]
+    if engine == "mujoco":
+        h = check_positive("timestep", parameters.get("timestep", 0.002), "s")
+
+        def run(v):
+            return mujoco.replica(parameters["solref"], h, v)
+
+    elif engine == "lammps" and parameters.get("timestep") is not None:
+        h = check_positive("timestep", parameters["timestep"], "s")
+        law = engine_response(engine, parameters, m=m, speeds=speeds[:1], radius=radius)[0]
+        stepping = dict(
+            k=float(law.parameters["c"]),
+            b=float(law.parameters["b"]),
+            limit_damping=bool(parameters.get("limit_damping", False)),
+            timestep=h,
+        )
+
+        def run(v):
+            return lammps.replica(stepping, m, v)
+
+    else:
+        return None
+    runs = [run(v) for v in speeds]
+    return (
+        h,
+        [float(np.mean(es)) for es, _ in runs],
+        [float(np.mean(Ts)) for _, Ts in runs],
+        [float(np.min(es)) for es, _ in runs],
+        [float(np.max(es)) for es, _ in runs],
+    )
