@@ -394,3 +394,66 @@ def test_engine_e_stepped_response_is_what_mujoco_realises():
     es, Ts = mujoco_engine.simulate(x.parameters, 1.0, m=0.05, phases=np.linspace(0.05, 0.95, 10))
     assert h == x.parameters["timestep"]
     assert abs(e_s[0] / np.mean(es) - 1) < 0.005 and abs(T_s[0] / np.mean(Ts) - 1) < 0.005
+
+
+def _documented_hertz_impact(E, nu, restitution, *, m, radius, v0, clamp):
+    """Two equal spheres under the Hertz law with restitution-based damping as LIGGGHTS
+    (gran_model_hertz doc) and Chrono (ChContactSMC.h) write it, integrated by scipy:
+    `F = 4/3 Y* sqrt(R* d) d + 2 sqrt(5/6) (-beta) sqrt(S_n m*) v`, `S_n = 2 Y* sqrt(R* d)`,
+    clamped at 0 when `clamp`. Returns `(e, T)`, T while the force is positive (clamped) or
+    while the spheres overlap."""
+    from scipy.integrate import solve_ivp
+
+    Y = E / (2 * (1 - nu**2))
+    R, mass = radius / 2, m / 2
+    beta = math.log(restitution) / math.sqrt(math.log(restitution) ** 2 + math.pi**2)
+
+    def raw_force(d, v):
+        Sn = 2 * Y * math.sqrt(R * max(d, 0.0))
+        return 2.0 / 3.0 * Sn * d - 2 * math.sqrt(5 / 6) * beta * math.sqrt(Sn * mass) * v
+
+    def force(d, v):
+        f = raw_force(d, v)
+        return max(f, 0.0) if clamp else f
+
+    def rhs(t, y):
+        return [y[1], -force(y[0], y[1]) / mass]
+
+    t_scale = (mass * v0**2 / (4 / 3 * Y * math.sqrt(R))) ** 0.4 / v0
+
+    def end(t, y):
+        return raw_force(y[0], y[1]) if clamp and t > 1e-3 * t_scale else y[0]
+
+    end.terminal, end.direction = True, -1
+    sol = solve_ivp(rhs, (0, 100 * t_scale), [0.0, v0], method="DOP853", rtol=1e-12,
+                    atol=[1e-14 * v0 * t_scale, 1e-14 * v0], events=end)  # fmt: skip
+    return -sol.y_events[0][0][1] / v0, sol.t_events[0][0]
+
+
+@pytest.mark.parametrize("e", [0.3, 0.8])
+def test_liggghts_and_chrono_exports_meet_their_documented_laws(e):
+    """The exported Young's modulus and restitution, fed to the engines' documented force
+    (an independent scipy integration), give the asked e and T: LIGGGHTS (overlap ends the
+    contact: the coefficient is the e) to 1e-7; Chrono (force clamped at 0: the export
+    inverts it) to 1e-6; each export's promise within 0.5 % of the target."""
+    m, radius, v0, T = 0.004, 0.005, 1.0, 1e-3
+    x = ji.export(None, "liggghts", m=m, v0=v0, e=e, T=T, radius=radius, curves=False)
+    got_e, got_T = _documented_hertz_impact(
+        x.parameters["youngs_modulus"], 0.3, x.parameters["coeff_restitution"],
+        m=m, radius=radius, v0=v0, clamp=False,
+    )  # fmt: skip
+    assert abs(got_e - e) < 1e-7 and abs(got_T / T - 1) < 1e-7
+    assert abs(x.e / e - 1) < 0.005 and "coefficientRestitution" in x.snippet
+    y = ji.export(None, "chrono", m=m, v0=v0, e=e, T=T, radius=radius, curves=False)
+    got_e, got_T = _documented_hertz_impact(
+        y.parameters["SetYoungModulus"], 0.3, y.parameters["SetRestitution"],
+        m=m, radius=radius, v0=v0, clamp=True,
+    )  # fmt: skip
+    assert abs(got_e - e) < 1e-6 and abs(got_T / T - 1) < 1e-6
+    assert y.parameters["SetRestitution"] < e  # the clamp raises e: a lower cr is asked
+    assert any("not replicated" in w for w in y.warnings)
+
+
+def test_chrono_cannot_go_below_its_clamped_floor():
+    with pytest.raises(ValueError, match="cannot realise e = 0.05"):
+        ji.export(None, "chrono", m=0.004, v0=1.0, e=0.05, T=1e-3, radius=0.005)

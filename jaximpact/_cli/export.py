@@ -12,7 +12,7 @@ from .common import (
     parse_params,
 )
 
-_ENGINES = ("mujoco", "lammps", "drake")
+_ENGINES = ("mujoco", "lammps", "drake", "liggghts", "chrono")
 
 
 def add_export(subparsers):
@@ -30,7 +30,9 @@ def add_export(subparsers):
         "jaximpact export --engine lammps --law hertz_rate --param c=2e6 b1=800 "
         "--mass 1 --v0 2.5 --radius 0.02 --json",
     )
-    parser.add_argument("--engine", required=True, metavar="NAME", help="mujoco, lammps or drake")
+    parser.add_argument(
+        "--engine", required=True, metavar="NAME", help="mujoco, lammps, drake, liggghts or chrono"
+    )
     parser.add_argument("--law", metavar="NAME", help="a law of 'jaximpact laws'")
     parser.add_argument("--param", action="extend", nargs="+", default=[], metavar="NAME=VALUE")
     parser.add_argument("--e", type=float, help="target restitution in (0, 1] (without --law)")
@@ -113,7 +115,9 @@ def add_engine_e(subparsers):
         '(MuJoCo {"solref": [timeconst, dampratio], "timestep": s} (default step 0.002 s, '
         'for its refsafe rule); LAMMPS {"E": Pa, '
         '"coeff_restitution": e, "poisson": nu, "limit_damping": false} for '
-        "hertz/material with damping coeff_restitution; Drake "
+        "hertz/material with damping coeff_restitution, and the same keys for LIGGGHTS "
+        "(limit_damping: its limitForce) and Chrono (its Young's modulus, restitution and "
+        "Poisson ratio; its force is always kept non-attractive); Drake "
         '{"point_contact_stiffness": N/m, "hunt_crossley_dissipation": s/m}), the e and T '
         "of the continuous law the engine integrates, at each --speed, and beside them what "
         "the engine's time stepping realises (MuJoCo at its timestep; LAMMPS when "
@@ -122,7 +126,9 @@ def add_engine_e(subparsers):
         example="jaximpact engine-e --engine mujoco --params '{\"solref\": [0.02, 1]}' "
         "--mass 0.05 --speed 0.5 1 2",
     )
-    parser.add_argument("--engine", required=True, metavar="NAME", help="mujoco, lammps or drake")
+    parser.add_argument(
+        "--engine", required=True, metavar="NAME", help="mujoco, lammps, drake, liggghts or chrono"
+    )
     parser.add_argument("--params", required=True, metavar="JSON", help="engine parameters")
     parser.add_argument("--mass", type=float, default=1.0, metavar="KG", help="mass, kg")
     parser.add_argument("--speed", type=float, nargs="+", required=True, metavar="M/S")
@@ -135,6 +141,8 @@ _NEEDED = {
     "mujoco": ("solref",),
     "lammps": ("E", "coeff_restitution"),
     "drake": ("point_contact_stiffness", "hunt_crossley_dissipation"),
+    "liggghts": ("E", "coeff_restitution"),
+    "chrono": ("E", "coeff_restitution"),
 }
 
 

@@ -6,10 +6,19 @@ import math
 
 import numpy as np
 
-from . import drake, lammps, mujoco
+from . import chrono, drake, lammps, liggghts, mujoco
 from .materials import check_positive, check_restitution
 
-ENGINES = {"mujoco": mujoco, "lammps": lammps, "drake": drake}
+ENGINES = {
+    "mujoco": mujoco,
+    "lammps": lammps,
+    "drake": drake,
+    "liggghts": liggghts,
+    "chrono": chrono,
+}
+# engines whose scene is two equal spheres head-on (effective mass m/2) and whose law is the
+# Tsuji form from Young's modulus, Poisson's ratio and a restitution coefficient
+TWO_SPHERES = ("lammps", "liggghts", "chrono")
 _SPEED_FACTORS = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0)
 
 
@@ -108,12 +117,13 @@ def export(
     limit_damping: bool = False,
     curves: bool = True,
 ) -> Export:
-    """Parameters for `engine` (`"mujoco"`, `"drake"`, `"lammps"`) that realise the e and T of
-    `law_or_fit` (a law or `calibrate`'s fit) for mass `m` (kg) at impact speed `v0` (m/s), or
-    the targets `e` and `T` (s) when `law_or_fit` is None.
+    """Parameters for `engine` (`"mujoco"`, `"drake"`, `"lammps"`, `"liggghts"`, `"chrono"`)
+    that realise the e and T of `law_or_fit` (a law or `calibrate`'s fit) for mass `m` (kg)
+    at impact speed `v0` (m/s), or the targets `e` and `T` (s) when `law_or_fit` is None.
 
-    The scene: MuJoCo and Drake, a body of mass `m` on a fixed plane; LAMMPS, two spheres each
-    of mass `m` and radius `radius` (m, required) colliding head-on at relative speed `v0`
+    The scene: MuJoCo and Drake, a body of mass `m` on a fixed plane; LAMMPS, LIGGGHTS and
+    Chrono, two spheres each of mass `m` and radius `radius` (m, required) colliding head-on at
+    relative speed `v0` (LIGGGHTS and Chrono by their documented formulas, not run here)
     (`poisson`: their Poisson's ratio, default 0.3; `limit_damping`: keep the force
     non-attractive). `timestep` (s): the engine's step if already chosen (the export then
     corrects for it where it can and warns where it cannot); default, a recommended step.
@@ -161,13 +171,13 @@ def export(
         out = mujoco.design(target_e, target_T, v0, timestep)
         separation = "force"
         h = out["parameters"]["timestep"]
-    elif engine == "lammps":
+    elif engine in TWO_SPHERES:
         if radius is None:
-            raise ValueError("LAMMPS needs the spheres' radius: pass radius= (m)")
+            raise ValueError(f"{engine} needs the spheres' radius: pass radius= (m)")
         radius = check_positive("radius", radius, "m")
         if target_T is None:
-            raise ValueError("LAMMPS needs a contact duration: pass T= (s) or a law")
-        out = lammps.design(
+            raise ValueError(f"{engine} needs a contact duration: pass T= (s) or a law")
+        out = module.design(
             target_e,
             target_T,
             m=m,
@@ -178,7 +188,7 @@ def export(
             limit_damping=limit_damping,
         )
         separation = out["separation"]
-        h = out["parameters"]["timestep_s"]
+        h = out["parameters"].get("timestep_s", out["parameters"].get("time_step"))
     else:
         if target_T is None:
             raise ValueError("Drake needs a contact duration: pass T= (s) or a law")
@@ -188,7 +198,7 @@ def export(
     warnings += out["warnings"]
     # the law each side realises; LAMMPS's promise is for the pair (effective mass m/2)
     engine_law = module.law(out["parameters"], m)
-    m_engine = m / 2.0 if engine == "lammps" else m
+    m_engine = m / 2.0 if engine in TWO_SPHERES else m
     speeds, e_engine, T_engine, e_target, T_target = (), (), (), None, None
     if curves:
         speeds = tuple(v0 * f for f in _SPEED_FACTORS)
@@ -238,9 +248,9 @@ def engine_response(engine: str, parameters: dict, *, m, speeds, radius=None):
     if engine == "mujoco":
         params = {"solref": parameters["solref"], "timestep": parameters.get("timestep", 0.002)}
         law, separation, m_engine = mujoco.law(params, m), "force", m
-    elif engine == "lammps":
+    elif engine in TWO_SPHERES:
         if radius is None:
-            raise ValueError("LAMMPS needs the spheres' radius: pass radius= (m)")
+            raise ValueError(f"{engine} needs the spheres' radius: pass radius= (m)")
         radius = check_positive("radius", radius, "m")
         E = check_positive("E", parameters["E"], "Pa")
         from .materials import check_poisson, hertz_stiffness
@@ -248,11 +258,16 @@ def engine_response(engine: str, parameters: dict, *, m, speeds, radius=None):
         nu = check_poisson("poisson", parameters.get("poisson", 0.3))
         coefficient = check_restitution(parameters["coeff_restitution"], "coeff_restitution")
         c = hertz_stiffness(E, nu, radius, R2=radius)
-        b = lammps._damp(coefficient) * math.sqrt(m / 2.0 * c) if coefficient < 1 else 0.0
+        b = (
+            lammps.damp_coefficient(coefficient) * math.sqrt(m / 2.0 * c)
+            if coefficient < 1
+            else 0.0
+        )
         from .._laws import law as make_law
 
         law = make_law("tsuji", c=c, b=b)
-        separation = "force" if parameters.get("limit_damping") else "penetration"
+        clamped = parameters.get("limit_damping") or engine == "chrono"
+        separation = "force" if clamped else "penetration"
         m_engine = m / 2.0
     else:
         k = check_positive("point_contact_stiffness", parameters["point_contact_stiffness"], "N/m")

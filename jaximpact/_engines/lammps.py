@@ -31,7 +31,7 @@ SCENE = (
 _E_RANGE_TOL = 0.002
 
 
-def _impact(e_coefficient: float, separation: str):
+def impact_at_unit_scales(e_coefficient: float, separation: str):
     """`(e, tau)` of the Tsuji-form law at `c = m_eff = v0 = 1` (tau: T in units of
     `t* = (m_eff v0^2/c)^(2/5) / v0`), from jaximpact's solver."""
     from .._laws import law
@@ -50,13 +50,15 @@ def coefficient_for(e: float, limit_damping: bool) -> float:
     """The `coeff_restitution` value that realises `e`."""
     if not limit_damping or e >= 1.0:
         return e
-    floor = _impact(1e-12, "force")[0]
+    floor = impact_at_unit_scales(1e-12, "force")[0]
     if e <= floor:
         raise ValueError(
             f"LAMMPS with limit_damping cannot realise e = {e:g}: coeff_restitution -> 0 gives "
             f"e = {floor:.4g} (drop limit_damping to reach lower values)"
         )
-    return brentq(lambda q: _impact(q, "force")[0] - e, 1e-12, 1.0, xtol=1e-13, rtol=1e-12)
+    return brentq(
+        lambda q: impact_at_unit_scales(q, "force")[0] - e, 1e-12, 1.0, xtol=1e-13, rtol=1e-12
+    )
 
 
 def acceleration(c: float, b: float, m_eff: float, limit_damping: bool):
@@ -67,7 +69,7 @@ def acceleration(c: float, b: float, m_eff: float, limit_damping: bool):
     return accel
 
 
-def _damp(e: float) -> float:
+def damp_coefficient(e: float) -> float:
     log_e = math.log(e)
     return math.sqrt(5.0) * -log_e / math.sqrt(math.pi**2 + log_e**2)
 
@@ -79,7 +81,7 @@ def replica(parameters, m: float, v0: float, phases=_stepping.PHASES):
     )
 
 
-def _nice_down(h: float) -> float:
+def nice_down(h: float) -> float:
     scale = 10.0 ** math.floor(math.log10(h))
     return float(f"{math.floor(h / scale * 10.0 * (1 + 1e-12)) / 10.0 * scale:.2g}")
 
@@ -88,17 +90,17 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Fal
     warnings = []
     separation = "force" if limit_damping else "penetration"
     coefficient = coefficient_for(e, limit_damping)
-    _, tau = _impact(coefficient, separation)
+    _, tau = impact_at_unit_scales(coefficient, separation)
     m_eff, R_eff = m / 2.0, radius / 2.0
     c = m_eff * v0**2 * (tau / (T * v0)) ** 2.5
     E = c * 3.0 / (4.0 * math.sqrt(R_eff)) * 2.0 * (1.0 - poisson**2)
     assert abs(hertz_stiffness(E, poisson, radius, R2=radius) / c - 1) < 1e-12
-    b = _damp(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
+    b = damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
     params = dict(k=c, b=b, limit_damping=limit_damping)
     if timestep is None:
         steps = 100
         while True:
-            params["timestep"] = _nice_down(T / steps)
+            params["timestep"] = nice_down(T / steps)
             es, Ts = replica(params, m, v0)
             ok_e = (es.max() - es.min()) / 2 <= _E_RANGE_TOL * es.mean()
             ok_bias = abs(es.mean() / e - 1) < 0.001 and abs(Ts.mean() / T - 1) < 0.001
@@ -113,7 +115,7 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Fal
         warnings.append(
             f"timestep {h:.3g} s gives {Ts.mean() / h:.0f} steps per contact: LAMMPS realises "
             f"e = {es.min():.4g} to {es.max():.4g} (asked {e:.4g}); "
-            f"use {_nice_down(T / 400):.3g} s "
+            f"use {nice_down(T / 400):.3g} s "
             "or less"
         )
     extra = " limit_damping" if limit_damping else ""
