@@ -5,6 +5,7 @@ discrete contact approximations (real Drake, sphere on a half space, gravity off
     python benchmarks/drake_discrete.py    # writes benchmarks/drake_discrete.md
 """
 
+import importlib.metadata
 import os
 import platform
 import sys
@@ -26,12 +27,12 @@ APPROXIMATIONS = ("tamsi", "sap", "lagged", "similar")
 
 
 def main():
-    import pydrake
+
 
     lines = [
         "# Drake's discrete plant against the continuous promise",
         "",
-        f"Drake {pydrake.__version__ if hasattr(pydrake, '__version__') else '(wheel)'}, "
+        f"Drake {importlib.metadata.version('drake')}, "
         f"Python {platform.python_version()}, {platform.machine()}; `python "
         "benchmarks/drake_discrete.py`. A sphere of 1 kg on a half space at 1 m/s, gravity "
         f"off; the export's parameters for the target e and T = {T:g} s (the continuous plant "
