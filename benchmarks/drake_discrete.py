@@ -28,12 +28,12 @@ APPROXIMATIONS = ("tamsi", "sap", "lagged", "similar")
 
 def main():
 
-
     lines = [
         "# Drake's discrete plant against the continuous promise",
         "",
         f"Drake {importlib.metadata.version('drake')}, "
-        f"Python {platform.python_version()}, {platform.machine()} ({os.cpu_count()} cores); `python "
+        f"Python {platform.python_version()}, {platform.machine()} ({os.cpu_count()} cores); "
+        "`python "
         "benchmarks/drake_discrete.py`. A sphere of 1 kg on a half space at 1 m/s, gravity "
         f"off; the export's parameters for the target e and T = {T:g} s (the continuous plant "
         "realises them to 1e-9). Each cell: the e Drake realises (relative error).",
