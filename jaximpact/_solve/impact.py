@@ -2,6 +2,7 @@
 with diffrax and ended by events (`_integrate`, imported only when needed)."""
 
 import math
+import warnings
 
 import equinox as eqx
 import jax
@@ -89,6 +90,25 @@ def _check_representable(result, m, v0):
         raise ValueError(
             f"m = {float(m):g} kg, v0 = {float(v0):g} m/s put the contact's scales outside "
             f"float64's range (T = {float(result.T):g} s): express the inputs in other units"
+        )
+
+
+def _warn_if_pulling(law, v0):
+    """A user's law whose force pulls the body in at first touch (`F(0, v0) < 0`) is not a
+    contact force law: what `impact` returns then (mostly a contact that never ends) is said
+    to be so, not left as a plain number."""
+    if getattr(law, "spec", None) is not None or isinstance(v0, jax.core.Tracer):
+        return
+    try:
+        force = float(law.force(0.0, v0))
+    except (TypeError, ValueError, jax.errors.ConcretizationTypeError):
+        return
+    if force < 0:
+        warnings.warn(
+            f"the law pulls the body in at first touch (F(x = 0, v = {float(v0):g} m/s) = "
+            f"{force:.4g} N < 0): a contact force pushes (F >= 0); read e and T as those of "
+            "an unphysical law",
+            stacklevel=3,
         )
 
 
@@ -261,6 +281,7 @@ def impact(
     )
     result = solve_impact(law, m, v0, g, ts, options)
     _check_representable(result, m, v0)
+    _warn_if_pulling(law, v0)
     if throw:
         result = eqx.error_if(
             result,

@@ -7,6 +7,7 @@ import os
 import subprocess
 import sys
 import textwrap
+import warnings
 
 import jax
 import jax.numpy as jnp
@@ -522,3 +523,16 @@ def test_float32_without_x64():
             assert math.isfinite(r[key]), (label, key)
             # measured: 1.2e-6 (hertz_rate e); float32 eps is 1.2e-7
             assert rel_err(r[key], ref[key]) < 1e-4, (label, key, rel_err(r[key], ref[key]))
+
+
+def test_a_custom_law_that_pulls_is_said_to_be_unphysical():
+    """A user's law with F(0, v0) < 0 (it pulls the body in at first touch) gets a warning
+    with the force it gave; it once returned e = 4.12 as if it were a result."""
+    pull = ji.custom_law(lambda x, v, p: p["k"] * x - p["d"] * v, k=2e6, d=4e4)
+    with pytest.warns(UserWarning, match=r"pulls the body in .* -1e\+05 N"):
+        result = ji.impact(pull, m=1.0, v0=2.5)
+    assert int(result.status) != ji.Status.separated or float(result.e) <= 1.0
+    push = ji.custom_law(lambda x, v, p: p["k"] * x + p["d"] * v, k=2e6, d=400.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ji.impact(push, m=1.0, v0=2.5)
