@@ -57,6 +57,8 @@ _PUBLIC = {
     "impact_batch": "_batch",
     "run_batch": "_batch",
     "write_table": "_batch",
+    "batch_file": "_batch.files",
+    "BatchFile": "_batch.files",
     # studies
     "bumper_design": "_studies.bumper",
     "drop_design": "_studies.drop",

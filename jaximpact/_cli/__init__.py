@@ -12,6 +12,7 @@ import argparse
 import os
 import sys
 
+from .batch import add_batch
 from .bench import add_bench
 from .calibrate import add_calibrate
 from .common import DEBUG_ENV, PROG, CLIError, Parser, configure_jax, fail, wrap_paragraphs
@@ -28,6 +29,7 @@ COMMANDS = [
     ("calibrate", add_calibrate),
     ("paper", add_paper),
     ("bench", add_bench),
+    ("batch", add_batch),
     ("export", add_export),
     ("engine-e", add_engine_e),
 ]
