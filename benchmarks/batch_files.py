@@ -1,0 +1,112 @@
+"""`batch_file` (a CSV of bodies streamed in chunks) against `impact_batch` on the same rows in
+memory: rows per second, the share of reading and writing, and peak memory per file size.
+
+    python benchmarks/batch_files.py     # writes benchmarks/batch_files.md
+
+Each size runs in a fresh process (peak resident memory from `resource`), twice: the first
+call compiles, the second is timed. Curves path (law 14 without gravity, chunks of 100,000).
+"""
+
+import json
+import os
+import platform
+import resource
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, ".."))
+SIZES = (10_000, 100_000, 1_000_000)
+
+
+def child(mode: str, n: int, folder: str):
+    """One measurement in this fresh process: `make` writes the file, `file` times
+    `batch_file`, `memory` times `impact_batch` on the same rows; prints JSON."""
+    import jax
+
+    jax.config.update("jax_enable_x64", True)
+    import numpy as np
+
+    import jaximpact as ji
+
+    source = os.path.join(folder, f"bodies-{n}.csv")
+    if mode == "make":
+        rng = np.random.default_rng(0)
+        columns = [rng.uniform(1e6, 3e6, n), rng.uniform(100.0, 2000.0, n),
+                   rng.uniform(0.5, 2.0, n), rng.uniform(0.5, 5.0, n)]  # fmt: skip
+        with open(source, "w") as handle:
+            handle.write("c,b1,m,v0\n")
+            for row in zip(*columns, strict=True):
+                handle.write(",".join(repr(float(x)) for x in row) + "\n")
+        print(json.dumps(dict(size_mib=os.path.getsize(source) / 2**20)))
+        return
+    if mode == "file":
+        out = os.path.join(folder, f"impacts-{n}.csv")
+        ji.batch_file(source, out, "hertz_rate", progress=False)  # compiles
+        start = time.perf_counter()
+        ji.batch_file(source, out, "hertz_rate", progress=False)
+    else:
+        table = np.loadtxt(source, delimiter=",", skiprows=1)
+        params = {"c": table[:, 0], "b1": table[:, 1]}
+        ji.impact_batch("hertz_rate", params, m=table[:, 2], v0=table[:, 3], progress=False)
+        start = time.perf_counter()
+        ji.impact_batch("hertz_rate", params, m=table[:, 2], v0=table[:, 3], progress=False)
+    seconds = time.perf_counter() - start
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # MiB on Linux
+    print(json.dumps(dict(seconds=seconds, peak_mib=peak)))
+
+
+def _run(mode, n, folder):
+    done = subprocess.run(
+        [sys.executable, __file__, "--child", mode, str(n), folder],
+        capture_output=True, text=True, check=True,
+    )  # fmt: skip
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def main():
+    import tempfile
+
+    rows = []
+    with tempfile.TemporaryDirectory() as folder:
+        for n in SIZES:
+            made, file, memory = (_run(mode, n, folder) for mode in ("make", "file", "memory"))
+            rows.append(dict(n=n, size_mib=made["size_mib"], file_s=file["seconds"],
+                             memory_s=memory["seconds"], peak_mib=file["peak_mib"],
+                             memory_peak_mib=memory["peak_mib"]))  # fmt: skip
+            print(rows[-1], flush=True)
+    load = os.getloadavg()[0]
+    lines = [
+        "# Many bodies from a file: `batch_file` against `impact_batch` in memory",
+        "",
+        f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, no "
+        f"accelerator, load {load:.1f}; `python benchmarks/batch_files.py`. Law 14 on the "
+        "curves (no gravity), chunks of 100,000 rows, second call timed.",
+        "",
+        "| rows | input file (MiB) | batch_file (s) | rows/s | impact_batch in memory (s) | "
+        "reading and writing (share) | batch_file peak memory (MiB) | in memory peak (MiB) |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        share = 1 - r["memory_s"] / r["file_s"]
+        lines.append(
+            f"| {r['n']:,} | {r['size_mib']:.1f} | {r['file_s']:.2f} | "
+            f"{r['n'] / r['file_s']:,.0f} | {r['memory_s']:.3f} | {share:.0%} | "
+            f"{r['peak_mib']:.0f} | {r['memory_peak_mib']:.0f} |"
+        )
+    lines += [
+        "",
+        "Each column is its own process: peak memory is that process's resident maximum "
+        "(the JAX runtime included). `batch_file` holds one chunk at a time; the in-memory "
+        "call holds every row.",
+    ]
+    with open(os.path.join(HERE, "batch_files.md"), "w") as handle:
+        handle.write("\n".join(lines) + "\n")
+
+
+if __name__ == "__main__":
+    if len(sys.argv) > 1 and sys.argv[1] == "--child":
+        child(sys.argv[2], int(sys.argv[3]), sys.argv[4])
+    else:
+        main()
