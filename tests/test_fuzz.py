@@ -19,7 +19,7 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 import jaximpact as ji
 
 FAST = settings(
-    max_examples=25,
+    max_examples=12,
     deadline=None,
     # capsys is read and reset by every example (`run_cli`), so sharing it is safe
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
@@ -134,7 +134,7 @@ def test_impact_options_out_of_range_are_refused(option, value):
 # ----------------------------------------------------------------------------- closed forms
 
 
-@FAST
+@settings(FAST, max_examples=6)  # each alpha is its own root solve (0.2 s)
 @given(alpha=st.floats(min_value=1e-12, max_value=1e6))
 def test_hunt_crossley_restitution_for_every_alpha(alpha):
     """e(alpha) in (0, 1), decreasing, for every alpha > 0 (its bracket once failed for

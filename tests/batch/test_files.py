@@ -142,9 +142,9 @@ def test_cli_batch(capsys, tmp_path):
     _bodies(tmp_path / "in.csv", n=20)
     out = tmp_path / "out.csv"
     argv = ["batch", str(tmp_path / "in.csv"), "--law", "hertz_rate", "--out", str(out)]
-    status, text, err = run_cli(capsys, [*argv, "--g", "9.81", "--chunk-rows", "8"])
+    status, text, err = run_cli(capsys, [*argv, "--chunk-rows", "8"])
     assert status == 0 and "20 impacts written" in text and "3 chunks computed" in text
-    assert set(_read(out)["path"]) == {"integrated"}
+    assert set(_read(out)["path"]) == {"similarity"}
     (tmp_path / "bad.csv").write_text("c,b1,m,v0\n2e6,800,1,oops\n")
     result = run_cli(capsys, ["batch", str(tmp_path / "bad.csv"), "--law", "hertz_rate",
                               "--out", str(tmp_path / "o.csv")])  # fmt: skip

@@ -527,12 +527,11 @@ def test_float32_without_x64():
 
 def test_a_custom_law_that_pulls_is_said_to_be_unphysical():
     """A user's law with F(0, v0) < 0 (it pulls the body in at first touch) gets a warning
-    with the force it gave; it once returned e = 4.12 as if it were a result."""
+    with the force it gave; it once returned e = 4.12 as if it were a result. The same
+    function pushing (d < 0) gets none (one compiled law for both)."""
     pull = ji.custom_law(lambda x, v, p: p["k"] * x - p["d"] * v, k=2e6, d=4e4)
     with pytest.warns(UserWarning, match=r"pulls the body in .* -1e\+05 N"):
-        result = ji.impact(pull, m=1.0, v0=2.5)
-    assert int(result.status) != ji.Status.separated or float(result.e) <= 1.0
-    push = ji.custom_law(lambda x, v, p: p["k"] * x + p["d"] * v, k=2e6, d=400.0)
+        ji.impact(pull, m=1.0, v0=2.5, max_steps=64)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        ji.impact(push, m=1.0, v0=2.5)
+        ji.impact(pull.replace(d=-400.0), m=1.0, v0=2.5, max_steps=64)
