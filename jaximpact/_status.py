@@ -13,8 +13,9 @@ class Status(enum.IntEnum):
       which the integration gave up, see `impact`).
     - `out_of_steps`: the solver used `max_steps` before the contact ended.
     - `invalid`: a row of a batch whose inputs were refused (not finite, or out of range:
-      a mass, speed or stiffness <= 0, a negative damping); it has no result (NaN) while
-      the other rows have theirs (`impact_batch`).
+      a mass, speed or stiffness <= 0, a negative damping), or whose results float64
+      cannot hold (its scales under- or overflow, e.g. v0 = 1e-300 m/s); it has no result
+      (NaN) while the other rows have theirs (`impact_batch`).
     """
 
     separated = 0

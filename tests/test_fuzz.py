@@ -9,12 +9,15 @@ checks the library agrees. The laws and shapes are fixed, so every example reuse
 compiled program; the long part is marked slow.
 """
 
+import json
 import math
+import warnings
 
+import jax.numpy as jnp
 import numpy as np
 import pytest
 from helpers import assert_one_line_error, run_cli
-from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis import HealthCheck, example, given, settings, strategies as st
 
 import jaximpact as ji
 
@@ -74,6 +77,43 @@ def test_law_takes_numbers_or_arrays_of_good_numbers_only(value):
         _one_line(error.value)
 
 
+def _refused(name: str, key: str, value: float) -> bool:
+    """DESIGN.md's rule: stiffness and exponent > 0, a nominal restitution in (0, 1], the
+    rest >= 0; Maxwell's dashpot > 0 (b = 0 carries no force: the body never stops)."""
+    if not math.isfinite(value):
+        return True
+    if key in ("c", "n") or (name == "maxwell" and key == "b"):
+        return value <= 0
+    if key == "e_nominal":
+        return not 0 < value <= 1
+    return value < 0
+
+
+@FAST
+@given(name=st.sampled_from(sorted(ji.LAW_NAMES)), which=st.integers(0, 3), value=ANY_FLOAT)
+def test_every_law_builds_or_refuses(name, which, value):
+    """One parameter of any law set to any number (the others from `starting_law`)."""
+    params = {k: float(v) for k, v in _start(name).parameters.items()}
+    key = sorted(params)[which % len(params)]
+    params[key] = value
+    if not _refused(name, key, value):
+        try:
+            built = ji.law(name, **params)
+        except ValueError as error:  # an exponent that breaks 0 <= p <= n, said so
+            _one_line(error)
+            assert key == "n" and "exponents" in str(error)
+            return
+        assert float(built.parameters[key]) == value
+    else:
+        with pytest.raises(ValueError) as error:
+            ji.law(name, **params)
+        _one_line(error.value)
+
+
+def _start(name):
+    return ji.starting_law(name, m=1.0, v0=2.5, e=0.8, T=7.8e-3)
+
+
 # ----------------------------------------------------------------------------- one impact
 
 
@@ -131,6 +171,94 @@ def test_impact_options_out_of_range_are_refused(option, value):
     _one_line(error.value)
 
 
+@settings(FAST, max_examples=6)  # one compiled solve with gravity for every example
+@given(g=ANY_FLOAT)
+@example(g=1e300)
+def test_impact_with_any_gravity_answers_or_refuses(g):
+    """Gravity along the normal: finite results (any status) or a clear refusal; g = 1e300
+    once came back as T = NaN under status captured."""
+    law = ji.law("hertz_rate", **LAW14)
+    if not (math.isfinite(g) and g >= 0):
+        with pytest.raises(ValueError) as error:
+            ji.impact(law, m=1.0, v0=2.5, g=g)
+        _one_line(error.value)
+        return
+    try:
+        r = ji.impact(law, m=1.0, v0=2.5, g=g)
+    except ValueError as error:
+        _one_line(error)
+        assert "float64" in str(error)
+        return
+    for key in ("e", "T", "x_max", "F_max", "t_max", "dissipated"):
+        assert math.isfinite(float(getattr(r, key))), (key, g)
+
+
+def test_maxwell_without_a_dashpot_is_refused():
+    """b = 0 once gave NaN results under status captured; it is a law with no force."""
+    with pytest.raises(ValueError, match="maxwell: b must be a finite number > 0"):
+        ji.law("maxwell", c=2e6, b=0.0)
+
+
+# ----------------------------------------------------------------------------- a user's law
+
+
+def _linear_with_x_damping(x, v, p):  # one module-level function: one compiled law
+    return p["k"] * x + p["d"] * x * v
+
+
+@settings(FAST, max_examples=6)
+@given(d=st.floats(min_value=-3e3, max_value=3e3))
+@example(d=-1e3)
+def test_a_custom_law_that_gives_energy_is_said_to_be_unphysical(d):
+    """F = k x + d x v: with d < 0 the law pushes the body out faster than it came (e > 1;
+    `c x^1.5 - b x^0.5 v` once gave e = 8.4 as a plain result); a warning says so. With
+    d >= 0 it takes energy: no warning, e <= 1."""
+    law = ji.custom_law(_linear_with_x_damping, k=2e6, d=d)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = ji.impact(law, m=1.0, v0=2.5)
+    said = [str(w.message) for w in caught if "gives the body energy" in str(w.message)]
+    assert int(r.status) == ji.Status.separated
+    if d >= 0:
+        assert not said and float(r.e) <= 1.0 + 1e-9
+    elif d < -10.0:
+        assert float(r.e) > 1.0 and len(said) == 1, (d, float(r.e))
+        assert f"e = {float(r.e):.4g}" in said[0]
+
+
+BAD_FUNCTIONS = {
+    "text": lambda x, v, p: "force",
+    "a vector": lambda x, v, p: p["k"] * x * jnp.ones(3),
+    "a complex number": lambda x, v, p: p["k"] * x + 1j,
+    "NaN": lambda x, v, p: p["k"] * x + jnp.nan,
+    "inf at x = 0": lambda x, v, p: p["k"] / x,
+    "a missing parameter": lambda x, v, p: p["stiffness"] * x,
+    "two arguments": lambda x, v: x,
+}
+
+
+@pytest.mark.parametrize("what", list(BAD_FUNCTIONS))
+def test_a_custom_law_whose_function_is_wrong_is_refused(what):
+    """Refused before any solve, in one line that says what the function gave."""
+    law = ji.custom_law(BAD_FUNCTIONS[what], k=2e6)
+    with pytest.raises((TypeError, ValueError)) as error:
+        ji.impact(law, m=1.0, v0=2.5)
+    _one_line(error.value)
+    assert "custom law" in str(error.value)
+
+
+@FAST
+@given(k=ANY_FLOAT)
+def test_custom_law_parameters_are_numbers(k):
+    """Any sign (the user's law decides what it means), but finite."""
+    if math.isfinite(k):
+        assert float(ji.custom_law(_linear_with_x_damping, k=k, d=1.0).parameters["k"]) == k
+    else:
+        with pytest.raises(ValueError) as error:
+            ji.custom_law(_linear_with_x_damping, k=k, d=1.0)
+        _one_line(error.value)
+
+
 # ----------------------------------------------------------------------------- closed forms
 
 
@@ -176,8 +304,34 @@ def test_batch_marks_exactly_the_bad_rows(v0):
         return
     with np.errstate(all="ignore"), pytest.warns() if bad.any() else _nothing():
         out = ji.impact_batch("hertz_rate", LAW14, m=1.0, v0=v0, progress=False)
-    np.testing.assert_array_equal(out["status"] == ji.Status.invalid, bad)
-    assert np.all(np.isnan(out["e"][bad])) and np.all(np.isfinite(out["e"][~bad]))
+    invalid = out["status"] == ji.Status.invalid
+    ordinary = (v0 >= 0.05) & (v0 <= 50.0)
+    assert np.all(invalid[bad]) and not np.any(invalid[ordinary])
+    # the others: a result, or (a speed float64 cannot carry through, 1e-300, 1e300) invalid
+    assert np.all(np.isnan(out["e"][invalid])) and np.all(np.isfinite(out["e"][~invalid]))
+
+
+EXTREME = st.sampled_from([1e-300, 1e-200, 1e-30, 2.5, 1e30, 1e200, 1e300])
+
+
+@FAST
+@given(v0=st.lists(EXTREME, min_size=3, max_size=3), c=st.lists(EXTREME, min_size=3, max_size=3))
+@example(v0=[1e-300, 2.5, 1e300], c=[2e6, 2e6, 1e300])
+def test_batch_rows_float64_cannot_hold_get_a_status(v0, c):
+    """Huge and tiny inputs (all valid numbers): each row has its result, or status invalid
+    with NaN, never a separated row with T = 0 or NaN (v0 = 1e-300 once gave T = 0)."""
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        out = ji.impact_batch(
+            "hertz_rate", {"c": np.asarray(c), "b1": 800.0}, m=1.0, v0=np.asarray(v0),
+            progress=False,
+        )  # fmt: skip
+    invalid = out["status"] == ji.Status.invalid
+    for key in ("e", "T", "x_max", "F_max"):
+        assert np.all(np.isfinite(out[key][~invalid])), (key, out)
+        assert np.all(np.isnan(out[key][invalid])), (key, out)
+    separated = out["status"] == ji.Status.separated
+    assert np.all(out["T"][separated] > 0) and np.all(out["e"][separated] <= 1.0)
 
 
 class _nothing:
@@ -245,6 +399,28 @@ def test_clean_impact_times_refuses_what_is_not_a_drop(times):
         return
     assert good, "accepted times that are not finite and increasing"
     assert np.all(np.isin(cleaned.times, array)), "the times were altered"
+
+
+@FAST
+@given(times=st.lists(st.floats(min_value=0.0, max_value=10.0), min_size=3, max_size=12))
+def test_interval_restitution_of_any_clean_drop(times):
+    """`e_k = D_{k+1} / D_k` from what `clean_impact_times` kept: positive and finite."""
+    times = sorted(set(times))
+    try:
+        cleaned = ji.clean_impact_times(times)
+    except ValueError as error:
+        _one_line(error)
+        return
+    k, e = ji.interval_restitution(cleaned)
+    assert len(k) == len(e) and np.all(np.isfinite(e)) and np.all(e > 0)
+
+
+@pytest.mark.parametrize("given_", [[0.1, 0.5, 0.8], np.array([0.1, 0.5, 0.8]), None, "0.1"])
+def test_interval_restitution_wants_cleaned_times(given_):
+    """Raw times once met an AttributeError; now a TypeError that says what to pass."""
+    with pytest.raises(TypeError, match="clean_impact_times") as error:
+        ji.interval_restitution(given_)
+    _one_line(error.value)
 
 
 # ----------------------------------------------------------------------------- materials
@@ -346,3 +522,128 @@ def test_cli_commands_never_show_a_traceback(capsys, command, args):
     if status != 0:
         assert status == 2, err
         assert len(err.strip().splitlines()) == 1, err
+
+
+@FAST
+@given(
+    params=st.dictionaries(
+        st.sampled_from(["solref", "timestep", "zz", "time_step"]),
+        st.one_of(
+            ANY_FLOAT.filter(math.isfinite),
+            st.lists(st.one_of(st.floats(0.001, 1.0), st.text(max_size=2)), max_size=3),
+            st.text(max_size=3),
+            st.booleans(),
+        ),
+        max_size=3,
+    )
+)
+@example(params={"solref": [0.02, 1.0], "time_step": 0.001})
+@example(params={"solref": ["a", 1.0]})
+def test_cli_engine_e_takes_only_what_it_reads(capsys, params):
+    """Any JSON object: an answer only where every key is one MuJoCo's reading takes and
+    every value a number (a misspelt key was once ignored, a text value a traceback)."""
+    status, out, err = run_cli(
+        capsys,
+        ["engine-e", "--engine", "mujoco", "--params", json.dumps(params), "--mass", "0.05",
+         "--speed", "1", "--json"],
+    )  # fmt: skip
+    if status != 0:
+        assert_one_line_error(status, out, err)
+        return
+    assert set(params) <= {"solref", "timestep"} and "solref" in params
+    assert all(np.isfinite(json.loads(out)["e"]))
+
+
+@FAST
+@given(e=WORDS, T=WORDS)
+@example(e="0.75", T="1e300")
+@example(e="0.75", T="1e-300")
+def test_cli_export_answers_or_says_why(capsys, e, T):
+    """Targets e, T as typed: an export, or one line (T = 1e300 once ended in an
+    OverflowError with exit status 1)."""
+    status, out, err = run_cli(
+        capsys,
+        ["export", "--engine", "mujoco", "--e", e, "--T", T, "--mass", "0.05", "--v0", "1",
+         "--json"],
+    )  # fmt: skip
+    if status == 0:
+        assert err == "" and json.loads(out)
+    else:
+        assert_one_line_error(status, out, err)
+
+
+@FAST
+@given(T=st.sampled_from(["1e300", "1e-300", "1e30", "7.8e-3", "nan", "-1"]))
+def test_cli_calibrate_with_any_duration(capsys, T):
+    """T = 1e300 s once ended in an OverflowError (exit status 1). A warning may come
+    before the error: each on its own line, `jaximpact: warning: ...`."""
+    status, out, err = run_cli(
+        capsys, ["calibrate", "--law", "hertz_rate", "--v0", "2.5", "--e", "0.8", "--T", T]
+    )
+    lines = err.splitlines()
+    assert all(line.startswith("jaximpact: warning: ") for line in lines[:-1]), err
+    if status != 0:
+        assert_one_line_error(status, out, lines[-1] + "\n")
+
+
+@pytest.mark.parametrize("option", [["--sigma", "0"], ["--sigma", "-1"], ["--sigma", "nan"]])
+def test_cli_fit_options_out_of_range(capsys, tmp_path, option):
+    """--sigma 0 once ended in 'SVD did not converge'."""
+    path = tmp_path / "impacts.csv"
+    path.write_text("t\n0.3\n0.7\n1.0\n1.2\n")
+    status, out, err = run_cli(
+        capsys,
+        ["fit", "--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--mass", "0.05", *option,
+         str(path)],
+    )  # fmt: skip
+    assert_one_line_error(status, out, err, contains="sigma")
+
+
+# ----------------------------------------------------------------------------- slow
+
+
+@pytest.mark.slow
+@settings(FAST, max_examples=40)
+@given(
+    name=st.sampled_from(sorted(ji.LAW_NAMES)),
+    scale=st.floats(min_value=1e-3, max_value=1e3),
+    v0=GOOD_SPEED,
+)
+def test_every_law_impact_is_a_result_or_a_status(name, scale, v0):
+    """Every law of the table, its damping scaled by any factor, at any ordinary speed: a
+    separated impact with 0 < e <= 1 and T > 0, or another status with e = 0; no NaN."""
+    law = _start(name)
+    damping = ji.LAWS[name].damping
+    if damping is not None and damping != "e_nominal":
+        law = law.replace(**{damping: float(law.parameters[damping]) * scale})
+    r = ji.impact(law, m=1.0, v0=v0)
+    for key in ("e", "T", "x_max", "F_max", "dissipated"):
+        assert math.isfinite(float(getattr(r, key))), (name, key)
+    if int(r.status) == ji.Status.separated:
+        assert 0.0 < float(r.e) <= 1.0 + 1e-9 and float(r.T) > 0.0
+    else:
+        assert float(r.e) == 0.0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "argv",
+    [
+        "simulate --law hertz_rate --param c=2e6 b1=800 --v0 1e300",
+        "calibrate --law hertz_rate --v0 2.5 --e 0.8 --T 1e300",
+        "export --engine mujoco --e 0.75 --T 1e-300 --mass 1 --v0 1",
+    ],
+)
+def test_cli_in_a_process_of_its_own(argv):
+    """The console script itself: exit status 2 and one error line (after any warning
+    lines), no traceback and no XLA log."""
+    import shutil
+    import subprocess
+
+    script = shutil.which("jaximpact")
+    assert script, "the jaximpact console script is not installed"
+    run = subprocess.run([script, *argv.split()], capture_output=True, text=True, timeout=300)
+    lines = run.stderr.splitlines()
+    assert run.returncode == 2 and run.stdout == "", run.stderr
+    assert lines and lines[-1].startswith("jaximpact: error: "), run.stderr
+    assert all(line.startswith("jaximpact: warning: ") for line in lines[:-1]), run.stderr

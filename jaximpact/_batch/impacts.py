@@ -193,6 +193,19 @@ def prepare_rows(law, params, *, m, v0, g=0.0, invalid: str = "raise"):
     return skeleton, arrays, kinematics, bad
 
 
+def _not_representable(out: dict) -> np.ndarray:
+    """Rows whose computed results are not finite numbers, or separated with T <= 0 (an
+    impact whose scales under- or overflow float64, e.g. v0 = 1e-300 m/s)."""
+    n = next(iter(out.values())).shape[0]
+    lost = np.zeros(n, bool)
+    for name, values in out.items():
+        if name != "status" and np.issubdtype(values.dtype, np.floating):
+            lost |= ~np.isfinite(values)
+    if "T" in out and "status" in out:
+        lost |= (out["status"] == int(Status.separated)) & ~(out["T"] > 0)
+    return lost
+
+
 def _invalid_rows(skeleton, params, kinematics) -> np.ndarray:
     """Rows that `prepare_rows(invalid="raise")` would refuse."""
     if skeleton[0] == "law":
@@ -298,12 +311,19 @@ def impact_batch(
         description=f"impacts ({label})",
     )
     out = {name: out[name] for name in fields if name in out}
+    lost = _not_representable(out) & ~bad
+    if lost.any():
+        first = int(np.argmax(lost))
+        message = (
+            f"{int(lost.sum())} of {lost.size} rows have results that float64 cannot hold "
+            f"(their scales under- or overflow, or the law gave NaN), the first at row {first}"
+        )
+        if invalid == "raise":
+            raise ValueError(f"{message}: express the inputs in other units")
+        warnings.warn(
+            f"{message}: their status is Status.invalid and their results NaN", stacklevel=2
+        )
     if bad.any():
-        for name, values in out.items():
-            if name == "status":
-                out[name] = np.where(bad, int(Status.invalid), values)
-            elif np.issubdtype(values.dtype, np.floating):
-                out[name] = np.where(bad, np.nan, values)
         rows = np.flatnonzero(bad)
         warnings.warn(
             f"{rows.size} of {bad.size} rows have invalid inputs (not finite, or out of "
@@ -311,4 +331,9 @@ def impact_batch(
             "results NaN",
             stacklevel=2,
         )
+    for name, values in out.items():
+        if name == "status":
+            out[name] = np.where(bad | lost, int(Status.invalid), values)
+        elif np.issubdtype(values.dtype, np.floating):
+            out[name] = np.where(bad | lost, np.nan, values)
     return out

@@ -11,6 +11,7 @@ helpers at import time, so `jaximpact --help` stays quick.
 import argparse
 import os
 import sys
+import warnings
 
 from .batch import add_batch
 from .bench import add_bench
@@ -56,6 +57,12 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    """A library warning on the command line: one line, `jaximpact: warning: ...`."""
+    text = " ".join(str(message).split())
+    print(f"{PROG}: warning: {text}", file=sys.stderr if file is None else file)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line on `argv` (default `sys.argv[1:]`); return 0 on success.
 
@@ -66,9 +73,17 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     configure_jax()
     try:
-        status = args.handler(args)
+        with warnings.catch_warnings():
+            warnings.showwarning = _show_warning
+            status = args.handler(args)
     except (CLIError, ValueError, OSError) as error:
         fail(str(error), status=2)
+    except ArithmeticError as error:  # a number of the input beyond float64 (1e300, 1e-300)
+        fail(
+            f"a computation left float64's range ({type(error).__name__}: {error}); check "
+            "the units and sizes of the numbers given",
+            status=2,
+        )
     except KeyboardInterrupt:
         fail("interrupted", status=130)
     except BrokenPipeError:  # e.g. `jaximpact laws | head`: stop quietly

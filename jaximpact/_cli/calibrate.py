@@ -141,6 +141,8 @@ def read_data(path: Path) -> dict:
         text = path.read_text()
     except OSError as error:
         raise CLIError(f"cannot read --data {path}: {error.strerror or error}") from None
+    except UnicodeDecodeError:
+        raise CLIError(f"--data {path} is not a text file (a CSV with columns v0,e)") from None
     lines = [
         (number, line)
         for number, line in enumerate(text.splitlines(), start=1)

@@ -146,6 +146,41 @@ _NEEDED = {
 }
 
 
+# the keys engine-e reads, beyond those needed: any other is refused, not ignored
+_OPTIONAL = {
+    "mujoco": ("timestep",),
+    "lammps": ("poisson", "limit_damping", "timestep"),
+    "drake": (),
+    "liggghts": ("poisson", "limit_damping"),
+    "chrono": ("poisson", "limit_damping"),
+}
+
+
+def _check_engine_params(engine, params):
+    """Every key one that `engine` reads, every value a number (`solref` two numbers,
+    `limit_damping` true or false)."""
+    known = (*_NEEDED[engine], *_OPTIONAL[engine])
+    unknown = [k for k in params if k not in known]
+    if unknown:
+        raise CLIError(
+            f"--params for {engine} has no key {', '.join(map(repr, unknown))}; "
+            f"it takes {', '.join(known)}"
+        )
+    for key, value in params.items():
+        if key == "limit_damping":
+            if not isinstance(value, bool):
+                raise CLIError(f"limit_damping must be true or false, got {value!r}")
+        elif key == "solref":
+            if not (isinstance(value, list) and len(value) == 2 and all(map(_number, value))):
+                raise CLIError("solref must be two numbers, [timeconst, dampratio]")
+        elif not _number(value):
+            raise CLIError(f"{key} must be a number, got {value!r}")
+
+
+def _number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
 def _run_engine_e(args):
     from .._engines import engine_response, stepped_response
 
@@ -160,10 +195,9 @@ def _run_engine_e(args):
     missing = [k for k in _NEEDED[args.engine] if k not in params]
     if missing:
         raise CLIError(f"--params for {args.engine} needs {', '.join(missing)}")
+    _check_engine_params(args.engine, params)
     if args.engine == "mujoco":
         solref = params["solref"]
-        if not (isinstance(solref, list) and len(solref) == 2):
-            raise CLIError("solref must be two numbers, [timeconst, dampratio]")
         if solref[0] > 0 and solref[1] <= 0:
             raise CLIError("solref dampratio must be > 0 in the standard form")
     law, separation, e, T = engine_response(

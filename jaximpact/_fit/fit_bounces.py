@@ -161,6 +161,12 @@ def fit_bounces(
         raise ValueError(f"mass m must be a finite number > 0 kg, got {m}")
     if not (np.isfinite(g) and g > 0):
         raise ValueError(f"gravity g must be a finite number > 0 m/s^2, got {g}")
+    for name, value in (("sigma", sigma), ("clean_tol", clean_tol), ("tol", tol),
+                        ("outlier_sigma", outlier_sigma)):  # fmt: skip
+        if value is not None and not (np.ndim(value) == 0 and 0 < float(value) < math.inf):
+            raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+    if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) or max_iter < 1:
+        raise ValueError(f"max_iter must be a positive integer, got {max_iter!r}")
     if fit_drag and drag is None:
         raise ValueError("fit_drag needs a starting value: drag=k (1/m)")
     if drag is not None and not (np.isfinite(drag) and drag > 0):

@@ -158,6 +158,11 @@ def interval_restitution(cleaned: CleanedImpacts) -> tuple[np.ndarray, np.ndarra
     """The textbook estimate `e_k = D_{k+1} / D_k` from consecutive intervals (contact
     durations and air drag neglected), for every impact number `k` whose two neighbouring
     intervals were both observed. Returns `(k, e_k)`."""
+    if not isinstance(cleaned, CleanedImpacts):
+        raise TypeError(
+            "interval_restitution takes what clean_impact_times returns: "
+            f"interval_restitution(clean_impact_times(times)), got {type(cleaned).__name__}"
+        )
     t, k = cleaned.times, cleaned.index
     gaps = np.diff(t)
     whole = np.diff(k) == 1

@@ -30,25 +30,43 @@ def starting_law(name: str, *, m: float, v0: float, e: float, T: float | None):
     T = 1e-3 if T is None or not np.isfinite(T) else T
     log_e = math.log(min(max(e, 1e-6), 0.999999))
     zeta = -log_e / math.sqrt(math.pi**2 + log_e**2)
-    if spec.coefficients is None:  # Maxwell: a spring of period 2 T in series with a dashpot
-        omega = math.pi / T
-        return law(name, c=m * omega**2, b=m * omega / max(zeta, 1e-3))
-    n, p = exponents(spec)
-    x_star = v0 * T / _undamped_tau(n)
-    c = m * v0**2 / x_star ** (n + 1.0)
-    b_linear = 2.0 * zeta * math.sqrt(m * m * v0**2 / x_star**2)  # 2 zeta sqrt(m c_linear)
+    try:
+        if spec.coefficients is None:  # Maxwell: a spring of period 2 T in series with a dashpot
+            omega = math.pi / T
+            return law(name, c=_in_range(m * omega**2), b=_in_range(m * omega / max(zeta, 1e-3)))
+        n, p = exponents(spec)
+        x_star = v0 * T / _undamped_tau(n)
+        c = _in_range(m * v0**2 / x_star ** (n + 1.0))
+        # 2 zeta sqrt(m c_linear), over x*^p
+        damping = _in_range(2.0 * zeta * math.sqrt(m * m * v0**2 / x_star**2) / x_star**p)
+    except (OverflowError, ZeroDivisionError):
+        raise ValueError(
+            f"T = {T:g} s at v0 = {v0:g} m/s and m = {m:g} kg asks for a stiffness outside "
+            "float64's range: check the units (s, m/s, kg)"
+        ) from None
     params = {"c": c, "n": n, "p": p}
     for key in spec.parameters:
         if key in ("b", "b1"):
-            params[key] = b_linear / x_star**p
+            params[key] = damping
         elif key == "a":
             params[key] = max(1.0 - e, 1e-3) / v0
+        elif key == "d":  # Hunt-Crossley's d = 1.5 a (Drake's point contact)
+            params[key] = 1.5 * max(1.0 - e, 1e-3) / v0
+        elif key == "m_eff":  # the laws whose damping is set for a mass
+            params[key] = m
         elif key == "P":
             energy = 0.5 * m * v0**2 * max(1.0 - e**2, 1e-3)
             params[key] = energy / (e * x_star) / (2.0 if _dry_both_ways(spec, v0) else 1.0)
         elif key == "e_nominal":
             params[key] = min(max(e, 0.05), 0.999)
     return law(name, **{k: v for k, v in params.items() if k in spec.parameters})
+
+
+def _in_range(value: float) -> float:
+    """`value`, which must be a float64 number > 0 (an `OverflowError` otherwise)."""
+    if not 0 < value < math.inf:
+        raise OverflowError(value)
+    return value
 
 
 def _dry_both_ways(spec, v0) -> bool:

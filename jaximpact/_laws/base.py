@@ -40,6 +40,8 @@ class LawSpec:
     against the one group ships for start values (`_fit.restitution_tables`); `nominal`:
     the formula `D(e, v0)` (s/m) of a Hunt-Crossley variant whose damping is set from a
     nominal restitution, so that its impact is `hunt_crossley`'s with `a = D / 1.5`.
+    `positive`: the parameters that must be > 0 (the others >= 0); Maxwell's dashpot with
+    b = 0 carries no force, and the body would never stop.
     """
 
     name: str
@@ -61,6 +63,7 @@ class LawSpec:
     map_fixed: dict[str, float] = dataclasses.field(default_factory=dict)
     restitution_table: bool = False
     nominal: Callable | None = None
+    positive: tuple[str, ...] = ("c", "n")
 
     @property
     def shape_parameters(self) -> tuple[str, ...]:

@@ -5,8 +5,10 @@ from collections.abc import Callable
 
 import equinox as eqx
 import jax.numpy as jnp
+import numpy as np
 from jaxtyping import Array
 
+from .._checks import check_values
 from .base import AbstractLaw
 from .dynamics import scaled_dynamics
 from .named_law import as_arrays
@@ -30,7 +32,7 @@ class CustomLaw(AbstractLaw):
                 f"this custom law has no parameter {', '.join(unknown)}; "
                 f"it has {', '.join(self.params)}"
             )
-        return CustomLaw(self.fn, {**self.params, **as_arrays(params)}, self.name)
+        return CustomLaw(self.fn, {**self.params, **_finite_arrays(params)}, self.name)
 
     def dynamics(self, *, m, v0, g):
         return scaled_dynamics(self.fn, self.params, m=m, v0=v0, g=g)
@@ -54,4 +56,16 @@ def custom_law(fn: Callable, **params) -> CustomLaw:
         raise ValueError("custom_law needs a function f(x, v, params) as its first argument")
     if not params:
         raise ValueError("custom_law needs the law's parameters as keywords, e.g. k=2e6")
-    return CustomLaw(fn, as_arrays(params))
+    return CustomLaw(fn, _finite_arrays(params))
+
+
+def _finite_arrays(params):
+    """The parameters as arrays, each finite (any sign: the user's law decides)."""
+    return {
+        key: check_values(value, _never, f"custom law: parameter {key} must be a finite number")
+        for key, value in as_arrays(params).items()
+    }
+
+
+def _never(array):
+    return np.zeros(np.shape(array), bool)

@@ -109,9 +109,9 @@ def as_arrays(params, numbers=()):
     return arrays
 
 
-def _parameter_rule(key):
+def _parameter_rule(key, spec):
     """What makes a law parameter's value invalid, besides not being finite."""
-    if key in ("c", "n"):
+    if key in spec.positive:
         return lambda a: a <= 0
     if key == "e_nominal":
         return lambda a: (a <= 0) | (a > 1)
@@ -127,9 +127,13 @@ def _check_law_parameters(name, params):
             checked[key] = check_positive(f"{name}: stiffness c", value, units["c"])
         elif key == "n":
             checked[key] = check_positive(f"{name}: exponent n", value)
+        elif key in LAWS[name].positive:
+            checked[key] = check_positive(f"{name}: {key}", value, units.get(key, ""))
         elif key == "e_nominal":
             checked[key] = check_values(
-                value, _parameter_rule(key), f"{name}: e_nominal must lie in (0, 1], got {value}"
+                value,
+                _parameter_rule(key, LAWS[name]),
+                f"{name}: e_nominal must lie in (0, 1], got {value}",
             )
         else:
             checked[key] = check_nonnegative(f"{name}: {key}", value, units.get(key, ""))
@@ -138,11 +142,12 @@ def _check_law_parameters(name, params):
 
 def invalid_parameter_rows(name: str, params: dict) -> np.ndarray:
     """Rows of 1-D parameter arrays that `law(name, ...)` would refuse: not finite, out of
-    range (c, n > 0; e_nominal in (0, 1]; the rest >= 0), or free exponents with p > n."""
+    range (the law's `positive` parameters > 0; e_nominal in (0, 1]; the rest >= 0), or
+    free exponents with p > n."""
     spec = LAWS[name]
     rows = np.zeros(np.shape(next(iter(params.values()))), bool)
     for key, value in params.items():
-        rows |= invalid_entries(value, _parameter_rule(key))
+        rows |= invalid_entries(value, _parameter_rule(key, spec))
     n, p = (params[q] if isinstance(q, str) else q for q in spec.shape or (1.0, 0.0))
     with np.errstate(invalid="ignore"):
         rows |= ~(np.asarray(p, float) <= np.asarray(n, float))

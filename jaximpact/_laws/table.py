@@ -115,6 +115,7 @@ _SPECS = [
         units={"c": "N/m", "b": "N s/m"},
         reference=f"{_PAPER}, eqs. 10-11",
         coefficients=None,
+        positive=("c", "b"),
     ),
     LawSpec(
         name="hertz_viscous",

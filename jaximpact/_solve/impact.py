@@ -79,35 +79,90 @@ def solve_impact(law, m, v0, g, ts, options: ImpactOptions) -> ImpactResult:
     )
 
 
-def _check_representable(result, m, v0):
-    """A separated impact whose duration or restitution float64 cannot hold (its scales
-    under- or overflow, e.g. v0 = 1e-300 m/s) is refused, not returned as T = 0."""
+def _check_representable(result, m, v0, g):
+    """A concrete impact with a result that float64 cannot hold (its scales under- or
+    overflow, e.g. v0 = 1e-300 m/s or g = 1e300 m/s^2) is refused, not returned as T = 0
+    or NaN."""
     if isinstance(result.T, jax.core.Tracer) or np.ndim(result.T) != 0:
         return
+    fields = {k: getattr(result, k) for k in ("e", "T", "x_max", "F_max", "t_max", "dissipated")}
+    values = {k: float(v) for k, v in fields.items() if v is not None}
     separated = int(result.status) == Status.separated
-    if separated and not (float(result.T) > 0 and np.isfinite(float(result.T))
-                          and np.isfinite(float(result.e))):  # fmt: skip
-        raise ValueError(
-            f"m = {float(m):g} kg, v0 = {float(v0):g} m/s put the contact's scales outside "
-            f"float64's range (T = {float(result.T):g} s): express the inputs in other units"
+    if all(np.isfinite(list(values.values()))) and not (separated and values["T"] <= 0):
+        return
+    raise ValueError(
+        f"m = {float(m):g} kg, v0 = {float(v0):g} m/s, g = {float(g):g} m/s^2 put the "
+        f"contact's scales outside float64's range (T = {values['T']:g} s, x_max = "
+        f"{values.get('x_max', math.nan):g} m): express the inputs in other units"
+    )
+
+
+def _check_custom_law(law, v0):
+    """A user's law is tried at first touch before it is integrated: its function must give
+    one real force (a `TypeError` or `ValueError` says what it gave instead), finite; one
+    that pulls the body in there (`F(0, v0) < 0`) is not a contact force law, and what
+    `impact` returns for it is said to be so (a warning), not left as a plain number."""
+    if getattr(law, "spec", None) is not None:
+        return
+    try:
+        out = jax.eval_shape(law.force, 0.0, v0)
+    except Exception as error:  # the user's function failed: say where, in one line
+        first = (str(error).strip().splitlines() or [""])[0]
+        kind = TypeError if isinstance(error, TypeError) else ValueError
+        raise kind(
+            f"the custom law's function failed at x = 0, v = v0 ({type(error).__name__}: "
+            f"{first}); it must take (x, v, params) and return the force in N"
+        ) from error
+    batch = np.broadcast_shapes(*(np.shape(p) for p in law.parameters.values()))
+    if (
+        not hasattr(out, "dtype")
+        or not jnp.issubdtype(out.dtype, jnp.floating)
+        and not (jnp.issubdtype(out.dtype, jnp.integer))
+    ):
+        raise TypeError(
+            f"the custom law's function must return a real force (N), got {out!r} at x = 0"
         )
-
-
-def _warn_if_pulling(law, v0):
-    """A user's law whose force pulls the body in at first touch (`F(0, v0) < 0`) is not a
-    contact force law: what `impact` returns then (mostly a contact that never ends) is said
-    to be so, not left as a plain number."""
-    if getattr(law, "spec", None) is not None or isinstance(v0, jax.core.Tracer):
+    if out.shape not in ((), batch):
+        raise TypeError(
+            f"the custom law's function must return one force for one (x, v), got shape "
+            f"{out.shape} at x = 0 (parameters of shape {batch})"
+        )
+    if isinstance(v0, jax.core.Tracer) or out.shape != ():
         return
     try:
         force = float(law.force(0.0, v0))
     except (TypeError, ValueError, jax.errors.ConcretizationTypeError):
-        return
+        return  # traced parameters (inside jit): nothing to say before the solve
+    if not math.isfinite(force):
+        raise ValueError(
+            f"the custom law's force at first touch is not a number (F(x = 0, v = "
+            f"{float(v0):g} m/s) = {force}); give a law that is finite at x = 0 (guard "
+            "fractional powers with jaximpact.safe_pow)"
+        )
     if force < 0:
         warnings.warn(
             f"the law pulls the body in at first touch (F(x = 0, v = {float(v0):g} m/s) = "
             f"{force:.4g} N < 0): a contact force pushes (F >= 0); read e and T as those of "
             "an unphysical law",
+            stacklevel=3,
+        )
+
+
+def _warn_if_energy_gained(law, result, m, v0):
+    """A user's law that gives the body energy over the contact (`dissipated < 0`, e > 1
+    without gravity: it pulls during the contact or its damping is negative) is said to be
+    unphysical: a passive contact takes energy (it once returned e = 8.4 as a result)."""
+    if getattr(law, "spec", None) is not None or isinstance(result.e, jax.core.Tracer):
+        return
+    if np.ndim(result.e) != 0 or int(result.status) != Status.separated:
+        return
+    kinetic = 0.5 * float(m) * float(v0) ** 2
+    if float(result.dissipated) < -1e-6 * kinetic:
+        warnings.warn(
+            f"the law gives the body energy during the contact ({-float(result.dissipated):.4g}"
+            f" J, e = {float(result.e):.4g}): a passive contact takes energy (its force pulls "
+            "somewhere, or its damping is negative); read e and T as those of an unphysical "
+            "law",
             stacklevel=3,
         )
 
@@ -253,6 +308,7 @@ def impact(
             raise ValueError(f"method='similarity' cannot serve this impact: {reason}")
     if method == "auto" and key is not None and (solver is not None or rtol < CURVES_RTOL):
         key = None  # the caller chose how to integrate
+    _check_custom_law(law, v0)
     if ts is not None:
         ts = jnp.asarray(ts, dtype=float)
         if ts.ndim != 1:
@@ -280,8 +336,8 @@ def impact(
         similarity=key,
     )
     result = solve_impact(law, m, v0, g, ts, options)
-    _check_representable(result, m, v0)
-    _warn_if_pulling(law, v0)
+    _check_representable(result, m, v0, g)
+    _warn_if_energy_gained(law, result, m, v0)
     if throw:
         result = eqx.error_if(
             result,
