@@ -383,6 +383,52 @@ class _maybe_warns:
         return self._catch.__exit__(*exc)
 
 
+CALIBRATE_WRONG = {  # what is wrong: (arguments, what the error must name)
+    "no speed": (dict(v0=[], e=[]), "v0 is empty"),
+    "two masses": (dict(m=[1.0, 2.0]), "m must be one number"),
+    "free as text": (dict(free="b1"), r"free=\('b1',\)"),
+    "no iterations": (dict(max_iter=0), "max_iter"),
+    "a rank-2 speed": (dict(v0=[[2.5]], e=[[0.8]]), "1-D"),
+    "e and v0 of different lengths": (dict(v0=[1.0, 2.0, 3.0], e=[0.8, 0.7]), "one per"),
+}
+
+
+@pytest.mark.parametrize("what", list(CALIBRATE_WRONG))
+def test_calibrate_wrong_shapes_and_types(what):
+    """Each once ended in an IndexError, an error from inside the fit, a fit of parameters
+    'b' and '1', or a 'converged' fit of no iteration."""
+    wrong, named = CALIBRATE_WRONG[what]
+    with pytest.raises((TypeError, ValueError), match=named) as error:
+        ji.calibrate(ji.law("hertz_rate", **LAW14), **(dict(m=1.0, v0=2.5, e=0.8) | wrong))
+    _one_line(error.value)
+
+
+@pytest.fixture(scope="module")
+def drop():
+    return ji.bounce(ji.law("hertz_rate", **LAW14), m=0.05, h0=0.5, t_end=1.0, g=9.81)
+
+
+@pytest.mark.slow  # the histories compile in 7 s
+@settings(FAST, max_examples=6)  # one compiled history for 4 times
+@given(ts=st.permutations([0.05, 0.3, 0.62, 0.9]))
+def test_bounce_heights_in_any_order(drop, ts):
+    """The times may come in any order (unsorted ones once ended in a runtime error
+    'saveat.ts must be increasing')."""
+    heights = np.asarray(drop.height(np.asarray(ts)))
+    np.testing.assert_allclose(
+        heights, np.asarray(drop.height(np.sort(ts)))[np.argsort(np.argsort(ts))]
+    )
+    assert np.all(np.isfinite(heights))
+
+
+@pytest.mark.parametrize("t", [math.nan, -0.1])
+def test_bounce_heights_at_no_time(drop, t):
+    """NaN or before the release: refused, not NaN or a parabola extrapolated backwards."""
+    with pytest.raises(ValueError) as error:
+        drop.height(np.array([t, 0.3, 0.62, 0.9]))
+    _one_line(error.value)
+
+
 # ----------------------------------------------------------------------------- impact times
 
 

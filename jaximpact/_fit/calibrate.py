@@ -342,6 +342,14 @@ def calibrate(
         raise ValueError(f"init must be 'auto' or 'given', got {init!r}")
     v0 = _as_rows("v0", v0, None)
     rows = v0.shape[0]
+    if rows == 0:
+        raise ValueError("v0 is empty: give at least one impact speed (m/s) and its e")
+    if np.ndim(m) != 0:
+        raise ValueError(f"m must be one number (kg) for every row, got shape {np.shape(m)}")
+    if isinstance(free, str):
+        raise TypeError(f"free takes a tuple of parameter names, e.g. free=({free!r},)")
+    if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) or max_iter < 1:
+        raise ValueError(f"max_iter must be a positive integer, got {max_iter!r}")
     e = _as_rows("e", e, rows)
     T = _as_rows("T", T, rows, allow_missing=True)
     sigma_e = _as_rows("sigma_e", sigma_e, rows)

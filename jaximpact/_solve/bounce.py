@@ -255,7 +255,12 @@ class BounceResult(eqx.Module):
         ts = jnp.asarray(ts, dtype=float)
         if ts.ndim != 1:
             raise ValueError("ts must be a 1-D array of times in seconds")
-        return _histories(self, ts)
+        if not isinstance(ts, jax.core.Tracer) and not bool(jnp.all(ts >= 0)):  # NaN too
+            raise ValueError("ts must be times >= 0 s from the release (no NaN)")
+        # any order: the solver's save times must increase, the caller's need not
+        order = jnp.argsort(ts)
+        back = jnp.argsort(order)
+        return tuple(h[back] for h in _histories(self, ts[order]))
 
     def height(self, ts) -> Array:
         """Height of the ball's lowest point above the undeformed floor (m) at `ts` (s);
