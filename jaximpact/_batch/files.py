@@ -1,22 +1,21 @@
-"""Many impacts from a table on disk: `batch_file(source, out, law, ...)` reads a CSV of bodies
-in chunks, runs `impact_batch` on each, and writes the inputs with `e`, `T`, `x_max`,
-`t_max`, `F_max`, `status` and `path` beside them.
+"""Many impacts from a table on disk: `batch_file(source, out, law, ...)` reads a CSV (or
+Parquet) file of bodies in chunks, runs `impact_batch` on each, and writes the inputs with
+`e`, `T`, `x_max`, `t_max`, `F_max`, `status` and `path` beside them.
 
 Nothing is lost: every value is checked before any work (one line naming the row and the
-column); each chunk is written whole or not at all (a temporary file renamed) into
-`OUT.parts/`, with a manifest holding a SHA-256 of the chunk's input text; `resume=True`
-skips the chunks whose part and hash are there and recomputes those whose input changed; the
-parts are joined into `OUT` (again renamed into place) only when all are done. Memory holds
-one chunk at a time.
+column); each chunk is written whole or not at all into `OUT.parts/` with a record of the
+SHA-256 of its inputs and of the run's settings (`parts`); `resume=True` skips the chunks
+whose part and hash are there and recomputes those whose input changed; the parts are joined
+into `OUT` (renamed into place) only when all are done. Memory holds one chunk at a time.
+Under `jax.distributed` every process computes its own chunks (`processes`) and process 0
+joins them: the same file, bit for bit, as one process writes.
 """
 
-import csv
 import dataclasses
 import hashlib
 import json
-import math
-import os
-import shutil
+import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -25,17 +24,23 @@ from .._laws import LAWS, law as make_law
 from .._progress import Progress
 from .._status import Status
 from .impacts import batch_path, impact_batch
+from .parts import FLOAT_OUTPUTS, OUTPUTS, Parts
+from .processes import ProcessGroup
+from .readers import TEXT_COLUMNS, is_parquet, open_table, require_pyarrow
+from .row_checks import KINEMATICS, check_fixed, check_rows
 
-KINEMATICS = ("m", "v0", "g")
-OUTPUTS = ("e", "T", "x_max", "t_max", "F_max", "status", "path")
-_POSITIVE = ("m", "v0", "c", "n")
+__all__ = ["OUTPUTS", "BatchFile", "batch_file"]
+_FORMAT = 2  # bump when the output of a chunk changes for the same inputs
+_STATUS_NAMES = np.array([Status(i).name if i in set(map(int, Status)) else "" for i in
+                          range(max(map(int, Status)) + 1)], object)  # fmt: skip
 
 
 @dataclasses.dataclass(frozen=True)
 class BatchFile:
     """What `batch_file` did: the output `path`, the number of `rows`, the `chunks` in all,
-    how many were `computed` and how many `reused` from an earlier run (`resume=True`), and
-    the count of each `status` name."""
+    how many this process `computed` and `reused` from an earlier run (`resume=True`), the
+    count of each `status` name over the whole file, and this process's place (`process`
+    of `processes`)."""
 
     path: str
     rows: int
@@ -43,6 +48,8 @@ class BatchFile:
     computed: int
     reused: int
     statuses: dict
+    process: int = 0
+    processes: int = 1
 
 
 def batch_file(
@@ -60,191 +67,179 @@ def batch_file(
     progress: bool = True,
     **impact_options,
 ) -> BatchFile:
-    """Run `impact_batch` over the rows of the CSV file `source` and write `out` (CSV).
+    """Run `impact_batch` over the rows of the file `source` and write `out`.
 
+    - `source`, `out`: CSV files, or Parquet (`.parquet`, `.pq`; needs pyarrow). The output
+      holds the input columns (a CSV's text as written) and `e`, `T` (s), `x_max` (m),
+      `t_max` (s), `F_max` (N), `status` (a `Status` name) and `path` per row, in file order.
     - `law`: a name of `LAW_NAMES`. The file's columns give, per row, any of its parameters
-      and `m` (kg), `v0` (m/s), `g` (m/s^2); `params`, `m`, `v0`, `g` give the rest (SI units).
-    - `separation` and `impact_options` (`method`, `rtol`, ...): as in `impact`.
-    - `chunk_rows`: rows per chunk (memory and the unit of resumption).
-    - `resume`: reuse the chunks an interrupted run left in `OUT.parts/` whose inputs have not
-      changed.
+      and `m` (kg), `v0` (m/s), `g` (m/s^2), `separation`; `params`, `m`, `v0`, `g`,
+      `separation` give the rest (SI units).
+    - `impact_options` (`method`, `rtol`, ...): as in `impact`.
+    - `chunk_rows`: rows per chunk (the unit of memory, of work per process and of
+      resumption).
+    - `resume`: reuse the chunks an interrupted run left in `OUT.parts/` whose inputs and
+      settings have not changed; recompute the others.
 
-    A `ValueError` names the first bad column or row (line numbers count the header as 1)
-    before anything is computed. **Example**: `batch_file("bodies.csv", "impacts.csv",
-    "hertz_rate", params={"b1": 800.0}, m=1.0)`.
+    A `ValueError` names the first bad column or row (CSV line numbers count the header as
+    1) before anything is computed or written. Rows that fail (stuck, captured, out of steps,
+    results float64 cannot hold) are kept with their status. Under `jax.distributed` (call
+    `jax.distributed.initialize()` first) each process computes the chunks `k` with
+    `k % process_count == process_index` and process 0 writes `out`.
+
+    **Example**: `batch_file("bodies.csv", "impacts.csv", "hertz_rate", params={"b1": 800.0},
+    m=1.0)`.
     """
     if law not in LAWS:
         raise ValueError(f"unknown law {law!r}; see `jaximpact laws`")
-    if not (isinstance(chunk_rows, int) and chunk_rows >= 1):
+    if isinstance(chunk_rows, bool) or not (isinstance(chunk_rows, int) and chunk_rows >= 1):
         raise ValueError(f"chunk_rows must be a positive integer, got {chunk_rows!r}")
     source, out = Path(source), Path(out)
+    if out.parent != Path("") and not out.parent.is_dir():
+        raise ValueError(f"{out}: directory {str(out.parent)!r} does not exist")
+    if is_parquet(out):
+        require_pyarrow(out)
     spec = LAWS[law]
-    fixed = {**spec.defaults, **(params or {})}
+    fixed = {**spec.defaults, **(params or {}), "separation": separation}
     fixed.update({k: v for k, v in (("m", m), ("v0", v0), ("g", g)) if v is not None})
-    columns = _header(source, allowed=(*spec.parameters, *KINEMATICS))
+    unknown = sorted(set(params or {}) - set(spec.parameters))
+    if unknown:
+        raise ValueError(f"law {law!r} has no parameter {', '.join(unknown)}; it takes "
+                         f"{', '.join(spec.parameters)}")  # fmt: skip
+    check_fixed(law, fixed)
+    table = open_table(source, allowed=(*spec.parameters, *KINEMATICS, *TEXT_COLUMNS))
+    columns = table.columns
     missing = [k for k in (*spec.parameters, "m", "v0") if k not in columns and k not in fixed]
     if missing:
         raise ValueError(
             f"{source}: no value for {', '.join(missing)}: give a column or a fixed value "
             f"(--param NAME=VALUE, --mass, --v0)"
         )
-    for key, value in fixed.items():
-        _check_value(key, value, f"fixed value {key}")
-    rows = _validate(source, columns)
-    parts = Path(f"{out}.parts")
-    if parts.exists() and not resume:
-        shutil.rmtree(parts)
-    parts.mkdir(parents=True, exist_ok=True)
-    manifest = _read_manifest(parts) if resume else {}
-    chunks = max(1, math.ceil(rows / chunk_rows))
-    computed = reused = 0
-    statuses = dict.fromkeys((s.name for s in Status), 0)
-    with Progress(chunks, f"batch {law}", enabled=progress) as bar:
-        for index, (text, cells) in enumerate(_chunks(source, columns, chunk_rows)):
-            digest = hashlib.sha256(text.encode()).hexdigest()
-            part = parts / f"part-{index:06d}.csv"
-            entry = manifest.get(str(index))
-            if entry and entry["sha256"] == digest and part.exists():
-                reused += 1
-                counts = entry["statuses"]
-            else:
-                counts = _run_chunk(cells, columns, fixed, law, separation, impact_options, part)
-                manifest[str(index)] = dict(sha256=digest, rows=len(cells), statuses=counts)
-                _write_manifest(parts, manifest)
-                computed += 1
-            for name, count in counts.items():
-                statuses[name] += count
-            bar.update(f"{(index + 1) * chunk_rows:,} rows" if index + 1 < chunks else "")
-    _join(parts, chunks, out, header=(*columns, *OUTPUTS))
-    shutil.rmtree(parts)
-    return BatchFile(str(out), rows, chunks, computed, reused, statuses)
+    fixed = {k: v for k, v in fixed.items() if k not in columns}
+    settings = json.dumps(
+        [_FORMAT, law, columns, sorted((k, repr(v)) for k, v in fixed.items()),
+         sorted((k, repr(v)) for k, v in impact_options.items()), is_parquet(out)]
+    )  # fmt: skip
+    group = ProcessGroup.current()
+    tag = f" (process {group.index} of {group.count})" if group.count > 1 else ""
+    parts = Parts(out, parquet=is_parquet(out))
 
-
-def _header(source: Path, allowed) -> tuple[str, ...]:
-    """The file's column names, checked: known, not repeated."""
-    try:
-        with open(source, newline="") as handle:
-            header = next(csv.reader(handle), None)
-    except FileNotFoundError:
-        raise ValueError(f"{source}: no such file") from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise ValueError(f"{source}: cannot read it as text ({error})") from None
-    if not header or not any(name.strip() for name in header):
-        raise ValueError(f"{source}: empty file; its first line must name the columns")
-    names = tuple(name.strip() for name in header)
-    for name in names:
-        if name not in allowed:
-            raise ValueError(
-                f"{source}, line 1: unknown column {name!r}; the columns may be "
-                f"{', '.join(allowed)}"
-            )
-    repeated = sorted({n for n in names if names.count(n) > 1})
-    if repeated:
-        raise ValueError(f"{source}, line 1: column {repeated[0]!r} appears twice")
-    return names
-
-
-def _check_value(key, value, where):
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{where}: {value!r} is not a number") from None
-    positive = key in _POSITIVE
-    if not math.isfinite(number) or number < 0 or (positive and number == 0):
-        need = "> 0" if positive else ">= 0"
-        raise ValueError(f"{where}: {key} = {value!s} must be a finite number {need}")
-    return number
-
-
-def _validate(source: Path, columns) -> int:
-    """Every cell a finite number in range; returns the number of data rows."""
-    rows = 0
-    with open(source, newline="") as handle:
-        reader = csv.reader(handle)
-        next(reader)
-        for line, cells in enumerate(reader, start=2):
-            if not cells or not any(c.strip() for c in cells):
-                continue
-            if len(cells) != len(columns):
-                raise ValueError(
-                    f"{source}, line {line}: {len(cells)} cells for {len(columns)} columns"
-                )
-            for key, cell in zip(columns, cells, strict=True):
-                _check_value(key, cell.strip(), f"{source}, line {line}, column {key}")
-            rows += 1
+    # 1. every value checked (each process its own chunks) before anything is written
+    digests, rows, chunks, problem = {}, 0, 0, None
+    estimate = max(1, -(-table.estimated_rows() // chunk_rows))
+    with Progress(estimate, f"checking {source.name}{tag}", enabled=progress) as bar:
+        for index, chunk in enumerate(table.chunks(chunk_rows)):
+            if group.owns(index) and problem is None:
+                try:
+                    cells = table.parse(chunk)
+                    check_rows(law, cells.values, fixed, cells.where)
+                except ValueError as error:
+                    problem = (index, str(error))
+                else:
+                    digests[index] = _digest(settings, cells.digest)
+            rows += table.size(chunk)
+            chunks += 1
+            bar.total = max(bar.total, chunks)
+            bar.update(f"{rows:,} rows")
+        bar.total = chunks
+    problems = sorted(tuple(p) for p in group.gather(problem) if p is not None)
+    if problems:
+        raise ValueError(problems[0][1])
     if rows == 0:
         raise ValueError(f"{source}: no data rows under the header")
-    return rows
 
-
-def _chunks(source: Path, columns, chunk_rows: int):
-    """`(text, rows of cells)` per chunk, `text` the chunk's lines as read (for its hash)."""
-    with open(source, newline="") as handle:
-        reader = csv.reader(handle)
-        next(reader)
-        cells = []
-        for row in reader:
-            if row and any(c.strip() for c in row):
-                cells.append([c.strip() for c in row])
-            if len(cells) == chunk_rows:
-                yield _text(cells), cells
-                cells = []
-        if cells:
-            yield _text(cells), cells
-
-
-def _text(cells) -> str:
-    return "\n".join(",".join(row) for row in cells)
-
-
-def _run_chunk(cells, columns, fixed, law, separation, impact_options, part: Path) -> dict:
-    table = np.asarray(cells, dtype=float).reshape(len(cells), len(columns))
-    given = {**fixed, **{key: table[:, i] for i, key in enumerate(columns)}}
-    params = {k: given[k] for k in LAWS[law].parameters}
-    out = impact_batch(
-        law,
-        params,
-        m=given["m"],
-        v0=given["v0"],
-        g=given.get("g", 0.0),
-        separation=separation,
-        fields=OUTPUTS[:-2] + ("status",),
-        progress=False,
-        invalid="raise",
-        **impact_options,
-    )
-    first = make_law(law, **{k: np.asarray(v).ravel()[0] for k, v in params.items()})
-    g_zero = bool(np.all(np.asarray(given.get("g", 0.0)) == 0.0))
-    path = batch_path(first, separation, g_is_zero=g_zero, **impact_options)
-    names = [Status(int(s)).name for s in out["status"]]
-    temporary = part.with_suffix(".tmp")
-    with open(temporary, "w", newline="") as handle:
-        writer = csv.writer(handle)
-        for i, row in enumerate(cells):
-            values = [repr(float(out[k][i])) for k in OUTPUTS[:-2]]
-            writer.writerow([*row, *values, names[i], path])
-    os.replace(temporary, part)
-    return {name: names.count(name) for name in set(names)}
-
-
-def _read_manifest(parts: Path) -> dict:
+    # 2. each process computes its chunks, reusing those an earlier run finished
+    if group.index == 0 and not resume:
+        parts.remove()
+    if group.index == 0:
+        parts.dir.mkdir(parents=True, exist_ok=True)
+    group.gather(None)  # the others wait for the parts directory
+    own = [i for i in range(chunks) if group.owns(i)]
+    own_rows = sum(min(chunk_rows, rows - i * chunk_rows) for i in own)
+    computed = reused = done_rows = 0
+    start = time.perf_counter()
+    failed = True
     try:
-        return json.loads((parts / "manifest.json").read_text())
-    except (OSError, ValueError):
-        return {}
+        with Progress(len(own), f"batch {law}{tag}", enabled=progress) as bar:
+            for index, chunk in enumerate(table.chunks(chunk_rows)):
+                if not group.owns(index):
+                    continue
+                if not (resume and parts.done(index, digests[index])):
+                    cells = table.parse(chunk)
+                    results = _compute(law, cells.values, cells.rows, fixed, impact_options)
+                    parts.write(index, digests[index], columns, cells, results)
+                    computed += 1
+                else:
+                    reused += 1
+                done_rows += table.size(chunk)
+                bar.update(_rate(done_rows, own_rows, time.perf_counter() - start))
+        failed = False
+    finally:  # every process says how it went, so that none waits for a dead one's parts
+        failures = group.gather(failed)
+    if any(failures):
+        raise RuntimeError("another process of the batch failed; run again with --resume")
+
+    # 3. process 0 joins the parts into OUT
+    statuses = dict.fromkeys((s.name for s in Status), 0)
+    if group.index == 0:
+        for record in parts.records(chunks):
+            for name, count in record["statuses"].items():
+                statuses[name] += count
+        parts.assemble(chunks, columns)
+        parts.remove()
+    statuses = group.gather(statuses)[0]  # and every process waits for the joined file
+    return BatchFile(str(out), rows, chunks, computed, reused, statuses, group.index, group.count)
 
 
-def _write_manifest(parts: Path, manifest: dict):
-    temporary = parts / "manifest.tmp"
-    temporary.write_text(json.dumps(manifest))
-    os.replace(temporary, parts / "manifest.json")
+def _digest(settings: str, inputs: bytes) -> str:
+    return hashlib.sha256(settings.encode() + inputs).hexdigest()
 
 
-def _join(parts: Path, chunks: int, out: Path, header):
-    temporary = out.with_name(out.name + ".tmp")
-    with open(temporary, "w", newline="") as handle:
-        csv.writer(handle).writerow(header)
-        for index in range(chunks):
-            with open(parts / f"part-{index:06d}.csv", newline="") as part:
-                shutil.copyfileobj(part, handle)
-    os.replace(temporary, out)
+def _rate(done: int, total: int, seconds: float) -> str:
+    """`12,345 rows, 5,678 rows/s, 1m05s left`."""
+    rate = done / seconds if seconds > 0 else 0.0
+    if rate <= 0:
+        return f"{done:,} rows"
+    left = int(round((total - done) / rate))
+    return f"{done:,} rows, {rate:,.0f} rows/s, {left // 60}m{left % 60:02d}s left"
+
+
+def _compute(law: str, values: dict, rows: int, fixed: dict, options: dict) -> dict:
+    """`impact_batch` over one chunk; rows grouped by separation, by whether gravity is
+    zero and by the law's shape parameters, so that each row's path depends on that row
+    alone (not on the chunk it falls in). Returns `OUTPUTS` -> one entry per row."""
+    spec = LAWS[law]
+    given = {k: np.broadcast_to(np.asarray(v, float), (rows,)) for k, v in fixed.items()
+             if k != "separation"}  # fmt: skip
+    given.update({k: v for k, v in values.items() if k != "separation"})
+    given.setdefault("g", np.zeros(rows))
+    sep = values.get("separation", np.full(rows, fixed.get("separation", "force"), object))
+    keys = [np.unique(sep, return_inverse=True)[1]] if "separation" in values else []
+    keys += [given["g"] == 0.0] if "g" in values else []
+    keys += [np.unique(values[k], return_inverse=True)[1] for k in spec.shape_parameters
+             if k in values]  # fmt: skip
+    group_of = np.zeros(rows, int)
+    if keys:
+        _, group_of = np.unique(np.stack(keys, axis=1), axis=0, return_inverse=True)
+        group_of = group_of.reshape(-1)
+    results = {k: np.full(rows, np.nan) for k in FLOAT_OUTPUTS}
+    status = np.empty(rows, object)
+    path = np.empty(rows, object)
+    for group in range(int(group_of.max()) + 1):
+        idx = np.flatnonzero(group_of == group)
+        separation = str(sep[idx[0]])
+        params = {k: given[k][idx] for k in spec.parameters}
+        with warnings.catch_warnings():  # invalid rows are counted in the statuses
+            warnings.simplefilter("ignore")
+            out = impact_batch(
+                law, params, m=given["m"][idx], v0=given["v0"][idx], g=given["g"][idx],
+                separation=separation, fields=(*FLOAT_OUTPUTS, "status"), progress=False,
+                invalid="mark", **options,
+            )  # fmt: skip
+        for k in FLOAT_OUTPUTS:
+            results[k][idx] = out[k]
+        status[idx] = _STATUS_NAMES[out["status"]]
+        first = make_law(law, **{k: float(v[0]) for k, v in params.items()})
+        zero_g = bool(given["g"][idx[0]] == 0.0)
+        path[idx] = batch_path(first, separation, g_is_zero=zero_g, **options)
+    return {**results, "status": status.tolist(), "path": path.tolist()}

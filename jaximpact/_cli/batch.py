@@ -1,4 +1,5 @@
-"""`jaximpact batch`: many impacts from a CSV file of bodies, written to a CSV file."""
+"""`jaximpact batch`: many impacts from a CSV (or Parquet) file of bodies, written to a CSV (or
+Parquet) file; on one process or several (`jax.distributed`)."""
 
 from pathlib import Path
 
@@ -9,18 +10,29 @@ def add_batch(subparsers):
     parser = command_parser(
         subparsers,
         "batch",
-        help="impacts of every row of a CSV file (streamed in chunks, resumable)",
-        description="One impact per row of the CSV file IN under the force law --law. The "
+        help="impacts of every row of a CSV or Parquet file (streamed, resumable, multi-process)",
+        description="One impact per row of the file IN under the force law --law. The "
         "columns of IN give, per row, any of the law's parameters and m (kg), v0 (m/s), g "
-        "(m/s^2); --param NAME=VALUE, --mass, --v0 and --g give the rest (SI units). OUT gets "
-        "the inputs and e, T (s), x_max (m), t_max (s), F_max (N), status and path. Every "
-        "value is checked before any work; chunks are written whole into OUT.parts/ and "
-        "joined into OUT at the end; --resume reuses the chunks of an interrupted run whose "
-        "inputs did not change.",
+        "(m/s^2), separation (force or penetration); --param NAME=VALUE, --mass, --v0, --g "
+        "and --separation give the rest (SI units). OUT gets the inputs and e, T (s), x_max "
+        "(m), t_max (s), F_max (N), status and path, in the order of IN. CSV always; Parquet "
+        "(.parquet, .pq) with pyarrow installed (pip install 'jaximpact[parquet]'). Every "
+        "value is checked before any work; chunks of --chunk-rows rows are written whole "
+        "into OUT.parts/ with a SHA-256 of their inputs and joined into OUT at the end; "
+        "--resume reuses the chunks of an interrupted run whose inputs did not change.\n\n"
+        "Several processes (jax.distributed): start one per process with --coordinator "
+        "HOST:PORT --num-processes N --process-id K, or with --distributed alone under "
+        "SLURM or Open MPI (srun, mpirun), which tell JAX the rest. Process K computes the "
+        "chunks k with k mod N = K; process 0 writes OUT, the same file as one process "
+        "writes. OUT must be on a file system all processes see.",
         example="jaximpact batch bodies.csv --law hertz_rate --param b1=800 --mass 1 "
-        "--out impacts.csv",
+        "--out impacts.csv\n"
+        "jaximpact batch bodies.csv --law hertz_rate --param b1=800 --out impacts.csv "
+        "--coordinator localhost:12345 --num-processes 2 --process-id 0",
     )
-    parser.add_argument("source", type=Path, metavar="IN", help="CSV file, one body per row")
+    parser.add_argument(
+        "source", type=Path, metavar="IN", help="CSV or Parquet file, one body per row"
+    )
     parser.add_argument("--law", required=True, metavar="NAME", help="see `jaximpact laws`")
     parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE")
     parser.add_argument("--mass", type=float, metavar="KG", help="m for every row, kg")
@@ -29,11 +41,52 @@ def add_batch(subparsers):
     parser.add_argument(
         "--separation", choices=("force", "penetration"), default="force", help="end of contact"
     )
-    parser.add_argument("--out", required=True, type=Path, metavar="OUT", help="CSV to write")
+    parser.add_argument("--out", required=True, type=Path, metavar="OUT", help="file to write")
     parser.add_argument("--chunk-rows", type=int, default=100_000, metavar="N")
     parser.add_argument("--resume", action="store_true", help="reuse finished chunks")
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
+    group = parser.add_argument_group("several processes (jax.distributed)")
+    group.add_argument(
+        "--distributed",
+        action="store_true",
+        help="join a jax.distributed job; under SLURM or Open MPI nothing else is needed",
+    )
+    group.add_argument("--coordinator", metavar="HOST:PORT", help="process 0's address")
+    group.add_argument("--num-processes", type=int, metavar="N", help="processes in all")
+    group.add_argument("--process-id", type=int, metavar="K", help="this process, 0 .. N-1")
     parser.set_defaults(handler=run_batch_command)
+
+
+def _start_processes(args):
+    """`jax.distributed.initialize` from the options (or the cluster's environment)."""
+    given = {
+        "--coordinator": args.coordinator,
+        "--num-processes": args.num_processes,
+        "--process-id": args.process_id,
+    }
+    if not args.distributed and all(v is None for v in given.values()):
+        return
+    if not args.distributed:
+        missing = [k for k, v in given.items() if v is None]
+        if missing:
+            raise CLIError(f"{', '.join(missing)} missing: give all three, or --distributed "
+                           "under SLURM or Open MPI")  # fmt: skip
+    n, k = args.num_processes, args.process_id
+    if n is not None and n < 1:
+        raise CLIError(f"--num-processes must be at least 1, got {n}")
+    if k is not None and not (0 <= k < (n if n is not None else k + 1)):
+        raise CLIError(f"--process-id must lie in 0 .. {n - 1}, got {k}")
+    if args.coordinator is not None and ":" not in args.coordinator:
+        raise CLIError(f"--coordinator {args.coordinator!r} must be HOST:PORT")
+    import jax
+
+    try:
+        jax.distributed.initialize(
+            coordinator_address=args.coordinator, num_processes=n, process_id=k
+        )
+    except (RuntimeError, ValueError) as error:
+        message = " ".join(str(error).split())[:300]
+        raise CLIError(f"cannot join the jax.distributed job: {message}") from None
 
 
 def run_batch_command(args):
@@ -44,11 +97,13 @@ def run_batch_command(args):
         raise CLIError("--chunk-rows must be at least 1")
     if args.out.parent != Path("") and not args.out.parent.is_dir():
         raise CLIError(f"--out {args.out}: directory {str(args.out.parent)!r} does not exist")
+    params = parse_params(args.param)
+    _start_processes(args)
     result = batch_file(
         args.source,
         args.out,
         args.law,
-        params=parse_params(args.param),
+        params=params,
         m=args.mass,
         v0=args.v0,
         g=args.g,
@@ -58,8 +113,9 @@ def run_batch_command(args):
         progress=progress_enabled(),
     )
     counts = ", ".join(f"{n} {k}" for k, n in result.statuses.items() if n)
+    where = f"process {result.process} of {result.processes}: " if result.processes > 1 else ""
     text = (
-        f"{result.rows} impacts written to {result.path} ({counts}); "
+        f"{where}{result.rows} impacts written to {result.path} ({counts}); "
         f"{result.computed} chunks computed, {result.reused} reused"
     )
     emit(args, {f: getattr(result, f) for f in result.__dataclass_fields__}, text)

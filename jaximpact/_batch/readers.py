@@ -1,0 +1,261 @@
+"""Tables of bodies read in chunks: a CSV file (always) or a Parquet file (with pyarrow).
+
+`open_table(path)` checks the header and returns a reader whose `chunks(rows)` yields every
+chunk of `rows` data rows as it is on disk (cheap: no number is parsed), and whose
+`parse(chunk)` turns one chunk into `Cells`: the columns as arrays (float64; `separation` as
+text), a SHA-256 of the chunk's bytes, the input lines as written (CSV), and where each row
+is in the file (`line N` of a CSV counting the header as 1, `row N` of a Parquet file).
+Memory holds one chunk at a time. A bad header or cell is a one-line `ValueError` naming the
+file, the line (or row) and the column.
+"""
+
+import csv
+import dataclasses
+import hashlib
+import itertools
+from pathlib import Path
+
+import numpy as np
+
+TEXT_COLUMNS = ("separation",)  # columns of words, not numbers
+PARQUET_SUFFIXES = (".parquet", ".pq")
+
+
+def is_parquet(path) -> bool:
+    """Whether `path` names a Parquet file (by its suffix)."""
+    return Path(path).suffix.lower() in PARQUET_SUFFIXES
+
+
+def require_pyarrow(path):
+    """pyarrow's Parquet module, or a one-line `ValueError` saying how to install it."""
+    try:
+        import pyarrow.parquet as pq
+    except ImportError:
+        raise ValueError(
+            f"{path}: Parquet needs pyarrow (pip install 'jaximpact[parquet]'), or use a CSV file"
+        ) from None
+    return pq
+
+
+@dataclasses.dataclass
+class Cells:
+    """One parsed chunk: `values` (column -> array of its `rows`), `digest` (SHA-256 of the
+    chunk's bytes), `lines` (a CSV's data lines as written, without line ends; None for
+    Parquet) and `where(i)`: the place of row `i` in the file, for messages."""
+
+    values: dict
+    rows: int
+    digest: bytes
+    lines: list | None
+    where: object
+
+
+def open_table(path, allowed):
+    """A `CsvTable` or `ParquetTable` for `path`, its header checked: every column in
+    `allowed`, none repeated."""
+    path = Path(path)
+    if not path.exists():
+        raise ValueError(f"{path}: no such file")
+    if path.is_dir():
+        raise ValueError(f"{path}: is a directory, not a file of bodies")
+    table = ParquetTable(path) if is_parquet(path) else CsvTable(path)
+    for name in table.columns:
+        if name not in allowed:
+            raise ValueError(
+                f"{table.where_header}: unknown column {name!r}; the columns may be "
+                f"{', '.join(allowed)}"
+            )
+    repeated = sorted({n for n in table.columns if table.columns.count(n) > 1})
+    if repeated:
+        raise ValueError(f"{table.where_header}: column {repeated[0]!r} appears twice")
+    return table
+
+
+class CsvTable:
+    """A CSV file: a header line naming the columns, then one body per line (blank lines are
+    skipped; their line numbers still count)."""
+
+    def __init__(self, path: Path):
+        self.path = path
+        self.where_header = f"{path}, line 1"
+        try:
+            with open(path, newline="") as handle:
+                header = next(csv.reader(handle), None)
+        except (OSError, UnicodeDecodeError) as error:
+            raise ValueError(f"{path}: cannot read it as text ({error})") from None
+        if not header or not any(name.strip() for name in header):
+            raise ValueError(f"{path}: empty file; its first line must name the columns")
+        self.columns = tuple(name.strip() for name in header)
+
+    def chunks(self, rows: int):
+        """`(first line number, data lines, their line numbers or None if consecutive)` per
+        chunk of `rows` data rows, in file order."""
+        with open(self.path, newline=None) as handle:
+            next(handle)
+            number = 2
+            while True:
+                lines, numbers, first = [], None, number
+                for line in itertools.islice(handle, rows):
+                    lines.append(line)
+                number += len(lines)
+                if not lines:
+                    return
+                if any(not line.strip() for line in lines):  # blank lines: keep the numbers
+                    numbers = [first + i for i, line in enumerate(lines) if line.strip()]
+                    lines = [line for line in lines if line.strip()]
+                    while len(lines) < rows:  # fill the chunk up to `rows` data rows
+                        line = handle.readline()
+                        if not line:
+                            break
+                        if line.strip():
+                            lines.append(line)
+                            numbers.append(number)
+                        number += 1
+                    if not lines:
+                        continue
+                yield first, lines, numbers
+
+    @staticmethod
+    def size(chunk) -> int:
+        """The number of data rows of `chunk`."""
+        return len(chunk[1])
+
+    def estimated_rows(self) -> int:
+        """About how many data rows the file holds (from its size and first lines)."""
+        with open(self.path, "rb") as handle:
+            head = handle.readline() and handle.readlines(1 << 16)
+        if not head:
+            return 0
+        return max(1, round(self.path.stat().st_size / (sum(map(len, head)) / len(head))))
+
+    def parse(self, chunk) -> Cells:
+        first, lines, numbers = chunk
+        path = self.path
+
+        def where(i):
+            return f"{path}, line {numbers[i] if numbers else first + i}"
+
+        lines = [line.rstrip("\r\n") for line in lines]
+        digest = hashlib.sha256("\n".join(lines).encode()).digest()
+        columns, ncol = self.columns, len(self.columns)
+        numeric = [j for j, name in enumerate(columns) if name not in TEXT_COLUMNS]
+        quoted = any('"' in line for line in lines)
+        rows = None
+        if quoted:
+            rows = list(csv.reader(lines))
+            counts = [len(cells) for cells in rows]
+        else:
+            counts = [line.count(",") + 1 for line in lines]
+        if any(c != ncol for c in counts):
+            i = next(i for i, c in enumerate(counts) if c != ncol)
+            raise ValueError(f"{where(i)}: {counts[i]} cells for {ncol} columns")
+        try:
+            if quoted:
+                table = np.array([[cells[j] for j in numeric] for cells in rows], dtype=float)
+            else:
+                table = np.loadtxt(lines, delimiter=",", dtype=float, usecols=numeric, ndmin=2)
+        except ValueError:
+            table = None
+        if table is None or table.shape != (len(lines), len(numeric)):
+            _name_the_bad_cell(lines, columns, numeric, where)
+            raise ValueError(f"{path}: cannot read the numbers of lines {where(0)} on")
+        values = {columns[j]: table[:, k] for k, j in enumerate(numeric)}
+        for j, name in enumerate(columns):
+            if name in TEXT_COLUMNS:
+                if rows is None:
+                    rows = [line.split(",") for line in lines]
+                values[name] = np.array([cells[j].strip() for cells in rows], dtype=object)
+        return Cells(values, len(lines), digest, lines, where)
+
+
+def _name_the_bad_cell(lines, columns, numeric, where):
+    """Raise the one-line error for the first cell that is not a number."""
+    for i, cells in enumerate(csv.reader(lines)):
+        for j in numeric:
+            cell = cells[j].strip()
+            try:
+                float(cell)
+            except ValueError:
+                shown = repr(cell) if cell else "an empty cell"
+                raise ValueError(
+                    f"{where(i)}, column {columns[j]}: {shown} is not a number"
+                ) from None
+
+
+class ParquetTable:
+    """A Parquet file (pyarrow): numeric columns (integers or floats; `separation` text),
+    read in record batches."""
+
+    def __init__(self, path: Path):
+        pq = require_pyarrow(path)
+        import pyarrow as pa
+
+        self.path = path
+        self.where_header = f"{path}, columns"
+        try:
+            self.file = pq.ParquetFile(path)
+        except (OSError, pa.ArrowException) as error:
+            raise ValueError(f"{path}: cannot read it as Parquet ({error})") from None
+        schema = self.file.schema_arrow
+        self.columns = tuple(schema.names)
+        if not self.columns:
+            raise ValueError(f"{path}: empty file; it has no columns")
+        for field in schema:
+            text = field.name in TEXT_COLUMNS
+            ok = (
+                pa.types.is_string(field.type) or pa.types.is_large_string(field.type)
+                if text
+                else pa.types.is_integer(field.type) or pa.types.is_floating(field.type)
+            )
+            if not ok:
+                want = "text" if text else "numbers"
+                raise ValueError(f"{path}, column {field.name}: of type {field.type}, not {want}")
+
+    def chunks(self, rows: int):
+        """`(first row index, record batch)` per chunk of `rows` rows, in file order."""
+        import pyarrow as pa
+
+        pending, count, start = [], 0, 0
+        for batch in self.file.iter_batches(batch_size=rows):
+            pending.append(batch)
+            count += batch.num_rows
+            while count >= rows:
+                table = pa.Table.from_batches(pending)
+                yield start, table.slice(0, rows)
+                rest = table.slice(rows)
+                pending = rest.to_batches() if rest.num_rows else []
+                count -= rows
+                start += rows
+        if count:
+            yield start, pa.Table.from_batches(pending)
+
+    @staticmethod
+    def size(chunk) -> int:
+        """The number of rows of `chunk`."""
+        return chunk[1].num_rows
+
+    def estimated_rows(self) -> int:
+        """The number of rows (from the file's metadata)."""
+        return self.file.metadata.num_rows
+
+    def parse(self, chunk) -> Cells:
+        start, table = chunk
+        path = self.path
+
+        def where(i):
+            return f"{path}, row {start + i + 1}"
+
+        values, digest = {}, hashlib.sha256()
+        for name in self.columns:
+            column = table.column(name)
+            if column.null_count:
+                i = int(np.flatnonzero(column.is_null().to_numpy(zero_copy_only=False))[0])
+                raise ValueError(f"{where(i)}, column {name}: an empty cell")
+            if name in TEXT_COLUMNS:
+                array = np.array([str(s).strip() for s in column.to_pylist()], dtype=object)
+                digest.update("\n".join(array).encode())
+            else:
+                array = column.to_numpy(zero_copy_only=False).astype(float)
+                digest.update(array.tobytes())
+            values[name] = array
+        return Cells(values, table.num_rows, digest.digest(), None, where)

@@ -1,0 +1,74 @@
+"""The values of a table of bodies checked before any work: every mass `m` (kg) and speed `v0`
+(m/s) finite and > 0, gravity `g` (m/s^2) finite and >= 0, every law parameter as the law
+table requires it (stiffness > 0, dampings >= 0, ...), `separation` one of its two words. The
+first bad value is one line naming its place (line or row) and column."""
+
+import numpy as np
+
+from .._laws import LAWS, law as make_law
+from .._laws.named_law import invalid_parameter_rows
+
+KINEMATICS = ("m", "v0", "g")
+SEPARATIONS = ("force", "penetration")
+_POSITIVE = ("m", "v0")
+
+
+def _rule(key, positive):
+    def bad(a):
+        with np.errstate(invalid="ignore"):
+            return ~np.isfinite(a) | ((a <= 0) if key in positive else (a < 0))
+
+    return bad
+
+
+def check_fixed(law: str, fixed: dict):
+    """The values given for every row (`--param`, `--mass`, ...): numbers in range."""
+    positive = (*_POSITIVE, *LAWS[law].positive)
+    for key, value in fixed.items():
+        if key == "separation":
+            if value not in SEPARATIONS:
+                raise ValueError(f"separation must be 'force' or 'penetration', got {value!r}")
+            continue
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            raise ValueError(f"fixed value {key}: {value!r} is not a number") from None
+        if _rule(key, positive)(np.asarray(number)):
+            need = "> 0" if key in positive else ">= 0"
+            raise ValueError(f"fixed value {key}: {key} = {value!s} must be a finite number {need}")
+
+
+def check_rows(law: str, values: dict, fixed: dict, where):
+    """Raise a one-line `ValueError` at the first row (file order) with a bad value in
+    `values` (column -> array); `fixed` completes the law's parameters; `where(i)` says where
+    row `i` is."""
+    spec = LAWS[law]
+    positive = (*_POSITIVE, *spec.positive)
+    rows = len(next(iter(values.values())))
+    first, message = rows, None
+    for key, column in values.items():
+        if key == "separation":
+            bad = ~np.isin(column, SEPARATIONS)
+        else:
+            bad = _rule(key, positive)(column)
+        if bad[:first].any():
+            i = int(np.argmax(bad))
+            if key == "separation":
+                text = f"{column[i]!r} is not 'force' or 'penetration'"
+            else:
+                need = "> 0" if key in positive else ">= 0"
+                text = f"{key} = {float(column[i])!r} must be a finite number {need}"
+            first, message = i, f"{where(i)}, column {key}: {text}"
+    params = {k: np.broadcast_to(np.asarray(v, float), (rows,)) for k, v in
+              {**fixed, **values}.items() if k in spec.parameters}  # fmt: skip
+    bad = invalid_parameter_rows(law, params)
+    if bad[:first].any():  # a rule of the law table beyond the signs (e_nominal <= 1, p <= n)
+        i = int(np.argmax(bad))
+        try:
+            make_law(law, **{k: float(v[i]) for k, v in params.items()})
+            text = "the law's parameters are out of range"
+        except ValueError as error:
+            text = str(error)
+        first, message = i, f"{where(i)}: {text}"
+    if message is not None:
+        raise ValueError(message)
