@@ -1,12 +1,18 @@
-"""Requested vs realised e and T in the real engines (MuJoCo, LAMMPS, Drake), for
-docs/engines.md. Run: python benchmarks/engines_table.py > benchmarks/engines_table.md"""
+"""Requested vs realised e and T in the real engines (MuJoCo, LAMMPS, Drake continuous and
+discrete, LIGGGHTS, Yade), for docs/engines.md.
+Run: python benchmarks/engines_table.py > benchmarks/engines_table.md"""
 
 import jax
 
 jax.config.update("jax_enable_x64", True)
 
+import shutil  # noqa: E402
+import subprocess  # noqa: E402
+
+import numpy as np  # noqa: E402
+
 import jaximpact as ji  # noqa: E402
-from jaximpact._engines import drake, lammps, mujoco  # noqa: E402
+from jaximpact._engines import drake, lammps, liggghts, mujoco, yade  # noqa: E402
 
 PHASES = (0.05, 0.3, 0.55, 0.8, 0.95)
 print("| engine | asked e | asked T (s) | promised e | engine e (5 start phases) | "
@@ -27,15 +33,52 @@ for e, T, limit in [(0.9, 1e-3, False), (0.5, 5e-4, False), (0.1, 1e-4, False),
     print(f"| {name} | {e} | {T:g} | {x.e:.5f} | {es.min():.5f} to {es.max():.5f} | "
           f"{x.T:.5g} | {Ts.min():.5g} to {Ts.max():.5g} | {x.timestep:g} |")
 try:
-    import pydrake
+    import importlib.metadata
+
+    import pydrake  # noqa: F401
+
+    DRAKE = importlib.metadata.version("drake")
 
     for e, T in [(0.8, 1e-3), (0.5, 5e-3), (0.3, 2e-3)]:
         x = ji.export(None, "drake", m=0.05, v0=1.0, e=e, T=T, curves=False)
         e_d, T_d = drake.simulate(x.parameters, m=0.05, v0=1.0)
-        print(f"| Drake {pydrake.__version__ if hasattr(pydrake, '__version__') else ''} "
+        print(f"| Drake {DRAKE} "
               f"continuous | {e} | {T:g} | {x.e:.5f} | {e_d:.5f} | {x.T:.5g} | {T_d:.5g} | 0 |")
+    for e, T, steps in [(0.6, 0.01, 40), (0.9, 0.02, 100), (0.9, 0.01, 10)]:
+        h = T / steps
+        x = ji.export(None, "drake", m=1.0, v0=1.0, e=e, T=T, timestep=h, curves=False)
+        runs = np.array([drake.simulate(x.parameters, m=1.0, v0=1.0, time_step=h,
+                                        gap=phase * h) for phase in PHASES])
+        print(f"| Drake {DRAKE} "
+              f"discrete (Lagged){' NOT REACHABLE' if x.e < 0.995 * e else ''} | {e} | {T:g} | "
+              f"{x.e:.5f} | {runs[:, 0].min():.5f} to {runs[:, 0].max():.5f} | {x.T:.5g} | "
+              f"{runs[:, 1].min():.5g} to {runs[:, 1].max():.5g} | {h:g} |")
 except ImportError as error:
     print(f"\nDrake not run: {error}")
+if shutil.which("liggghts"):
+    for e, T, limit in [(0.9, 1e-3, False), (0.5, 5e-4, False), (0.3, 1e-3, True)]:
+        x = ji.export(None, "liggghts", m=0.004, v0=1.0, radius=0.005, e=e, T=T,
+                      limit_damping=limit, curves=False)
+        es, Ts = liggghts.simulate(x.parameters, m=0.004, v0=1.0, radius=0.005, phases=PHASES)
+        name = "LIGGGHTS 3.8.0" + (" limitForce" if limit else "")
+        print(f"| {name} | {e} | {T:g} | {x.e:.5f} | {es.min():.5f} to {es.max():.5f} | "
+              f"{x.T:.5g} | {Ts.min():.5g} to {Ts.max():.5g} | {x.timestep:g} |")
+else:
+    print("\nLIGGGHTS not run: no liggghts executable")
+if shutil.which("yade"):
+    version = subprocess.run(["yade", "--version"], capture_output=True, text=True).stdout
+    version = (version.split() or ["?"])[-1]
+    for e, T in [(0.8, 5e-4), (0.5, 1e-3), (0.2, 1e-3)]:
+        x = ji.export(None, "yade", m=0.01, v0=1.0, radius=0.01, e=e, T=T, curves=False)
+        es, Ts = yade.simulate(x.parameters, m=0.01, v0=1.0, radius=0.01, phases=PHASES)
+        print(f"| Yade {version} | {e} | {T:g} | {x.e:.5f} | {es.min():.5f} to {es.max():.5f} | "
+              f"{x.T:.5g} | {Ts.min():.5g} to {Ts.max():.5g} | {x.timestep:g} |")
+    x = ji.export(None, "yade", m=0.01, v0=1.0, radius=0.01, e=0.5, T=1e-3, curves=False)
+    es, _ = yade.simulate(x.parameters, m=0.01, v0=1.0, radius=0.01, phases=(0.5,), damping=0.2)
+    print(f"\nYade with NewtonIntegrator's default damping 0.2 (the export sets 0): asked 0.5, "
+          f"Yade gives e = {es[0]:.4f}")
+else:
+    print("\nYade not run: no yade executable")
 # the requested-vs-realised gap of LAMMPS's own formulas (what users meet)
 print("\n| LAMMPS input | coefficient given | realised e (LAMMPS) |")
 print("|---|---|---|")

@@ -12,26 +12,31 @@ from .common import (
     parse_params,
 )
 
-_ENGINES = ("mujoco", "lammps", "drake", "liggghts", "chrono")
+_ENGINES = ("mujoco", "lammps", "drake", "liggghts", "chrono", "yade")
 
 
 def add_export(subparsers):
     parser = command_parser(
         subparsers,
         "export",
-        help="an engine's contact parameters (MuJoCo, LAMMPS, Drake) for a law or target e, T",
+        help="an engine's contact parameters (MuJoCo, Drake, LAMMPS, LIGGGHTS, Chrono, Yade) "
+        "for a law or target e, T",
         description="Turn a law (--law, --param) or target --e and --T into the contact "
-        "parameters of MuJoCo, LAMMPS or Drake, in the engine's own names and units, with a "
+        "parameters of MuJoCo, Drake, LAMMPS, LIGGGHTS, Chrono or Yade, in the engine's own "
+        "names and units, with a "
         "snippet to paste, a recommended time step, and the e and T the engine realises "
         "(its time stepping included). Scenes: MuJoCo and Drake, a body of --mass on a "
-        "plane; LAMMPS, two spheres each of --mass and --radius colliding head-on at "
+        "plane; the others, two spheres each of --mass and --radius colliding head-on at "
         "relative speed --v0. docs/engines.md has the formulas and measured tables.",
         example="jaximpact export --engine mujoco --e 0.75 --T 0.01 --mass 0.05 --v0 1\n"
         "jaximpact export --engine lammps --law hertz_rate --param c=2e6 b1=800 "
         "--mass 1 --v0 2.5 --radius 0.02 --json",
     )
     parser.add_argument(
-        "--engine", required=True, metavar="NAME", help="mujoco, lammps, drake, liggghts or chrono"
+        "--engine",
+        required=True,
+        metavar="NAME",
+        help="mujoco, lammps, drake, liggghts, chrono or yade",
     )
     parser.add_argument("--law", metavar="NAME", help="a law of 'jaximpact laws'")
     parser.add_argument("--param", action="extend", nargs="+", default=[], metavar="NAME=VALUE")
@@ -122,12 +127,17 @@ def add_engine_e(subparsers):
         "of the continuous law the engine integrates, at each --speed, and beside them what "
         "the engine's time stepping realises (MuJoCo at its timestep; LAMMPS when "
         '"timestep" is given; the mean over where first touch falls inside a step, with the '
-        "range of e). Drake's discrete solver is not modelled: its continuous plant only.",
+        'range of e); Yade {"tc": s, "en": e} (ViscElMat; "timestep" and '
+        'NewtonIntegrator "damping" for its stepping); Drake with "time_step" > 0: its '
+        "discrete plant (Lagged, Similar, TAMSI).",
         example="jaximpact engine-e --engine mujoco --params '{\"solref\": [0.02, 1]}' "
         "--mass 0.05 --speed 0.5 1 2",
     )
     parser.add_argument(
-        "--engine", required=True, metavar="NAME", help="mujoco, lammps, drake, liggghts or chrono"
+        "--engine",
+        required=True,
+        metavar="NAME",
+        help="mujoco, lammps, drake, liggghts, chrono or yade",
     )
     parser.add_argument("--params", required=True, metavar="JSON", help="engine parameters")
     parser.add_argument("--mass", type=float, default=1.0, metavar="KG", help="mass, kg")
@@ -137,29 +147,16 @@ def add_engine_e(subparsers):
     parser.set_defaults(handler=_run_engine_e)
 
 
-_NEEDED = {
-    "mujoco": ("solref",),
-    "lammps": ("E", "coeff_restitution"),
-    "drake": ("point_contact_stiffness", "hunt_crossley_dissipation"),
-    "liggghts": ("E", "coeff_restitution"),
-    "chrono": ("E", "coeff_restitution"),
-}
-
-
-# the keys engine-e reads, beyond those needed: any other is refused, not ignored
-_OPTIONAL = {
-    "mujoco": ("timestep",),
-    "lammps": ("poisson", "limit_damping", "timestep"),
-    "drake": (),
-    "liggghts": ("poisson", "limit_damping"),
-    "chrono": ("poisson", "limit_damping"),
-}
-
-
 def _check_engine_params(engine, params):
-    """Every key one that `engine` reads, every value a number (`solref` two numbers,
-    `limit_damping` true or false)."""
-    known = (*_NEEDED[engine], *_OPTIONAL[engine])
+    """Every needed key there, every key one that `engine` reads (its module's `KEYS`), every
+    value a number (`solref` two numbers, `limit_damping` true or false)."""
+    from .._engines.export import ENGINES
+
+    needed, optional = ENGINES[engine].KEYS
+    missing = [k for k in needed if k not in params]
+    if missing:
+        raise CLIError(f"--params for {engine} needs {', '.join(missing)}")
+    known = (*needed, *optional)
     unknown = [k for k in params if k not in known]
     if unknown:
         raise CLIError(
@@ -192,14 +189,7 @@ def _run_engine_e(args):
         raise CLIError(f"--params is not JSON: {error.msg}") from None
     if not isinstance(params, dict):
         raise CLIError("--params must be a JSON object, e.g. '{\"solref\": [0.02, 1]}'")
-    missing = [k for k in _NEEDED[args.engine] if k not in params]
-    if missing:
-        raise CLIError(f"--params for {args.engine} needs {', '.join(missing)}")
     _check_engine_params(args.engine, params)
-    if args.engine == "mujoco":
-        solref = params["solref"]
-        if solref[0] > 0 and solref[1] <= 0:
-            raise CLIError("solref dampratio must be > 0 in the standard form")
     law, separation, e, T = engine_response(
         args.engine, params, m=args.mass, speeds=args.speed, radius=args.radius
     )

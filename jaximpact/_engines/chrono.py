@@ -1,18 +1,24 @@
 """Project Chrono (SMC): two equal spheres with `ChContactMaterialSMC` and the Hertz force
 model from material properties, by its source (not run here: PyChrono is on conda only).
 
-`src/chrono/physics/ChContactSMC.h`, `ChSystemSMC::Hertz` with `UseMaterialProperties(true)`
-(the defaults): `kn = 2/3 S_n`, `gn = -2 sqrt(5/6) beta sqrt(S_n m_eff)`,
-`S_n = 2 E_eff sqrt(R_eff delta)`, `beta = ln(cr)/sqrt(ln^2 cr + pi^2)`,
-`forceN = kn delta - gn v_n`, and a negative `forceN` is set to zero. With
-`E_eff = 1/((1 - nu1^2)/E1 + (1 - nu2^2)/E2)` (`ChContactMaterialCompositeSMC`) that is the
-Tsuji form of LAMMPS's `coeff_restitution` (law `tsuji_restitution`) with the force kept
+Chrono main (commit 7689fbc, 2026), `src/chrono/physics/ChContactSMC.cpp`,
+`ChDefaultContactForceTorqueSMC::CalculateForceTorque`: `eff_mass = m1 m2/(m1 + m2)`;
+`case ChSystemSMC::Hertz` with `UsingMaterialProperties()` (the default):
+`Sn = 2 E_eff sqrt(eff_radius delta)`, `beta = ln(cr_eff)/sqrt(ln^2 cr_eff + pi^2)`,
+`kn = 2/3 Sn`, `gn = -2 sqrt(5/6) beta sqrt(Sn eff_mass)`; then
+`forceN = kn delta - gn relvel_n` "and if negative, set to zero" (line ~175).
+`ChContactMaterialSMC.cpp`: `E_eff = 1/((1 - nu1^2)/E1 + (1 - nu2^2)/E2)` (computed in
+float), `cr_eff = min(cr1, cr2)` (`ChContactMaterialCompositionStrategy`). That is the Tsuji
+form of LAMMPS's `coeff_restitution` (law `tsuji_restitution`) with the force kept
 non-attractive (`separation="force"`): the realised e is above the `cr` given, and no `cr`
 gives less than about 0.14; the export inverts that law. Chrono's time stepper (implicit
 Euler by default) is not replicated: the promise is the continuous law's, at a recommended
-step of T/100 or less. Pitfalls: `m_eff` uses both contactables' masses, so a sphere on a
-fixed ground body has `m_eff = m M/(m + M)` with the ground's own mass `M` (give it a large
-one); `cr_eff` is the smaller of the two materials' restitutions.
+step of T/100 or less. Pitfalls: (1) `eff_radius` comes from the collision system: the
+Multicore narrowphase computes `R1 R2/(R1 + R2)` for two spheres, but the default Bullet
+system leaves `ChCollisionInfo`'s default, 0.1 m (`ChCollisionInfo.cpp`), whatever the
+spheres' size: the snippet sets that default to the pair's `R/2`. (2) `eff_mass` uses both
+contactables' masses, so a sphere on a fixed ground body sees the ground's own mass (give it
+a large one). (3) `cr_eff` is the smaller of the two materials' restitutions.
 """
 
 import math
@@ -22,6 +28,7 @@ from . import lammps
 NAME = "chrono"
 SCENE = lammps.SCENE
 law = lammps.law
+KEYS = (lammps.KEYS[0], ("poisson", "limit_damping"))
 
 
 def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=True):
@@ -33,6 +40,8 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Tru
     b = lammps.damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
     h = lammps.nice_down(T / 100.0) if timestep is None else float(timestep)
     warnings = [
+        f"set the effective curvature radius to {R_eff:.6g} m (the snippet does): Chrono's "
+        "default Bullet collision system uses 0.1 m for every contact",
         "Chrono's time stepper is not replicated: e and T are the continuous law's "
         f"(with about {T / h:.0f} steps per contact)"
     ]
@@ -48,6 +57,7 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Tru
         "contact_force_model": "ChSystemSMC.Hertz",
         "UseMaterialProperties": True,
         "time_step": h,
+        "effective_curvature_radius": R_eff,
         "k": c,
         "b": b,
     }
@@ -70,6 +80,9 @@ def snippet(parameters) -> str:
             "sys = chrono.ChSystemSMC()",
             "sys.SetContactForceModel(chrono.ChSystemSMC.Hertz)",
             "sys.UseMaterialProperties(True)",
+            "# Bullet (the default collision system) reports no curvature: set the pair's",
+            "chrono.ChCollisionInfo.SetDefaultEffectiveCurvatureRadius("
+            f"{parameters['effective_curvature_radius']:.10g})",
             "mat = chrono.ChContactMaterialSMC()",
             f"mat.SetYoungModulus({parameters['SetYoungModulus']:.10g})",
             f"mat.SetPoissonRatio({parameters['SetPoissonRatio']:.10g})",

@@ -8,8 +8,14 @@ non-negative: Hunt & Crossley with n = 1 (law `point_contact`). Its restitution 
 an export is exact at the `v0` it was made for. Drake documents no d-from-e formula. Two
 geometries combine as springs in series, `k = k1 k2 / (k1 + k2)`,
 `d = (k2 d1 + k1 d2) / (k1 + k2)`: giving both the body and the ground `2k` and `d` yields
-`k` and `d`. A discrete plant (`time_step > 0`) adds numerical dissipation (TAMSI, Lagged,
-Similar) or ignores d (SAP); the promise is for the continuous plant.
+`k` and `d`. A discrete plant (`time_step > 0`) steps the contact implicitly: with TAMSI,
+Lagged (Drake's default approximation) and Similar, a point contact found at a step's start
+(`x > 0`) gives the new speed from `m (v1 - v) = -h k (x + h v1)_+ (1 + d v1)_+`
+(Castro et al., "An unconstrained convex formulation of compliant contact", 2022, and TAMSI,
+Castro et al. 2019): `replica` integrates that and equals Drake 1.51.1 to 5 digits phase by
+phase (tests/test_engines.py). That step damps (e = 0.9 came out 0.59 at 10 steps per
+contact), so with a `timestep` the export corrects k and d for it, or warns where even
+d = 0 damps too much. kSap ignores `hunt_crossley_dissipation`.
 """
 
 import math
@@ -18,9 +24,12 @@ import numpy as np
 from scipy.optimize import brentq
 
 NAME = "drake"
+# the keys `engine-e` takes: (needed, optional)
+KEYS = (("point_contact_stiffness", "hunt_crossley_dissipation"), ("time_step",))
 SCENE = (
     "a body of mass m on a fixed half space (both geometries with the exported properties), "
-    "no gravity, approaching along the normal at v0, continuous plant (time_step = 0)"
+    "no gravity, approaching along the normal at v0; continuous plant (time_step = 0), or "
+    "discrete with the Lagged, Similar or TAMSI approximation when a timestep is given"
 )
 
 
@@ -48,37 +57,130 @@ def alpha_for(e: float) -> float:
 
 
 def design(e, T, *, m, v0, timestep=None):
+    """`point_contact_stiffness` k (N/m) and `hunt_crossley_dissipation` d (s/m) that realise
+    `e` and `T` (s) for mass `m` (kg) at `v0` (m/s): on the continuous plant (`timestep`
+    None or 0: exact, from the closed-form e of `f = k x (1 + d v)`), or on a discrete plant
+    of step `timestep` (s) with the Lagged (Drake's default), Similar or TAMSI approximation,
+    whose implicit step damps further: k and d are then corrected through `replica` (mean
+    over where first touch falls inside a step), and a warning says when no d >= 0 can
+    give `e` at that step."""
     from ..closed_forms import hunt_crossley_restitution
 
     warnings = []
     alpha = alpha_for(e)
     d = alpha / v0
     k = m * (_tau(alpha) / T) ** 2
-    if timestep:
-        steps = T / timestep
-        warnings.append(
-            f"a discrete plant (time_step {timestep:.3g} s, {steps:.0f} steps per contact) adds "
-            "its own dissipation: measured with TAMSI, Lagged and Similar, e came out 36 % low "
-            "at 10 steps per contact, 11 % at 40, 4.6 % at 100, 0.5 % at 1000 "
-            "(benchmarks/drake_discrete.md); SAP ignores hunt_crossley_dissipation (e near 0 "
-            "there). The promised e and T are for time_step = 0"
+    if not timestep:
+        parameters = _parameters(k, d, 0.0)
+        return dict(
+            parameters=parameters,
+            e=float(hunt_crossley_restitution(alpha)),
+            T=float(_tau(alpha) * math.sqrt(m / k)),
+            e_range=None,
+            T_range=None,
+            steps_per_contact=None,
+            warnings=warnings,
         )
-    parameters = {
+    h = float(timestep)
+    params = _parameters(k, d, h)
+    reachable = True
+    for _ in range(40):
+        es, Ts = replica(params, m, v0, h)
+        e_mean, T_mean = float(es.mean()), float(Ts.mean())
+        if abs(e_mean / e - 1) < 1e-5 and abs(T_mean / T - 1) < 1e-4:
+            break
+        k *= (T_mean / T) ** 2
+        if e_mean > 0 and e < 1:
+            alpha = max(0.0, alpha + alpha_for(e) - alpha_for(min(e_mean, 1.0)))
+        if alpha == 0.0 and e_mean < e * (1 - 1e-5):
+            reachable = False
+        params = _parameters(k, alpha / v0, h)
+    es, Ts = replica(params, m, v0, h)
+    steps = float(Ts.mean() / h)
+    if not reachable or abs(es.mean() / e - 1) > 0.005:
+        warnings.append(
+            f"a discrete plant at time_step {h:.3g} s ({steps:.0f} steps per contact) damps "
+            f"more than e = {e:.4g} allows: even with hunt_crossley_dissipation = 0 it realises "
+            f"e = {es.mean():.4g} (its implicit step; TAMSI, Lagged and Similar alike, "
+            "measured); use time_step = 0 or a smaller step"
+        )
+    if (es.max() - es.min()) / 2 > 0.005 * es.mean():
+        warnings.append(
+            f"time_step {h:.3g} s: e ranges {es.min():.4g} to {es.max():.4g} with where first "
+            "touch falls inside a step"
+        )
+    warnings.append(
+        "the promise is for the Lagged (Drake's default), Similar or TAMSI discrete "
+        "approximation; kSap ignores hunt_crossley_dissipation (e near 0)"
+    )
+    return dict(
+        parameters=params,
+        e=float(es.mean()),
+        T=float(Ts.mean()),
+        e_range=(float(es.min()), float(es.max())),
+        T_range=(float(Ts.min()), float(Ts.max())),
+        steps_per_contact=steps,
+        warnings=warnings,
+    )
+
+
+def _parameters(k: float, d: float, time_step: float) -> dict:
+    out = {
         "point_contact_stiffness": k,
         "hunt_crossley_dissipation": d,
-        "time_step": 0.0,
+        "time_step": time_step,
         "per_geometry": {"point_contact_stiffness": 2.0 * k, "hunt_crossley_dissipation": d},
         "contact_model": "point",
     }
-    return dict(
-        parameters=parameters,
-        e=float(hunt_crossley_restitution(alpha)),
-        T=float(_tau(alpha) * math.sqrt(m / k)),
-        e_range=None,
-        T_range=None,
-        steps_per_contact=None,
-        warnings=warnings,
-    )
+    if time_step:
+        out["discrete_contact_approximation"] = "lagged"
+    return out
+
+
+def discrete_step(x, v, k, d, m, h):
+    """One step of a discrete plant's implicit contact (TAMSI's scheme, Castro et al. 2019;
+    Lagged and Similar agree with it here): with the contact found at the step's start
+    (`x > 0`), the new approach speed `v1` solves `m (v1 - v) = -h k (x + h v1)_+ (1 + d
+    v1)_+` and `x1 = x + h v1`. Arrays `x` (m), `v` (m/s); returns `(x1, v1, pushing)`."""
+    A = h * h * k * d
+    B = m + h * h * k + h * k * d * x
+    C = h * k * x - m * v
+    with np.errstate(invalid="ignore", divide="ignore"):
+        root = np.where(
+            A > 0,
+            (-B + np.sqrt(np.maximum(B * B - 4 * A * C, 0.0))) / (2 * np.where(A > 0, A, 1.0)),
+            -C / B,
+        )
+    active = (x > 0) & (x + h * v > 0) & (1 + d * v > 0)
+    v1 = np.where(active, root, v)
+    return x + h * v1, v1, active
+
+
+def replica(parameters, m: float, v0: float, timestep: float, phases=None):
+    """`(e, T)` per start phase that a discrete plant (`time_step = timestep` s) realises with
+    `parameters` for a body of mass `m` (kg) at `v0` (m/s): `discrete_step` from first touch,
+    `phase * timestep` after a step's start, to the step where the contact is no longer
+    found. Checked against Drake's TAMSI, Lagged and Similar in tests/test_engines.py."""
+    from . import _stepping
+
+    phases = _stepping.PHASES if phases is None else phases
+    k = parameters["point_contact_stiffness"]
+    d = parameters["hunt_crossley_dissipation"]
+    h = float(timestep)
+    x = -v0 * h * np.asarray(phases, float)
+    v = np.full_like(x, v0)
+    steps = np.zeros_like(x)
+    started = np.zeros(x.shape, bool)
+    done = np.zeros(x.shape, bool)
+    for _ in range(2_000_000):
+        x1, v1, pushing = discrete_step(x, v, k, d, m, h)
+        x, v = np.where(done, x, x1), np.where(done, v, v1)
+        started |= pushing
+        done |= started & ~pushing
+        steps += pushing & ~done
+        if done.all():
+            return -v / v0, steps * h
+    raise RuntimeError("the replica did not finish the contact; the time step is far too small")
 
 
 def snippet(parameters) -> str:
@@ -89,8 +191,14 @@ def snippet(parameters) -> str:
         f"AddContactMaterial(dissipation={per['hunt_crossley_dissipation']!r}, "
         f"point_stiffness={per['point_contact_stiffness']!r}, properties=props)\n"
         "# give these props to BOTH geometries in contact (they combine in series)\n"
-        "plant = MultibodyPlant(time_step=0.0)  # continuous: the promise holds\n"
-        "plant.set_contact_model(ContactModel.kPoint)"
+        f"plant = MultibodyPlant(time_step={parameters['time_step']!r})"
+        + (
+            "  # continuous: the promise holds\n"
+            if not parameters["time_step"]
+            else "\nplant.set_discrete_contact_approximation("
+            "DiscreteContactApproximation.kLagged)  # not kSap\n"
+        )
+        + "plant.set_contact_model(ContactModel.kPoint)"
     )
 
 
@@ -104,8 +212,11 @@ def law(parameters, m: float):
     )
 
 
-def simulate(parameters, *, m, v0, radius=0.01, time_step=0.0, accuracy=1e-10, approximation=None):
-    """Run Drake: a sphere (mass `m`, radius `radius`) onto a half space, gravity off.
+def simulate(
+    parameters, *, m, v0, radius=0.01, time_step=0.0, accuracy=1e-10, approximation=None, gap=0.0
+):
+    """Run Drake: a sphere (mass `m`, radius `radius`) onto a half space, gravity off, its
+    first touch `gap` (m) ahead (a discrete plant: `phase * v0 * time_step`).
     Returns `(e, T)`, T from the contact force's first and last non-zero sample (continuous
     plant: dense sampling through the integrator's steps). `time_step > 0`: a discrete plant,
     with `approximation` (`"tamsi"`, `"sap"`, `"lagged"`, `"similar"`; None: Drake's
@@ -155,7 +266,7 @@ def simulate(parameters, *, m, v0, radius=0.01, time_step=0.0, accuracy=1e-10, a
     simulator = Simulator(diagram)
     context = simulator.get_mutable_context()
     plant_context = plant.GetMyMutableContextFromRoot(context)
-    plant.SetFreeBodyPose(plant_context, body, RigidTransform([0, 0, radius]))
+    plant.SetFreeBodyPose(plant_context, body, RigidTransform([0, 0, radius + gap]))
     from pydrake.multibody.math import SpatialVelocity
 
     plant.SetFreeBodySpatialVelocity(plant_context, body, SpatialVelocity(np.zeros(3), [0, 0, -v0]))
@@ -179,5 +290,5 @@ def simulate(parameters, *, m, v0, radius=0.01, time_step=0.0, accuracy=1e-10, a
             break
     # refine the exit: the ball leaves x = 0 at constant speed after the force vanished
     # (f = k x (1 + d v) vanishes only at x = 0 for d v > -1)
-    T = t_end - (z - radius) / vz
+    T = t_end - (z - radius) / vz - gap / v0
     return float(vz / v0), float(T)

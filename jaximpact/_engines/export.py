@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from . import chrono, drake, lammps, liggghts, mujoco
+from . import chrono, drake, lammps, liggghts, mujoco, yade
 from .materials import check_positive, check_restitution
 
 ENGINES = {
@@ -15,10 +15,13 @@ ENGINES = {
     "drake": drake,
     "liggghts": liggghts,
     "chrono": chrono,
+    "yade": yade,
 }
-# engines whose scene is two equal spheres head-on (effective mass m/2) and whose law is the
-# Tsuji form from Young's modulus, Poisson's ratio and a restitution coefficient
-TWO_SPHERES = ("lammps", "liggghts", "chrono")
+# engines whose law is the Tsuji form from Young's modulus, Poisson's ratio and a restitution
+# coefficient, for two equal spheres head-on (effective mass m/2)
+TSUJI = ("lammps", "liggghts", "chrono")
+# engines whose scene is two equal spheres head-on
+TWO_SPHERES = (*TSUJI, "yade")
 _SPEED_FACTORS = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0)
 
 
@@ -117,13 +120,14 @@ def export(
     limit_damping: bool = False,
     curves: bool = True,
 ) -> Export:
-    """Parameters for `engine` (`"mujoco"`, `"drake"`, `"lammps"`, `"liggghts"`, `"chrono"`)
+    """Parameters for `engine` (`"mujoco"`, `"drake"`, `"lammps"`, `"liggghts"`, `"chrono"`,
+    `"yade"`)
     that realise the e and T of `law_or_fit` (a law or `calibrate`'s fit) for mass `m` (kg)
     at impact speed `v0` (m/s), or the targets `e` and `T` (s) when `law_or_fit` is None.
 
-    The scene: MuJoCo and Drake, a body of mass `m` on a fixed plane; LAMMPS, LIGGGHTS and
-    Chrono, two spheres each of mass `m` and radius `radius` (m, required) colliding head-on at
-    relative speed `v0` (LIGGGHTS and Chrono by their documented formulas, not run here)
+    The scene: MuJoCo and Drake, a body of mass `m` on a fixed plane; LAMMPS, LIGGGHTS, Chrono
+    and Yade, two spheres each of mass `m` and radius `radius` (m, required) colliding head-on
+    at relative speed `v0` (Chrono by its source's formula, not run here)
     (`poisson`: their Poisson's ratio, default 0.3; `limit_damping`: keep the force
     non-attractive). `timestep` (s): the engine's step if already chosen (the export then
     corrects for it where it can and warns where it cannot); default, a recommended step.
@@ -158,6 +162,8 @@ def export(
         if int(result.status) != 0:
             raise ValueError("the law does not separate at this m and v0 (e = 0): no engine target")
         target_e, target_T = float(result.e), float(result.T)
+    if target_T is not None:
+        _check_scales(m, v0, target_T)
     warnings = []
     module = ENGINES[engine]
     if engine == "mujoco":
@@ -188,12 +194,13 @@ def export(
             limit_damping=limit_damping,
         )
         separation = out["separation"]
-        h = out["parameters"].get("timestep_s", out["parameters"].get("time_step"))
+        p = out["parameters"]
+        h = p.get("timestep_s", p.get("time_step", p.get("timestep")))
     else:
         if target_T is None:
             raise ValueError("Drake needs a contact duration: pass T= (s) or a law")
         out = drake.design(target_e, target_T, m=m, v0=v0, timestep=timestep)
-        separation = "force"
+        separation = "force"  # h: the plant's time_step (0: continuous)
         h = out["parameters"]["time_step"]
     warnings += out["warnings"]
     # the law each side realises; LAMMPS's promise is for the pair (effective mass m/2)
@@ -237,18 +244,43 @@ def export(
     )
 
 
+def _check_scales(m: float, v0: float, T: float) -> None:
+    """A one-line ValueError where float64 cannot hold the contact's scales: its stiffness
+    `m / T^2`, the square of a step `(T / 1e5)^2`, its depth `v0 T` and force `m v0 / T`."""
+    with np.errstate(all="ignore"):
+        m_, v_, T_ = np.float64(m), np.float64(v0), np.float64(T)
+        scales = (m_ / T_**2, (T_ / 1e5) ** 2, v_ * T_, m_ * v_ / T_)
+    tiny = np.finfo(np.float64).tiny
+    if not all(np.isfinite(s) and s > tiny for s in scales):
+        raise ValueError(
+            f"T = {T:g} s, m = {m:g} kg and v0 = {v0:g} m/s give a stiffness, step or force "
+            "that float64 cannot hold; are they in s, kg and m/s?"
+        )
+
+
 def engine_response(engine: str, parameters: dict, *, m, speeds, radius=None):
     """The inverse: e(v) and T(v) (continuous law of the engine) that given engine parameters
-    produce, for a body of mass `m` (kg; LAMMPS: each sphere) at each speed of `speeds` (m/s).
+    produce, for a body of mass `m` (kg; two-sphere engines: each sphere) at each speed of
+    `speeds` (m/s). Parameters: MuJoCo `solref` (`timestep` for refsafe); LAMMPS, LIGGGHTS,
+    Chrono `E` (Pa), `coeff_restitution`, `poisson`, `limit_damping`; Yade `tc` (s), `en`;
+    Drake `point_contact_stiffness` (N/m), `hunt_crossley_dissipation` (s/m). The time step
+    is not part of this answer: `stepped_response` gives what the stepping realises.
     Returns `(law, separation, e, T)`."""
     if engine not in ENGINES:
         raise ValueError(f"unknown engine {engine!r}; choose one of: {', '.join(ENGINES)}")
     m = check_positive("m", m, "kg")
     speeds = [check_positive("speed", v, "m/s") for v in np.atleast_1d(speeds)]
     if engine == "mujoco":
-        params = {"solref": parameters["solref"], "timestep": parameters.get("timestep", 0.002)}
+        solref = mujoco.check_solref(parameters["solref"])
+        timestep = check_positive("timestep", parameters.get("timestep", 0.002), "s")
+        params = {"solref": solref, "timestep": timestep}
         law, separation, m_engine = mujoco.law(params, m), "force", m
-    elif engine in TWO_SPHERES:
+    elif engine == "yade":
+        tc = check_positive("tc", parameters["tc"], "s")
+        check_restitution(parameters["en"], "en")
+        law = yade.law({"tc": tc, "en": float(parameters["en"])}, m)
+        separation, m_engine = "force", m / 2.0
+    elif engine in TSUJI:
         if radius is None:
             raise ValueError(f"{engine} needs the spheres' radius: pass radius= (m)")
         radius = check_positive("radius", radius, "m")
@@ -283,9 +315,13 @@ def engine_response(engine: str, parameters: dict, *, m, speeds, radius=None):
 def stepped_response(engine: str, parameters: dict, *, m, speeds, radius=None):
     """What the engine's own time stepping realises with `parameters` at each speed (m/s):
     `(timestep, e, T, e_min, e_max)`, e and T the mean over where the first touch falls
-    inside a step and `e_min`, `e_max` their extremes; `None` where the step is not known
-    or not modelled: LAMMPS without a `timestep`, and Drake (its continuous plant; the
-    discrete solver's own damping is not modelled)."""
+    inside a step and `e_min`, `e_max` their extremes. Modelled (replicas checked against
+    the engines): MuJoCo at its `timestep` (default 0.002 s), LAMMPS and LIGGGHTS with a
+    `timestep` (velocity Verlet), Yade with a `timestep` (leapfrog, and its NewtonIntegrator
+    `damping`, default 0 here), Drake with `time_step > 0` (its implicit discrete step, the
+    Lagged, Similar and TAMSI approximations). `None` where the step does not apply or is
+    not known: a two-sphere engine without a `timestep`, Drake's continuous plant
+    (error-controlled integration: no step error), and Chrono (its stepper not modelled)."""
     m = check_positive("m", m, "kg")
     speeds = [check_positive("speed", v, "m/s") for v in np.atleast_1d(speeds)]
     if engine == "mujoco":
@@ -294,7 +330,7 @@ def stepped_response(engine: str, parameters: dict, *, m, speeds, radius=None):
         def run(v):
             return mujoco.replica(parameters["solref"], h, v)
 
-    elif engine == "lammps" and parameters.get("timestep") is not None:
+    elif engine in ("lammps", "liggghts") and parameters.get("timestep") is not None:
         h = check_positive("timestep", parameters["timestep"], "s")
         law = engine_response(engine, parameters, m=m, speeds=speeds[:1], radius=radius)[0]
         stepping = dict(
@@ -306,6 +342,23 @@ def stepped_response(engine: str, parameters: dict, *, m, speeds, radius=None):
 
         def run(v):
             return lammps.replica(stepping, m, v)
+
+    elif engine == "yade" and parameters.get("timestep") is not None:
+        h = check_positive("timestep", parameters["timestep"], "s")
+        damping = float(parameters.get("damping", 0.0))
+        if not 0.0 <= damping < 1.0:
+            raise ValueError(f"NewtonIntegrator damping must lie in [0, 1), got {damping!r}")
+        stepping = {"tc": float(parameters["tc"]), "en": float(parameters["en"]),
+                    "timestep": h, "damping": damping}  # fmt: skip
+
+        def run(v):
+            return yade.replica(stepping, m, v)
+
+    elif engine == "drake" and parameters.get("time_step"):
+        h = check_positive("time_step", parameters["time_step"], "s")
+
+        def run(v):
+            return drake.replica(parameters, m, v, h)
 
     else:
         return None

@@ -24,6 +24,8 @@ from . import _stepping
 from .materials import hertz_stiffness
 
 NAME = "lammps"
+# the keys `engine-e` takes: (needed, optional)
+KEYS = (("E", "coeff_restitution"), ("poisson", "limit_damping", "timestep"))
 SCENE = (
     "two equal spheres, each of mass m and radius `radius`, colliding head-on at relative "
     "speed v0 (no gravity, no friction effect on a head-on impact)"

@@ -27,6 +27,8 @@ from scipy.optimize import brentq
 from . import _stepping
 
 NAME = "mujoco"
+# the keys `engine-e` takes: (needed, optional)
+KEYS = (("solref",), ("timestep",))
 SCENE = (
     "a free body of mass m on a fixed plane (MuJoCo scales the contact per unit mass: the "
     "promise holds for any mass), no gravity, approaching along the normal at v0"
@@ -61,6 +63,24 @@ def acceleration(stiffness: float, damping: float):
     """The contact acceleration `a(x, v)` along the penetration (per unit mass, never
     pulling) of stiffness `stiffness` (1/s^2) and damping `damping` (1/s)."""
     return lambda x, v: -np.maximum(0.0, damping * v + stiffness * x)
+
+
+def check_solref(solref) -> tuple[float, float]:
+    """`solref` as two floats, or a one-line ValueError: the standard form `[timeconst > 0,
+    dampratio > 0]` or the direct form `[-stiffness < 0, -damping <= 0]`."""
+    try:
+        a, b = (float(value) for value in solref)
+    except (TypeError, ValueError):
+        message = f"solref must be two numbers, [timeconst, dampratio]; got {solref!r}"
+        raise ValueError(message) from None
+    standard = a > 0 and b > 0 and math.isfinite(a) and math.isfinite(b)
+    direct = a < 0 and b <= 0 and math.isfinite(a) and math.isfinite(b)
+    if not (standard or direct):
+        raise ValueError(
+            "solref must be [timeconst > 0, dampratio > 0] (standard) or [-stiffness < 0, "
+            f"-damping <= 0] (direct), finite; got {list(solref)!r}"
+        )
+    return a, b
 
 
 def effective(solref, timestep: float) -> tuple[float, float]:

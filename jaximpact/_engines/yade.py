@@ -1,0 +1,251 @@
+"""Yade: two equal spheres of `ViscElMat(tc=, en=, et=)` through
+`Ip2_ViscElMat_ViscElMat_ViscElPhys` and `Law2_ScGeom_ViscElPhys_Basic`, by its source.
+
+Yade 2025.2.0 (and 2023.02a, Debian's package), `pkg/dem/ViscoelasticPM.cpp`:
+`Calculate_ViscElMat_ViscElMat_ViscElPhys` sets, from Pournin et al. (2001) with the reduced
+mass `massR = m1 m2/(m1 + m2)`, `kn1 = kn2 = 2 massR (pi^2 + ln^2 en)/tc^2`,
+`cn1 = cn2 = -4 massR ln(en)/tc`, combined in series (`contactParameterCalculation`):
+
+    kn = massR (pi^2 + ln^2 en) / tc^2 (N/m),   cn = -2 massR ln(en) / tc (N s/m);
+
+`computeForceTorqueViscEl` applies `F = kn x + cn v` and sets it to zero when negative
+("Prevent appearing of attraction forces", after Schwager & Poschel 2007): a linear
+spring-dashpot whose force never pulls, `kelvin_voigt` under `separation="force"`. Pournin's
+formulas give `en` and `tc` for the contact that lasts while the spheres overlap; with the
+force clamped the realised e is higher and T shorter (en = 0.5 gives e = 0.552), and no `en`
+gives less than e = exp(-2) = 0.135 (the critically damped limit, `en -> 0`). The export
+inverts the clamped law: it asks for the `en` and `tc` that realise the target.
+
+Time stepping: `NewtonIntegrator` is a leapfrog, the contact force taken at `x_n` and the
+half-step velocity `v_{n-1/2}` (`_stepping.semi_implicit_euler`), and it applies Cundall's
+non-viscous damping `a *= 1 - damping sign(a (v + dt a/2))` (`cundallDamp2nd`), with
+`damping = 0.2` by default: that alone turns a requested 0.5 into about 0.42 (the public
+report in the issue). The snippet sets `damping=0`; `replica` models any value.
+Pitfall: a sphere on a wall or facet of mass 0 gets `massR = m/2` (Yade copies the other
+body's mass), not `m`: then `tc` is sqrt(2) too long and the damping ratio 1/sqrt(2) too low.
+"""
+
+import math
+
+import numpy as np
+
+from . import _stepping, mujoco
+from .lammps import nice_down
+
+NAME = "yade"
+# the keys `engine-e` takes: (needed, optional)
+KEYS = (("tc", "en"), ("timestep", "damping"))
+SCENE = (
+    "two equal spheres of ViscElMat, each of mass m and radius `radius`, colliding head-on at "
+    "relative speed v0 (no gravity, NewtonIntegrator(damping=0))"
+)
+_E_RANGE_TOL = 0.002
+CUNDALL_DEFAULT = 0.2  # NewtonIntegrator.damping's default (pkg/dem/NewtonIntegrator.hpp)
+
+
+def stiffness_damping(tc: float, en: float, mass_r: float) -> tuple[float, float]:
+    """`(kn, cn)` (N/m, N s/m) that Yade derives from `tc` (s), `en` and the reduced mass
+    `mass_r` (kg): `kn = mass_r (pi^2 + ln^2 en)/tc^2`, `cn = -2 mass_r ln(en)/tc`."""
+    log_e = math.log(en)
+    return mass_r * (math.pi**2 + log_e**2) / tc**2, -2.0 * mass_r * log_e / tc
+
+
+def inputs_for(e: float, T: float) -> tuple[float, float, float]:
+    """`(en, tc, zeta)`: the ViscElMat inputs whose clamped contact realises `e` and `T` (s),
+    and its damping ratio `zeta = cn / (2 sqrt(kn massR))` (< 1: Pournin's form has no
+    over-damped case)."""
+    if e >= 1.0:
+        return 1.0, T, 0.0
+    floor = math.exp(-2.0)
+    if e <= floor:
+        raise ValueError(
+            f"Yade's ViscElMat cannot realise e = {e:g}: its force is kept non-attractive and "
+            f"en -> 0 gives e = exp(-2) = {floor:.4f} (use kn and cn directly for less)"
+        )
+    zeta = mujoco.dampratio_for(e)
+    omega0 = mujoco.continuous(zeta)[1] / T
+    en = math.exp(-math.pi * zeta / math.sqrt(1.0 - zeta**2))
+    tc = math.pi / (omega0 * math.sqrt(1.0 - zeta**2))
+    return en, tc, zeta
+
+
+def acceleration(kn: float, cn: float, mass_r: float, damping: float = 0.0, h: float = 0.0):
+    """The relative acceleration `a(x, v)` (x the overlap, v its rate) of the two spheres:
+    `-max(0, kn x + cn v)/massR`, then Cundall's factor `1 - damping sign(a (v + h a/2))`."""
+
+    def accel(x, v):
+        a = -np.maximum(0.0, kn * x + cn * v) / mass_r
+        if damping:
+            a = a * (1.0 - damping * np.sign(a * (v + 0.5 * h * a)))
+        return a
+
+    return accel
+
+
+def replica(parameters, m: float, v0: float, phases=_stepping.PHASES):
+    """`(e, T)` per start phase that Yade's NewtonIntegrator realises for two spheres of mass
+    `m` (kg) at relative speed `v0` (m/s); `parameters`: `tc`, `en`, `timestep` and
+    optionally `damping` (NewtonIntegrator's, default 0 here)."""
+    h = parameters["timestep"]
+    kn, cn = stiffness_damping(parameters["tc"], parameters["en"], m / 2.0)
+    accel = acceleration(kn, cn, m / 2.0, parameters.get("damping", 0.0), h)
+    return _stepping.semi_implicit_euler(accel, h, v0, phases)
+
+
+def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=True):
+    """ViscElMat inputs and O.dt for target `e` and `T` (s): a dict with `parameters`, `e`,
+    `T` (the mean over start phases of the replica), `e_range`, `T_range`, `warnings`."""
+    warnings = []
+    en, tc, zeta = inputs_for(e, T)
+    params = {"tc": tc, "en": en, "damping": 0.0}
+    if timestep is None:
+        steps = 100
+        while True:
+            params["timestep"] = nice_down(T / steps)
+            es, Ts = replica(params, m, v0)
+            ok_e = (es.max() - es.min()) / 2 <= _E_RANGE_TOL * es.mean()
+            ok_bias = abs(es.mean() / e - 1) < 0.001 and abs(Ts.mean() / T - 1) < 0.001
+            if (ok_e and ok_bias and steps >= 400) or steps >= 51200:
+                break
+            steps *= 2
+    else:
+        params["timestep"] = float(timestep)
+    h = params["timestep"]
+    es, Ts = replica(params, m, v0)
+    if (es.max() - es.min()) / 2 > 0.005 * es.mean() or abs(es.mean() / e - 1) > 0.005:
+        warnings.append(
+            f"O.dt = {h:.3g} s gives {Ts.mean() / h:.0f} steps per contact: Yade realises "
+            f"e = {es.min():.4g} to {es.max():.4g} (asked {e:.4g}); use {nice_down(T / 400):.3g} "
+            "s or less"
+        )
+    warnings.append(
+        f"en = {en:.6g} is not the e Yade realises: its force is kept non-attractive, so "
+        f"en = {en:.4g} and tc = {tc:.4g} s give e = {e:.4g}, T = {T:.4g} s"
+    )
+    warnings.append(
+        "keep NewtonIntegrator(damping=0): its default 0.2 damps every contact further "
+        f"(measured on the replica: e = {_with_cundall(params, m, v0):.4g} instead of "
+        f"{es.mean():.4g})"
+    )
+    kn, cn = stiffness_damping(tc, en, m / 2.0)
+    rho = m / (4.0 / 3.0 * math.pi * radius**3)
+    parameters = {
+        "tc": tc,
+        "en": en,
+        "et": 1.0,
+        "density": rho,
+        "frictionAngle": 0.0,
+        "NewtonIntegrator_damping": 0.0,
+        "timestep": h,
+        "kn": kn,
+        "cn": cn,
+        "damping_ratio": zeta,
+        "material": (
+            f"ViscElMat(tc={tc!r}, en={en!r}, et=1.0, density={rho!r}, frictionAngle=0.0)"
+        ),
+    }
+    return dict(
+        parameters=parameters,
+        e=float(es.mean()),
+        T=float(Ts.mean()),
+        e_range=(float(es.min()), float(es.max())),
+        T_range=(float(Ts.min()), float(Ts.max())),
+        steps_per_contact=float(Ts.mean() / h),
+        warnings=warnings,
+        separation="force",
+    )
+
+
+def _with_cundall(params, m, v0) -> float:
+    es, _ = replica({**params, "damping": CUNDALL_DEFAULT}, m, v0)
+    return float(es.mean())
+
+
+def snippet(parameters) -> str:
+    return "\n".join(
+        [
+            f"mat = O.materials.append({parameters['material']})",
+            "O.engines = [",
+            "    ForceResetter(),",
+            "    InsertionSortCollider([Bo1_Sphere_Aabb()]),",
+            "    InteractionLoop([Ig2_Sphere_Sphere_ScGeom()], "
+            "[Ip2_ViscElMat_ViscElMat_ViscElPhys()], [Law2_ScGeom_ViscElPhys_Basic()]),",
+            "    NewtonIntegrator(damping=0.0),  # its default 0.2 damps every contact",
+            "]",
+            f"O.dt = {parameters['timestep']!r}",
+        ]
+    )
+
+
+def law(parameters, m: float):
+    """The continuous law Yade realises between the two spheres (effective mass `m/2`):
+    `kelvin_voigt` with `c = kn`, `b = cn`, under `separation="force"`."""
+    from .._laws import law as make_law
+
+    kn, cn = stiffness_damping(parameters["tc"], parameters["en"], m / 2.0)
+    return make_law("kelvin_voigt", c=kn, b=cn)
+
+
+_SCRIPT = """
+import sys
+from yade import utils
+tc, en, rho, R, v0, h, phase, damping = {args}
+mat = O.materials.append(ViscElMat(tc=tc, en=en, et=1.0, density=rho, frictionAngle=0.0))
+gap = v0 * h * phase
+O.bodies.append(utils.sphere((-R - gap / 2, 0, 0), R, material=mat))
+O.bodies.append(utils.sphere((R + gap / 2, 0, 0), R, material=mat))
+O.bodies[0].state.vel = Vector3(v0 / 2, 0, 0)
+O.bodies[1].state.vel = Vector3(-v0 / 2, 0, 0)
+O.engines = [
+    ForceResetter(),
+    InsertionSortCollider([Bo1_Sphere_Aabb()]),
+    InteractionLoop([Ig2_Sphere_Sphere_ScGeom()], [Ip2_ViscElMat_ViscElMat_ViscElPhys()],
+                    [Law2_ScGeom_ViscElPhys_Basic()]),
+    NewtonIntegrator(damping=damping, gravity=(0, 0, 0)),
+]
+O.dt = h
+steps, started = 0, False
+for _ in range(10000000):
+    O.step()
+    f = O.forces.f(0)[0]
+    if f != 0.0:
+        steps += 1
+        started = True
+    elif started:
+        break
+v = O.bodies[1].state.vel[0] - O.bodies[0].state.vel[0]
+print("RESULT %r %r %r" % (v / v0, steps * h, O.bodies[0].state.mass))
+sys.stdout.flush()
+"""
+
+
+def simulate(parameters, *, m, v0, radius, phases=(0.5,), damping=0.0, executable="yade"):
+    """Run Yade (`executable`, batch mode) on two spheres (mass `m` kg and radius `radius` m
+    each, head-on at relative speed `v0` m/s) with `parameters`' `tc`, `en`, `timestep` and
+    NewtonIntegrator `damping`; returns arrays `(e, T)`, T the number of steps with a non-zero
+    contact force times the step."""
+    import os
+    import subprocess
+    import tempfile
+
+    rho = m / (4.0 / 3.0 * math.pi * radius**3)
+    es, Ts = [], []
+    for phase in map(float, phases):
+        args = (parameters["tc"], parameters["en"], rho, radius, v0, parameters["timestep"],
+                phase, damping)  # fmt: skip
+        with tempfile.TemporaryDirectory() as folder:
+            path = os.path.join(folder, "impact.py")
+            with open(path, "w") as handle:
+                handle.write(_SCRIPT.format(args=repr(args)))
+            out = subprocess.run(
+                [executable, "-n", "-x", path], capture_output=True, text=True, timeout=600
+            )
+        lines = [line for line in out.stdout.splitlines() if line.startswith("RESULT")]
+        if not lines:
+            raise RuntimeError(f"Yade gave no result: {out.stderr.strip()[-400:]}")
+        e, T, mass = map(float, lines[-1].split()[1:])
+        if abs(mass / m - 1) > 1e-9:
+            raise RuntimeError(f"Yade's sphere has mass {mass}, not {m}")
+        es.append(e)
+        Ts.append(T)
+    return np.array(es), np.array(Ts)
