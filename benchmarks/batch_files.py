@@ -4,23 +4,34 @@ memory: rows per second, the share of reading and writing, and peak memory per f
     python benchmarks/batch_files.py     # writes benchmarks/batch_files.md
 
 Each size runs in a fresh process (peak resident memory from `resource`), twice: the first
-call compiles, the second is timed. Curves path (law 14 without gravity, chunks of 100,000).
+call compiles, the second is timed. Curves path (law 14 without gravity, chunks of 100,000)
+from 1e4 to 1e7 rows, and the integrated path (gravity on) at 1e5 rows. Then one process
+against two (`jaximpact batch --coordinator ... --num-processes 2`, on this machine), wall
+clock of the whole command (start-up and compiling included, as a user sees it).
 """
 
 import json
 import os
 import platform
 import resource
+import socket
 import subprocess
 import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, ".."))
-SIZES = (10_000, 100_000, 1_000_000)
+CASES = (  # (path, rows, g)
+    ("curves", 10_000, 0.0),
+    ("curves", 100_000, 0.0),
+    ("curves", 1_000_000, 0.0),
+    ("curves", 10_000_000, 0.0),
+    ("integrated", 100_000, 9.81),
+)
+PROCESS_CASES = (("curves", 1_000_000, 0.0), ("integrated", 100_000, 9.81))
 
 
-def child(mode: str, n: int, folder: str):
+def child(mode: str, n: int, folder: str, g: float = 0.0):
     """One measurement in this fresh process: `make` writes the file, `file` times
     `batch_file`, `memory` times `impact_batch` on the same rows; prints JSON."""
     import jax
@@ -43,55 +54,93 @@ def child(mode: str, n: int, folder: str):
         return
     if mode == "file":
         out = os.path.join(folder, f"impacts-{n}.csv")
-        ji.batch_file(source, out, "hertz_rate", progress=False)  # compiles
+        ji.batch_file(source, out, "hertz_rate", g=g, progress=False)  # compiles
         start = time.perf_counter()
-        ji.batch_file(source, out, "hertz_rate", progress=False)
+        ji.batch_file(source, out, "hertz_rate", g=g, progress=False)
     else:
         table = np.loadtxt(source, delimiter=",", skiprows=1)
         params = {"c": table[:, 0], "b1": table[:, 1]}
-        ji.impact_batch("hertz_rate", params, m=table[:, 2], v0=table[:, 3], progress=False)
+        kwargs = dict(m=table[:, 2], v0=table[:, 3], g=g, progress=False)
+        ji.impact_batch("hertz_rate", params, **kwargs)
         start = time.perf_counter()
-        ji.impact_batch("hertz_rate", params, m=table[:, 2], v0=table[:, 3], progress=False)
+        ji.impact_batch("hertz_rate", params, **kwargs)
     seconds = time.perf_counter() - start
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # MiB on Linux
     print(json.dumps(dict(seconds=seconds, peak_mib=peak)))
 
 
-def _run(mode, n, folder):
+def _run(mode, n, folder, g=0.0):
     done = subprocess.run(
-        [sys.executable, __file__, "--child", mode, str(n), folder],
+        [sys.executable, __file__, "--child", mode, str(n), folder, repr(g)],
         capture_output=True, text=True, check=True,
     )  # fmt: skip
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
+def _processes(n, folder, g, count):
+    """Wall clock (s) of `jaximpact batch` on `count` processes, and the output's bytes."""
+    source = os.path.join(folder, f"bodies-{n}.csv")
+    out = os.path.join(folder, f"impacts-{n}-{count}p.csv")
+    command = ["jaximpact", "batch", source, "--law", "hertz_rate", "--out", out,
+               "--g", repr(g)]  # fmt: skip
+    if count > 1:
+        with socket.socket() as probe:
+            probe.bind(("localhost", 0))
+            port = probe.getsockname()[1]
+        command += ["--coordinator", f"localhost:{port}", "--num-processes", str(count)]
+    env = {**os.environ, "JAXIMPACT_PROGRESS": "0"}
+    start = time.perf_counter()
+    procs = [
+        subprocess.Popen(command + (["--process-id", str(k)] if count > 1 else []), env=env,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        for k in range(count)
+    ]  # fmt: skip
+    for p in procs:
+        _, err = p.communicate()
+        if p.returncode:
+            raise RuntimeError(err.decode()[-2000:])
+    seconds = time.perf_counter() - start
+    with open(out, "rb") as handle:
+        data = handle.read()
+    os.remove(out)
+    return seconds, data
+
+
 def main():
     import tempfile
 
-    rows = []
+    rows, process_rows = [], []
     with tempfile.TemporaryDirectory() as folder:
-        for n in SIZES:
-            made, file, memory = (_run(mode, n, folder) for mode in ("make", "file", "memory"))
-            rows.append(dict(n=n, size_mib=made["size_mib"], file_s=file["seconds"],
+        for path, n, g in CASES:
+            made, file, memory = (_run(mode, n, folder, g) for mode in ("make", "file", "memory"))
+            rows.append(dict(path=path, n=n, size_mib=made["size_mib"], file_s=file["seconds"],
                              memory_s=memory["seconds"], peak_mib=file["peak_mib"],
                              memory_peak_mib=memory["peak_mib"]))  # fmt: skip
             print(rows[-1], flush=True)
+        for path, n, g in PROCESS_CASES:
+            one, one_bytes = _processes(n, folder, g, 1)
+            two, two_bytes = _processes(n, folder, g, 2)
+            process_rows.append(dict(path=path, n=n, one=one, two=two,
+                                     same=one_bytes == two_bytes))  # fmt: skip
+            print(process_rows[-1], flush=True)
     load = os.getloadavg()[0]
     lines = [
         "# Many bodies from a file: `batch_file` against `impact_batch` in memory",
         "",
         f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, no "
-        f"accelerator, load {load:.1f}; `python benchmarks/batch_files.py`. Law 14 on the "
-        "curves (no gravity), chunks of 100,000 rows, second call timed.",
+        f"accelerator, load {load:.1f} at the end; `python benchmarks/batch_files.py`. Law 14 "
+        "(c, b1, m, v0 per row), chunks of 100,000 rows, second call timed; `curves`: no "
+        "gravity (the universal curves), `integrated`: g = 9.81 m/s^2 (diffrax).",
         "",
-        "| rows | input file (MiB) | batch_file (s) | rows/s | impact_batch in memory (s) | "
-        "reading and writing (share) | batch_file peak memory (MiB) | in memory peak (MiB) |",
-        "|---|---|---|---|---|---|---|---|",
+        "| path | rows | input file (MiB) | batch_file (s) | rows/s | impact_batch in memory "
+        "(s) | reading and writing (share) | batch_file peak memory (MiB) | in memory peak "
+        "(MiB) |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         share = 1 - r["memory_s"] / r["file_s"]
         lines.append(
-            f"| {r['n']:,} | {r['size_mib']:.1f} | {r['file_s']:.2f} | "
+            f"| {r['path']} | {r['n']:,} | {r['size_mib']:.1f} | {r['file_s']:.2f} | "
             f"{r['n'] / r['file_s']:,.0f} | {r['memory_s']:.3f} | {share:.0%} | "
             f"{r['peak_mib']:.0f} | {r['memory_peak_mib']:.0f} |"
         )
@@ -99,7 +148,23 @@ def main():
         "",
         "Each column is its own process: peak memory is that process's resident maximum "
         "(the JAX runtime included). `batch_file` holds one chunk at a time; the in-memory "
-        "call holds every row.",
+        "call holds every row (and `np.loadtxt`'s copy of the file).",
+        "",
+        "## One process against two (`jaximpact batch`, this machine)",
+        "",
+        "| path | rows | 1 process (s) | 2 processes (s) | speed-up | same file, bit for bit |",
+        "|---|---|---|---|---|---|",
+    ]
+    for r in process_rows:
+        lines.append(
+            f"| {r['path']} | {r['n']:,} | {r['one']:.1f} | {r['two']:.1f} | "
+            f"{r['one'] / r['two']:.2f} | {'yes' if r['same'] else 'NO'} |"
+        )
+    lines += [
+        "",
+        "Wall clock of the whole command, start-up and compiling included. Both processes "
+        "share this machine's 2 cores (XLA already uses both from one process), so two "
+        "processes here show the overhead of coordination, not the gain of a second machine.",
     ]
     with open(os.path.join(HERE, "batch_files.md"), "w") as handle:
         handle.write("\n".join(lines) + "\n")
@@ -107,6 +172,6 @@ def main():
 
 if __name__ == "__main__":
     if len(sys.argv) > 1 and sys.argv[1] == "--child":
-        child(sys.argv[2], int(sys.argv[3]), sys.argv[4])
+        child(sys.argv[2], int(sys.argv[3]), sys.argv[4], float(sys.argv[5]))
     else:
         main()

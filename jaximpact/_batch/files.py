@@ -14,6 +14,7 @@ joins them: the same file, bit for bit, as one process writes.
 import dataclasses
 import hashlib
 import json
+import os
 import time
 import warnings
 from pathlib import Path
@@ -26,7 +27,7 @@ from .._status import Status
 from .impacts import batch_path, impact_batch
 from .parts import FLOAT_OUTPUTS, OUTPUTS, Parts
 from .processes import ProcessGroup
-from .readers import TEXT_COLUMNS, is_parquet, open_table, require_pyarrow
+from .readers import TEXT_COLUMNS, is_parquet, open_chunks, open_table, require_pyarrow
 from .row_checks import KINEMATICS, check_fixed, check_rows
 
 __all__ = ["OUTPUTS", "BatchFile", "batch_file"]
@@ -72,6 +73,10 @@ def batch_file(
     - `source`, `out`: CSV files, or Parquet (`.parquet`, `.pq`; needs pyarrow). The output
       holds the input columns (a CSV's text as written) and `e`, `T` (s), `x_max` (m),
       `t_max` (s), `F_max` (N), `status` (a `Status` name) and `path` per row, in file order.
+      `source` may also be an iterable of chunks from a script: mappings column -> 1-D array
+      or number (dicts of numpy arrays, pandas DataFrames), each chunk used as given (not
+      `chunk_rows`). A list is read twice (every value checked first); a generator once,
+      each chunk checked just before it is computed.
     - `law`: a name of `LAW_NAMES`. The file's columns give, per row, any of its parameters
       and `m` (kg), `v0` (m/s), `g` (m/s^2), `separation`; `params`, `m`, `v0`, `g`,
       `separation` give the rest (SI units).
@@ -94,7 +99,10 @@ def batch_file(
         raise ValueError(f"unknown law {law!r}; see `jaximpact laws`")
     if isinstance(chunk_rows, bool) or not (isinstance(chunk_rows, int) and chunk_rows >= 1):
         raise ValueError(f"chunk_rows must be a positive integer, got {chunk_rows!r}")
-    source, out = Path(source), Path(out)
+    from_file = isinstance(source, (str, os.PathLike))
+    out = Path(out)
+    if from_file:
+        source = Path(source)
     if out.parent != Path("") and not out.parent.is_dir():
         raise ValueError(f"{out}: directory {str(out.parent)!r} does not exist")
     if is_parquet(out):
@@ -107,13 +115,16 @@ def batch_file(
         raise ValueError(f"law {law!r} has no parameter {', '.join(unknown)}; it takes "
                          f"{', '.join(spec.parameters)}")  # fmt: skip
     check_fixed(law, fixed)
-    table = open_table(source, allowed=(*spec.parameters, *KINEMATICS, *TEXT_COLUMNS))
+    allowed = (*spec.parameters, *KINEMATICS, *TEXT_COLUMNS)
+    table = open_table(source, allowed) if from_file else open_chunks(source, allowed)
+    label = source.name if from_file else "chunks"
+    one_pass = not getattr(table, "replayable", True)  # a generator: check as it comes
     columns = table.columns
     missing = [k for k in (*spec.parameters, "m", "v0") if k not in columns and k not in fixed]
     if missing:
         raise ValueError(
-            f"{source}: no value for {', '.join(missing)}: give a column or a fixed value "
-            f"(--param NAME=VALUE, --mass, --v0)"
+            f"{source if from_file else 'chunks'}: no value for {', '.join(missing)}: give a "
+            "column or a fixed value (--param NAME=VALUE, --mass, --v0)"
         )
     fixed = {k: v for k, v in fixed.items() if k not in columns}
     settings = json.dumps(
@@ -127,8 +138,8 @@ def batch_file(
     # 1. every value checked (each process its own chunks) before anything is written
     digests, rows, chunks, problem = {}, 0, 0, None
     estimate = max(1, -(-table.estimated_rows() // chunk_rows))
-    with Progress(estimate, f"checking {source.name}{tag}", enabled=progress) as bar:
-        for index, chunk in enumerate(table.chunks(chunk_rows)):
+    with Progress(estimate, f"checking {label}{tag}", enabled=progress and not one_pass) as bar:
+        for index, chunk in enumerate(() if one_pass else table.chunks(chunk_rows)):
             if group.owns(index) and problem is None:
                 try:
                     cells = table.parse(chunk)
@@ -145,8 +156,8 @@ def batch_file(
     problems = sorted(tuple(p) for p in group.gather(problem) if p is not None)
     if problems:
         raise ValueError(problems[0][1])
-    if rows == 0:
-        raise ValueError(f"{source}: no data rows under the header")
+    if rows == 0 and not one_pass:
+        raise ValueError(f"{label}: no data rows" + (" under the header" if from_file else ""))
 
     # 2. each process computes its chunks, reusing those an earlier run finished
     if group.index == 0 and not resume:
@@ -155,17 +166,29 @@ def batch_file(
         parts.dir.mkdir(parents=True, exist_ok=True)
     group.gather(None)  # the others wait for the parts directory
     own = [i for i in range(chunks) if group.owns(i)]
-    own_rows = sum(min(chunk_rows, rows - i * chunk_rows) for i in own)
+    own_rows = sum(min(chunk_rows, rows - i * chunk_rows) for i in own) if from_file else None
+    if not from_file and not one_pass:
+        sizes = [table.size(chunk) for chunk in table.chunks(chunk_rows)]  # cheap: no parsing
+        own_rows = sum(sizes[i] for i in own)
     computed = reused = done_rows = 0
     start = time.perf_counter()
     failed = True
     try:
-        with Progress(len(own), f"batch {law}{tag}", enabled=progress) as bar:
+        with Progress(max(len(own), 1), f"batch {law}{tag}", enabled=progress) as bar:
             for index, chunk in enumerate(table.chunks(chunk_rows)):
+                if one_pass:
+                    rows += table.size(chunk)
+                    chunks += 1
+                    bar.total = max(bar.total, -(-chunks // group.count))
                 if not group.owns(index):
                     continue
-                if not (resume and parts.done(index, digests[index])):
+                cells = None
+                if one_pass:
                     cells = table.parse(chunk)
+                    check_rows(law, cells.values, fixed, cells.where)
+                    digests[index] = _digest(settings, cells.digest)
+                if not (resume and parts.done(index, digests[index])):
+                    cells = cells or table.parse(chunk)
                     results = _compute(law, cells.values, cells.rows, fixed, impact_options)
                     parts.write(index, digests[index], columns, cells, results)
                     computed += 1
@@ -173,11 +196,15 @@ def batch_file(
                     reused += 1
                 done_rows += table.size(chunk)
                 bar.update(_rate(done_rows, own_rows, time.perf_counter() - start))
+        if one_pass and rows == 0:
+            raise ValueError("chunks: no rows in any chunk")
         failed = False
     finally:  # every process says how it went, so that none waits for a dead one's parts
         failures = group.gather(failed)
     if any(failures):
         raise RuntimeError("another process of the batch failed; run again with --resume")
+    if one_pass and group.count > 1:  # each process counted the chunks it read
+        chunks = max(group.gather(chunks))
 
     # 3. process 0 joins the parts into OUT
     statuses = dict.fromkeys((s.name for s in Status), 0)
@@ -200,6 +227,8 @@ def _rate(done: int, total: int, seconds: float) -> str:
     rate = done / seconds if seconds > 0 else 0.0
     if rate <= 0:
         return f"{done:,} rows"
+    if total is None:
+        return f"{done:,} rows, {rate:,.0f} rows/s"
     left = int(round((total - done) / rate))
     return f"{done:,} rows, {rate:,.0f} rows/s, {left // 60}m{left % 60:02d}s left"
 

@@ -6,6 +6,7 @@ the integrated rows so that each chunk holds members of similar cost.
 
 import functools
 import warnings
+from collections.abc import Mapping
 
 import jax
 import jax.numpy as jnp
@@ -223,8 +224,8 @@ def impact_batch(
     law,
     params: dict | None = None,
     *,
-    m,
-    v0,
+    m=None,
+    v0=None,
     g=0.0,
     separation: str = "force",
     method: str = "auto",
@@ -237,6 +238,7 @@ def impact_batch(
     devices=None,
     exact: bool = True,
     invalid: str = "mark",
+    out=None,
     **impact_options,
 ) -> dict[str, np.ndarray]:
     """Impacts of many bodies at once: `impact` over a batch, in chunks, on all local devices.
@@ -266,6 +268,12 @@ def impact_batch(
     Returns a dict of numpy arrays of length `n` (`status` as integers of `Status`).
     Inputs are checked once for the whole batch, before any work.
 
+    Streaming, as `jaximpact batch` does: with `params` an iterable of chunks (mappings
+    column -> array, each holding any of the law's parameters and `m`, `v0`, `g`,
+    `separation`; a generator is read once) and `out` a CSV or Parquet path, each chunk is
+    computed and written as it comes, and a `BatchFile` record is returned (see
+    `batch_file`, which takes the same and `resume=`). `law` must then be a name.
+
     **Example**:
     ```python
     out = impact_batch("hertz_rate", {"c": 2e6, "b1": np.linspace(100, 2000, 10_000)},
@@ -273,6 +281,11 @@ def impact_batch(
     out["e"], out["T"]
     ```
     """
+    if out is not None or not (params is None or isinstance(params, Mapping)):
+        return _stream(law, params, out, m=m, v0=v0, g=g, separation=separation,
+                       method=method, rtol=rtol, progress=progress, **impact_options)  # fmt: skip
+    if m is None or v0 is None:
+        raise ValueError("impact_batch needs m= (kg) and v0= (m/s): numbers or 1-D arrays")
     if order not in ("cost", "given"):
         raise ValueError(f"order must be 'cost' or 'given', got {order!r}")
     unknown = sorted(set(fields) - set(_ALL_FIELDS))
@@ -337,3 +350,17 @@ def impact_batch(
         elif np.issubdtype(values.dtype, np.floating):
             out[name] = np.where(bad | lost, np.nan, values)
     return out
+
+
+def _stream(law, chunks, out, *, m, v0, g, separation, progress, **options):
+    """`impact_batch` over an iterable of chunks, written to `out` (`batch_file`)."""
+    from .files import batch_file
+
+    if not isinstance(law, str):
+        raise ValueError("impact_batch with chunks and out= takes a law name (see LAW_NAMES)")
+    if out is None:
+        raise ValueError("impact_batch over chunks needs out= (a CSV or Parquet path)")
+    if chunks is None:
+        raise ValueError("impact_batch with out= needs the chunks (an iterable of mappings)")
+    return batch_file(chunks, out, law, m=m, v0=v0, g=g, separation=separation,
+                      progress=progress, **options)  # fmt: skip

@@ -259,3 +259,115 @@ class ParquetTable:
                 digest.update(array.tobytes())
             values[name] = array
         return Cells(values, table.num_rows, digest.digest(), None, where)
+
+
+def open_chunks(source, allowed):
+    """A `ChunkTable` for `source`, an iterable of chunks, its columns checked as a file's
+    header is."""
+    table = ChunkTable(source)
+    for name in table.columns:
+        if name not in allowed:
+            raise ValueError(
+                f"{table.where_header}: unknown column {name!r}; the columns may be "
+                f"{', '.join(allowed)}"
+            )
+    return table
+
+
+class ChunkTable:
+    """Chunks given by a script: an iterable of mappings column -> 1-D array or number (a
+    dict of numpy arrays, a pandas DataFrame, ...), each chunk used as given. A list (or any
+    iterable whose `iter` starts afresh) is `replayable`: read once to check every value and
+    again to compute. A one-shot iterator (a generator) is read once: each chunk is checked
+    just before it is computed."""
+
+    def __init__(self, source):
+        if isinstance(source, (str, bytes)) or not hasattr(source, "__iter__"):
+            raise ValueError(
+                "chunks must be an iterable of mappings column -> array, got "
+                f"{type(source).__name__}"
+            )
+        iterator = iter(source)
+        self.replayable = iterator is not source
+        try:
+            first = next(iterator)
+        except StopIteration:
+            raise ValueError("chunks: the iterable holds no chunk") from None
+        self._first = _columns_of(first, 0)
+        self.columns = tuple(self._first)
+        self.where_header = "chunk 0"
+        self._source = source if self.replayable else itertools.chain([first], iterator)
+        self._used = False
+
+    def chunks(self, rows: int):
+        """`(index, first row, chunk)` per chunk, as given (`rows` is not used)."""
+        if not self.replayable:
+            if self._used:
+                raise RuntimeError("a one-shot iterator of chunks can be read only once")
+            self._used = True
+        start = 0
+        for index, chunk in enumerate(self._source):
+            values = _columns_of(chunk, index)
+            if tuple(values) != self.columns:
+                raise ValueError(
+                    f"chunk {index}: columns {', '.join(values)}, not those of chunk 0 "
+                    f"({', '.join(self.columns)})"
+                )
+            yield index, start, values
+            start += self.size((index, start, values))
+
+    @staticmethod
+    def size(chunk) -> int:
+        """The number of rows of `chunk`."""
+        return max((np.size(v) for v in chunk[2].values()), default=0)
+
+    def estimated_rows(self) -> int:
+        """Unknown for chunks: the count of the first chunk's rows."""
+        return self.size((0, 0, self._first))
+
+    def parse(self, chunk) -> Cells:
+        index, start, values = chunk
+        rows = self.size(chunk)
+
+        def where(i):
+            return f"chunk {index}, row {i} (row {start + i} of all)"
+
+        out, digest = {}, hashlib.sha256()
+        for name, value in values.items():
+            digest.update(name.encode() + b"\0")
+            if name in TEXT_COLUMNS:
+                array = np.broadcast_to(np.asarray(value, dtype=object), (rows,))
+                array = np.array([str(s).strip() for s in array], dtype=object)
+                digest.update("\n".join(array).encode())
+            else:
+                try:
+                    array = np.asarray(value, dtype=float)
+                except (TypeError, ValueError):
+                    raise ValueError(
+                        f"chunk {index}, column {name}: not numbers ({_shown(value)})"
+                    ) from None
+                if array.ndim > 1 or (array.ndim == 1 and array.size not in (1, rows)):
+                    raise ValueError(
+                        f"chunk {index}, column {name}: {array.size} values for {rows} rows "
+                        "(give one per row, or one number)"
+                    )
+                array = np.array(np.broadcast_to(array, (rows,)))
+                digest.update(array.tobytes())
+            out[name] = array
+        return Cells(out, rows, digest.digest(), None, where)
+
+
+def _columns_of(chunk, index: int) -> dict:
+    """`chunk` as an ordered mapping column -> values (a DataFrame's columns included)."""
+    if hasattr(chunk, "to_dict") and hasattr(chunk, "columns"):  # a pandas DataFrame
+        return {str(name): chunk[name].to_numpy() for name in chunk.columns}
+    if not hasattr(chunk, "keys"):
+        raise ValueError(
+            f"chunk {index}: a mapping column -> array is needed, got {type(chunk).__name__}"
+        )
+    return {str(name): chunk[name] for name in chunk.keys()}
+
+
+def _shown(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."

@@ -103,7 +103,8 @@ def test_columns_for_separation_and_failing_rows_kept_with_their_status(tmp_path
     for word in ("force", "penetration"):
         rows = separation == word
         want = ji.impact_batch("kelvin_voigt", {"c": 2e6, "b": b[rows]}, m=1.0, v0=2.0,
-                               separation=word, fields=("e", "T", "status"), progress=False)  # fmt: skip
+                               separation=word, fields=("e", "T", "status"),
+                               progress=False)  # fmt: skip
         got = {k: np.asarray(out[k])[rows] for k in ("e", "T", "status")}
         np.testing.assert_allclose(got["e"].astype(float), want["e"], rtol=1e-13, atol=1e-17)
         np.testing.assert_allclose(got["T"].astype(float), want["T"], rtol=1e-13)
@@ -237,6 +238,86 @@ def test_parquet_in_and_out(tmp_path):
         ji.batch_file(tmp_path / "bad.parquet", tmp_path / "o.csv", "hertz_rate", progress=False)
 
 
+def _chunks(columns, sizes=(100, 100, 50)):
+    """`columns` cut into chunks of `sizes` rows (mappings column -> array)."""
+    edges = np.cumsum((0, *sizes))
+    bounds = zip(edges[:-1], edges[1:], strict=True)
+    return [{k: v[a:b] for k, v in columns.items()} for a, b in bounds]
+
+
+def test_chunks_from_a_script_give_the_file_of_the_command(tmp_path):
+    """A list of chunks and a generator of them, through `impact_batch(..., out=)`, write
+    the same rows (and results, bit for bit) as `batch_file` on the CSV of those rows."""
+    columns = _bodies(tmp_path / "in.csv")
+    _run(tmp_path, "from_file.csv")
+    chunks = _chunks(columns)
+    listed = ji.impact_batch("hertz_rate", chunks, out=tmp_path / "listed.csv", progress=False)
+    made = ji.impact_batch(
+        "hertz_rate", (c for c in chunks), out=tmp_path / "made.csv", progress=False
+    )
+    assert (listed.rows, listed.chunks, made.rows, made.chunks) == (N, 3, N, 3)
+    assert (tmp_path / "listed.csv").read_bytes() == (tmp_path / "made.csv").read_bytes()
+    want, got = _read(tmp_path / "from_file.csv"), _read(tmp_path / "listed.csv")
+    for key in ("c", "b1", "m", "v0", "e", "T", "x_max", "t_max", "F_max"):
+        np.testing.assert_array_equal(np.asarray(got[key], float), np.asarray(want[key], float))
+    assert got["status"] == want["status"] and got["path"] == want["path"]
+    # a number for a whole chunk is broadcast, as a fixed value would be
+    fixed = [{**c, "c": 2e6} for c in chunks]
+    out = ji.batch_file(fixed, tmp_path / "fixed.csv", "hertz_rate", progress=False)
+    assert out.rows == N and set(_read(tmp_path / "fixed.csv")["c"]) == {"2000000.0"}
+
+
+def test_a_generator_stops_at_its_first_bad_chunk_and_resume_completes_it(tmp_path):
+    """A generator is checked as it comes: a bad row in chunk 1 is named after chunk 0 was
+    written; OUT is not there; fixed, `resume` reuses chunk 0 and writes the whole file."""
+    columns = _bodies(tmp_path / "in.csv")
+    good = _chunks(columns)
+    bad = [good[0], {**good[1], "m": np.r_[good[1]["m"][:7], -1.0, good[1]["m"][8:]]}, good[2]]
+    with pytest.raises(ValueError, match=r"chunk 1, row 7 \(row 107 of all\), column m"):
+        ji.batch_file((c for c in bad), tmp_path / "out.csv", "hertz_rate", progress=False)
+    assert not (tmp_path / "out.csv").exists()
+    with pytest.raises(ValueError, match=r"chunk 1, row 7"):  # a list: before any work
+        ji.batch_file(bad, tmp_path / "list.csv", "hertz_rate", progress=False)
+    assert not Path(f"{tmp_path / 'list.csv'}.parts").exists()
+    again = ji.batch_file((c for c in good), tmp_path / "out.csv", "hertz_rate", resume=True,
+                          progress=False)  # fmt: skip
+    assert (again.computed, again.reused) == (2, 1)
+    whole = ji.batch_file(good, tmp_path / "whole.csv", "hertz_rate", progress=False)
+    assert whole.computed == 3
+    assert (tmp_path / "out.csv").read_bytes() == (tmp_path / "whole.csv").read_bytes()
+
+
+@pytest.mark.parametrize(
+    "chunks, kwargs, match",
+    [
+        ([{"c": [1e6], "b1": [1.0], "v0": [1.0]}, {"c": [1e6], "v0": [1.0]}], {},
+         "chunk 1: columns c, v0, not those of chunk 0"),
+        ([[1, 2, 3]], {}, "chunk 0: a mapping column -> array is needed, got list"),
+        ([], {}, "holds no chunk"),
+        ([{"c": [1e6, 2e6], "b1": [1.0, 2.0, 3.0], "v0": 1.0}], {},
+         "column c: 2 values for 3 rows"),
+        ([{"c": ["a"], "b1": [1.0], "v0": 1.0}], {}, "column c: not numbers"),
+        ([{"c": [1e6], "b1": [1.0], "v0": [1.0], "speed": [2.0]}], {}, "unknown column 'speed'"),
+        ([{"c": [1e6], "b1": [1.0]}], {}, "no value for v0"),
+    ],
+)  # fmt: skip
+def test_bad_chunks_are_named_in_one_line(tmp_path, chunks, kwargs, match):
+    with pytest.raises(ValueError, match=match) as info:
+        ji.impact_batch("hertz_rate", chunks, out=tmp_path / "o.csv", m=1.0, progress=False)
+    assert "\n" not in str(info.value)
+    assert not (tmp_path / "o.csv").exists()
+
+
+def test_impact_batch_streaming_needs_a_name_and_a_path(tmp_path):
+    chunks = [{"c": [1e6], "b1": [1.0], "v0": [1.0]}]
+    with pytest.raises(ValueError, match="needs out="):
+        ji.impact_batch("hertz_rate", chunks, m=1.0)
+    with pytest.raises(ValueError, match="takes a law name"):
+        ji.impact_batch(ji.law("hertz_rate", c=1e6, b1=1.0), chunks, m=1.0, out=tmp_path / "o")
+    with pytest.raises(ValueError, match="needs m= .* and v0="):
+        ji.impact_batch("hertz_rate", {"c": 1e6, "b1": 1.0})
+
+
 def test_progress_reports_rows_per_second_and_time_left():
     assert files._rate(1000, 4000, 2.0) == "1,000 rows, 500 rows/s, 0m06s left"
 
@@ -298,7 +379,7 @@ def _start(argv, processes: int, **popen):
 
 def _finish(procs, timeout=400):
     outputs = [p.communicate(timeout=timeout) for p in procs]
-    for p, (out, err) in zip(procs, outputs, strict=True):
+    for p, (_, err) in zip(procs, outputs, strict=True):
         assert p.returncode == 0, err.decode()[-2000:]
     return [out.decode() for out, _ in outputs]
 
