@@ -19,10 +19,12 @@ ROOT = Path(__file__).resolve().parents[1]
 NEEDS_DATA = {"fit_microphone_impacts.py", "fit_video_trajectory.py", "pick_a_law.py"}
 OUTPUTS = {  # script -> (arguments, files it must write)
     "batch_100k.py": ([], ["batch_100k.png", "batch_100k.csv"]),
+    "batch_from_file.py": ([], ["batch_from_file.png", "impacts.csv", "streamed_impacts.csv"]),
     "bounce_paper_section7.py": ([], ["bounce_section7.png"]),
     "bumper_design.py": ([], ["bumper_design.png"]),
     "calibrate_e_and_T.py": ([], ["calibration.png"]),
     "drop_design.py": ([], ["drop_design.png"]),
+    "export_to_engines.py": ([], ["export_to_engines.png"]),
     "fit_microphone_impacts.py": ([], ["microphone_impacts.png"]),
     "fit_video_trajectory.py": ([], ["video_trajectory.png"]),
     "maps.py": (["--out", "maps"], ["maps"]),

@@ -272,7 +272,8 @@ def impact_batch(
     column -> array, each holding any of the law's parameters and `m`, `v0`, `g`,
     `separation`; a generator is read once) and `out` a CSV or Parquet path, each chunk is
     computed and written as it comes, and a `BatchFile` record is returned (see
-    `batch_file`, which takes the same and `resume=`). `law` must then be a name.
+    `batch_file`; `resume=True` reuses the chunks an interrupted run finished). `law` must
+    then be a name.
 
     **Example**:
     ```python
