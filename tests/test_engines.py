@@ -97,7 +97,7 @@ def test_mujoco_refsafe_raises_timeconst():
 
 @pytest.mark.parametrize("e, T", [(0.75, 0.01), (0.3, 2e-3)])
 def test_mujoco_design_hits_targets_through_the_replica(e, T):
-    out = mujoco_engine.design(e, T, 1.0)
+    out = mujoco_engine.design(e, T, v0=1.0)
     assert abs(out["e"] / e - 1) < 1e-3 and abs(out["T"] / T - 1) < 2e-3
     lo, hi = out["e_range"]
     assert lo <= out["e"] <= hi and (hi - lo) / 2 < 0.005 * e
@@ -108,7 +108,7 @@ def test_mujoco_design_hits_targets_through_the_replica(e, T):
 
 
 def test_mujoco_coarse_step_is_warned():
-    out = mujoco_engine.design(0.5, 2e-3, 1.0, timestep=2e-4)
+    out = mujoco_engine.design(0.5, 2e-3, v0=1.0, timestep=2e-4)
     assert any("steps per contact" in w or "refsafe" in w for w in out["warnings"])
 
 

@@ -65,8 +65,10 @@ def _run_export(args):
         raise CLIError("give either --law or --e/--T, not both")
     if args.law is None and args.param:
         raise CLIError("--param needs --law")
-    if args.radius is None and args.engine == "lammps":
-        raise CLIError("LAMMPS needs --radius (m) of the two spheres")
+    from .._engines.export import ENGINES
+
+    if args.radius is None and ENGINES[args.engine].TWO_SPHERES:
+        raise CLIError(f"{args.engine} needs --radius (m) of the two spheres")
     source = None
     if args.law is not None:
         from .._laws import law

@@ -29,6 +29,17 @@ NAME = "chrono"
 SCENE = lammps.SCENE
 law = lammps.law
 KEYS = (lammps.KEYS[0], ("poisson", "limit_damping"))
+TWO_SPHERES = True
+
+
+def response(parameters, *, m: float, radius=None):
+    """`(law, separation)`: the Tsuji form with the force always kept non-attractive."""
+    return lammps.tsuji_response(parameters, m=m, radius=radius, clamped=True, engine=NAME)
+
+
+def stepper(parameters, *, m: float, radius=None):
+    """None: Chrono's implicit stepper is not replicated."""
+    return None
 
 
 def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=True):
@@ -43,7 +54,7 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Tru
         f"set the effective curvature radius to {R_eff:.6g} m (the snippet does): Chrono's "
         "default Bullet collision system uses 0.1 m for every contact",
         "Chrono's time stepper is not replicated: e and T are the continuous law's "
-        f"(with about {T / h:.0f} steps per contact)"
+        f"(with about {T / h:.0f} steps per contact)",
     ]
     if T / h < 50:
         warnings.append(
@@ -70,6 +81,7 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Tru
         steps_per_contact=T / h,
         warnings=warnings,
         separation="force",
+        timestep=h,
     )
 
 

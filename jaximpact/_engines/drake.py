@@ -23,9 +23,12 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
+from .materials import check_positive
+
 NAME = "drake"
 # the keys `engine-e` takes: (needed, optional)
 KEYS = (("point_contact_stiffness", "hunt_crossley_dissipation"), ("time_step",))
+TWO_SPHERES = False  # the scene: a body of mass m on a half space
 SCENE = (
     "a body of mass m on a fixed half space (both geometries with the exported properties), "
     "no gravity, approaching along the normal at v0; continuous plant (time_step = 0), or "
@@ -56,7 +59,7 @@ def alpha_for(e: float) -> float:
     return brentq(f, 0.0, hi, xtol=1e-15, rtol=1e-13)
 
 
-def design(e, T, *, m, v0, timestep=None):
+def design(e, T, *, m, v0, timestep=None, **_):
     """`point_contact_stiffness` k (N/m) and `hunt_crossley_dissipation` d (s/m) that realise
     `e` and `T` (s) for mass `m` (kg) at `v0` (m/s): on the continuous plant (`timestep`
     None or 0: exact, from the closed-form e of `f = k x (1 + d v)`), or on a discrete plant
@@ -66,6 +69,8 @@ def design(e, T, *, m, v0, timestep=None):
     give `e` at that step."""
     from ..closed_forms import hunt_crossley_restitution
 
+    if T is None:
+        raise ValueError("Drake needs a contact duration: pass T= (s) or a law")
     warnings = []
     alpha = alpha_for(e)
     d = alpha / v0
@@ -80,6 +85,8 @@ def design(e, T, *, m, v0, timestep=None):
             T_range=None,
             steps_per_contact=None,
             warnings=warnings,
+            timestep=0.0,
+            separation="force",
         )
     h = float(timestep)
     params = _parameters(k, d, h)
@@ -121,6 +128,8 @@ def design(e, T, *, m, v0, timestep=None):
         T_range=(float(Ts.min()), float(Ts.max())),
         steps_per_contact=steps,
         warnings=warnings,
+        timestep=h,
+        separation="force",
     )
 
 
@@ -210,6 +219,26 @@ def law(parameters, m: float):
         c=parameters["point_contact_stiffness"],
         d=parameters["hunt_crossley_dissipation"],
     )
+
+
+def response(parameters, *, m: float, radius=None):
+    """`(law, separation)`: the point contact of `parameters` (`point_contact_stiffness`
+    N/m > 0, `hunt_crossley_dissipation` s/m >= 0) for a body of mass `m` (kg)."""
+    k = check_positive("point_contact_stiffness", parameters["point_contact_stiffness"], "N/m")
+    d = float(parameters["hunt_crossley_dissipation"])
+    if not (math.isfinite(d) and d >= 0):
+        raise ValueError(f"hunt_crossley_dissipation must be >= 0 s/m, got {d:g}")
+    return law({"point_contact_stiffness": k, "hunt_crossley_dissipation": d}, m), "force"
+
+
+def stepper(parameters, *, m: float, radius=None):
+    """`(time_step, run)`: the discrete plant's implicit step (`replica`) when
+    `parameters["time_step"] > 0`, else None (the continuous plant has no step error)."""
+    if not parameters.get("time_step"):
+        return None
+    h = check_positive("time_step", parameters["time_step"], "s")
+    response(parameters, m=m)  # the values checked
+    return h, lambda v: replica(parameters, m, v, h)
 
 
 def simulate(

@@ -2,7 +2,6 @@
 the e and T that the engine will realise."""
 
 import dataclasses
-import math
 
 import numpy as np
 
@@ -17,11 +16,10 @@ ENGINES = {
     "chrono": chrono,
     "yade": yade,
 }
-# engines whose law is the Tsuji form from Young's modulus, Poisson's ratio and a restitution
-# coefficient, for two equal spheres head-on (effective mass m/2)
-TSUJI = ("lammps", "liggghts", "chrono")
-# engines whose scene is two equal spheres head-on
-TWO_SPHERES = (*TSUJI, "yade")
+# Each engine module holds its own facts: NAME, SCENE, KEYS (what engine-e takes),
+# TWO_SPHERES (its scene: two equal spheres head-on, effective mass m/2, or a body on a
+# plane), design (targets -> parameters and what the engine realises), law and response
+# (parameters -> its continuous law), stepper (its time stepping, replicated), snippet.
 _SPEED_FACTORS = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0)
 
 
@@ -136,8 +134,7 @@ def export(
 
     **Example**: `export(law("hertz_rate", c=2e6, b1=800.0), "mujoco", m=1.0, v0=2.5).parameters`.
     """
-    if engine not in ENGINES:
-        raise ValueError(f"unknown engine {engine!r}; choose one of: {', '.join(ENGINES)}")
+    _engine(engine)
     m = check_positive("m", m, "kg")
     v0 = check_positive("v0", v0, "m/s")
     if timestep is not None:
@@ -166,46 +163,28 @@ def export(
         _check_scales(m, v0, target_T)
     warnings = []
     module = ENGINES[engine]
-    if engine == "mujoco":
-        if target_T is None:
-            # MuJoCo's default timeconst (0.02 s) at the damping ratio the target needs
-            zeta = mujoco.dampratio_for(target_e)
-            target_T = mujoco.continuous(zeta)[1] * 0.02 * max(zeta, 1e-300)
-            if zeta == 0:
-                target_T = math.pi * 0.02
-            warnings.append(f"no T given: MuJoCo's default timeconst 0.02 s, T = {target_T:.4g} s")
-        out = mujoco.design(target_e, target_T, v0, timestep)
-        separation = "force"
-        h = out["parameters"]["timestep"]
-    elif engine in TWO_SPHERES:
+    if module.TWO_SPHERES:
         if radius is None:
             raise ValueError(f"{engine} needs the spheres' radius: pass radius= (m)")
         radius = check_positive("radius", radius, "m")
         if target_T is None:
             raise ValueError(f"{engine} needs a contact duration: pass T= (s) or a law")
-        out = module.design(
-            target_e,
-            target_T,
-            m=m,
-            v0=v0,
-            radius=radius,
-            poisson=0.3 if poisson is None else poisson,
-            timestep=timestep,
-            limit_damping=limit_damping,
-        )
-        separation = out["separation"]
-        p = out["parameters"]
-        h = p.get("timestep_s", p.get("time_step", p.get("timestep")))
-    else:
-        if target_T is None:
-            raise ValueError("Drake needs a contact duration: pass T= (s) or a law")
-        out = drake.design(target_e, target_T, m=m, v0=v0, timestep=timestep)
-        separation = "force"  # h: the plant's time_step (0: continuous)
-        h = out["parameters"]["time_step"]
+    out = module.design(
+        target_e,
+        target_T,
+        m=m,
+        v0=v0,
+        radius=radius,
+        poisson=0.3 if poisson is None else poisson,
+        timestep=timestep,
+        limit_damping=limit_damping,
+    )
+    target_T = out.get("target_T", target_T)  # MuJoCo without T: its default timeconst's
+    separation, h = out["separation"], out["timestep"]
     warnings += out["warnings"]
     # the law each side realises; LAMMPS's promise is for the pair (effective mass m/2)
     engine_law = module.law(out["parameters"], m)
-    m_engine = m / 2.0 if engine in TWO_SPHERES else m
+    m_engine = m / 2.0 if module.TWO_SPHERES else m
     speeds, e_engine, T_engine, e_target, T_target = (), (), (), None, None
     if curves:
         speeds = tuple(v0 * f for f in _SPEED_FACTORS)
@@ -266,49 +245,11 @@ def engine_response(engine: str, parameters: dict, *, m, speeds, radius=None):
     Drake `point_contact_stiffness` (N/m), `hunt_crossley_dissipation` (s/m). The time step
     is not part of this answer: `stepped_response` gives what the stepping realises.
     Returns `(law, separation, e, T)`."""
-    if engine not in ENGINES:
-        raise ValueError(f"unknown engine {engine!r}; choose one of: {', '.join(ENGINES)}")
+    module = _engine(engine)
     m = check_positive("m", m, "kg")
     speeds = [check_positive("speed", v, "m/s") for v in np.atleast_1d(speeds)]
-    if engine == "mujoco":
-        solref = mujoco.check_solref(parameters["solref"])
-        timestep = check_positive("timestep", parameters.get("timestep", 0.002), "s")
-        params = {"solref": solref, "timestep": timestep}
-        law, separation, m_engine = mujoco.law(params, m), "force", m
-    elif engine == "yade":
-        tc = check_positive("tc", parameters["tc"], "s")
-        check_restitution(parameters["en"], "en")
-        law = yade.law({"tc": tc, "en": float(parameters["en"])}, m)
-        separation, m_engine = "force", m / 2.0
-    elif engine in TSUJI:
-        if radius is None:
-            raise ValueError(f"{engine} needs the spheres' radius: pass radius= (m)")
-        radius = check_positive("radius", radius, "m")
-        E = check_positive("E", parameters["E"], "Pa")
-        from .materials import check_poisson, hertz_stiffness
-
-        nu = check_poisson("poisson", parameters.get("poisson", 0.3))
-        coefficient = check_restitution(parameters["coeff_restitution"], "coeff_restitution")
-        c = hertz_stiffness(E, nu, radius, R2=radius)
-        b = (
-            lammps.damp_coefficient(coefficient) * math.sqrt(m / 2.0 * c)
-            if coefficient < 1
-            else 0.0
-        )
-        from .._laws import law as make_law
-
-        law = make_law("tsuji", c=c, b=b)
-        clamped = parameters.get("limit_damping") or engine == "chrono"
-        separation = "force" if clamped else "penetration"
-        m_engine = m / 2.0
-    else:
-        k = check_positive("point_contact_stiffness", parameters["point_contact_stiffness"], "N/m")
-        d = parameters["hunt_crossley_dissipation"]
-        if d < 0:
-            raise ValueError(f"hunt_crossley_dissipation must be >= 0 s/m, got {d}")
-        law = drake.law({"point_contact_stiffness": k, "hunt_crossley_dissipation": d}, m)
-        separation, m_engine = "force", m
-    e, T = _curve(law, m_engine, speeds, separation)
+    law, separation = module.response(parameters, m=m, radius=radius)
+    e, T = _curve(law, m / 2.0 if module.TWO_SPHERES else m, speeds, separation)
     return law, separation, e, T
 
 
@@ -322,46 +263,13 @@ def stepped_response(engine: str, parameters: dict, *, m, speeds, radius=None):
     Lagged, Similar and TAMSI approximations). `None` where the step does not apply or is
     not known: a two-sphere engine without a `timestep`, Drake's continuous plant
     (error-controlled integration: no step error), and Chrono (its stepper not modelled)."""
+    module = _engine(engine)
     m = check_positive("m", m, "kg")
     speeds = [check_positive("speed", v, "m/s") for v in np.atleast_1d(speeds)]
-    if engine == "mujoco":
-        h = check_positive("timestep", parameters.get("timestep", 0.002), "s")
-
-        def run(v):
-            return mujoco.replica(parameters["solref"], h, v)
-
-    elif engine in ("lammps", "liggghts") and parameters.get("timestep") is not None:
-        h = check_positive("timestep", parameters["timestep"], "s")
-        law = engine_response(engine, parameters, m=m, speeds=speeds[:1], radius=radius)[0]
-        stepping = dict(
-            k=float(law.parameters["c"]),
-            b=float(law.parameters["b"]),
-            limit_damping=bool(parameters.get("limit_damping", False)),
-            timestep=h,
-        )
-
-        def run(v):
-            return lammps.replica(stepping, m, v)
-
-    elif engine == "yade" and parameters.get("timestep") is not None:
-        h = check_positive("timestep", parameters["timestep"], "s")
-        damping = float(parameters.get("damping", 0.0))
-        if not 0.0 <= damping < 1.0:
-            raise ValueError(f"NewtonIntegrator damping must lie in [0, 1), got {damping!r}")
-        stepping = {"tc": float(parameters["tc"]), "en": float(parameters["en"]),
-                    "timestep": h, "damping": damping}  # fmt: skip
-
-        def run(v):
-            return yade.replica(stepping, m, v)
-
-    elif engine == "drake" and parameters.get("time_step"):
-        h = check_positive("time_step", parameters["time_step"], "s")
-
-        def run(v):
-            return drake.replica(parameters, m, v, h)
-
-    else:
+    stepping = module.stepper(parameters, m=m, radius=radius)
+    if stepping is None:
         return None
+    h, run = stepping
     runs = [run(v) for v in speeds]
     return (
         h,
@@ -370,3 +278,10 @@ def stepped_response(engine: str, parameters: dict, *, m, speeds, radius=None):
         [float(np.min(es)) for es, _ in runs],
         [float(np.max(es)) for es, _ in runs],
     )
+
+
+def _engine(name: str):
+    """The module of engine `name`, or a one-line ValueError naming the engines."""
+    if name not in ENGINES:
+        raise ValueError(f"unknown engine {name!r}; choose one of: {', '.join(ENGINES)}")
+    return ENGINES[name]

@@ -21,11 +21,12 @@ import numpy as np
 from scipy.optimize import brentq
 
 from . import _stepping
-from .materials import hertz_stiffness
+from .materials import check_poisson, check_positive, check_restitution, hertz_stiffness
 
 NAME = "lammps"
 # the keys `engine-e` takes: (needed, optional)
 KEYS = (("E", "coeff_restitution"), ("poisson", "limit_damping", "timestep"))
+TWO_SPHERES = True  # the scene: two equal spheres head-on (effective mass m/2)
 SCENE = (
     "two equal spheres, each of mass m and radius `radius`, colliding head-on at relative "
     "speed v0 (no gravity, no friction effect on a head-on impact)"
@@ -89,6 +90,10 @@ def nice_down(h: float) -> float:
 
 
 def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=False):
+    """`pair_style granular` with `hertz/material ... damping coeff_restitution` for target
+    `e` and `T` (s), two spheres of mass `m` (kg) and radius `radius` (m) at relative speed
+    `v0` (m/s): a dict with `parameters`, `e`, `T` (the replica's mean over start phases),
+    `e_range`, `T_range`, `steps_per_contact`, `warnings`, `timestep`, `separation`."""
     warnings = []
     separation = "force" if limit_damping else "penetration"
     coefficient = coefficient_for(e, limit_damping)
@@ -146,6 +151,7 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Fal
         steps_per_contact=float(Ts.mean() / h),
         warnings=warnings,
         separation=separation,
+        timestep=h,
     )
 
 
@@ -168,6 +174,44 @@ def law(parameters, m: float):
     from .._laws import law as make_law
 
     return make_law("tsuji", c=parameters["k"], b=parameters["b"])
+
+
+def tsuji_response(parameters, *, m: float, radius, clamped: bool, engine: str):
+    """`(law, separation)` of a Tsuji-form engine (LAMMPS, LIGGGHTS, Chrono) from its
+    Young's modulus `E` (Pa), `coeff_restitution` and `poisson` (default 0.3), for two spheres
+    of mass `m` (kg) and radius `radius` (m); `clamped`: the force is kept non-attractive."""
+    if radius is None:
+        raise ValueError(f"{engine} needs the spheres' radius: pass radius= (m)")
+    radius = check_positive("radius", radius, "m")
+    E = check_positive("E", parameters["E"], "Pa")
+    nu = check_poisson("poisson", parameters.get("poisson", 0.3))
+    coefficient = check_restitution(parameters["coeff_restitution"], "coeff_restitution")
+    c = hertz_stiffness(E, nu, radius, R2=radius)
+    b = damp_coefficient(coefficient) * math.sqrt(m / 2.0 * c) if coefficient < 1 else 0.0
+    return law({"k": c, "b": b}, m), "force" if clamped else "penetration"
+
+
+def response(parameters, *, m: float, radius=None):
+    """`(law, separation)` that `parameters` (`E`, `coeff_restitution`, `poisson`,
+    `limit_damping`) give two spheres of mass `m` (kg) and radius `radius` (m)."""
+    clamped = bool(parameters.get("limit_damping", False))
+    return tsuji_response(parameters, m=m, radius=radius, clamped=clamped, engine=NAME)
+
+
+def stepper(parameters, *, m: float, radius=None):
+    """`(timestep, run)`: velocity Verlet at `parameters["timestep"]` (s), or None without
+    one; `run(v)` gives `(e, T)` per start phase at relative speed `v` (m/s)."""
+    if parameters.get("timestep") is None:
+        return None
+    h = check_positive("timestep", parameters["timestep"], "s")
+    pair = response(parameters, m=m, radius=radius)[0]
+    stepping = dict(
+        k=float(pair.parameters["c"]),
+        b=float(pair.parameters["b"]),
+        limit_damping=bool(parameters.get("limit_damping", False)),
+        timestep=h,
+    )
+    return h, lambda v: replica(stepping, m, v)
 
 
 def load():

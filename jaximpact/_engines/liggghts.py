@@ -26,6 +26,14 @@ MIN_COEFFICIENT = 0.05  # createCoeffRest: "0.05 < coefficientRestitution <= 1 r
 SCENE = lammps.SCENE
 law = lammps.law
 KEYS = lammps.KEYS
+TWO_SPHERES = True
+stepper = lammps.stepper  # fix nve/sphere: the same velocity Verlet
+
+
+def response(parameters, *, m: float, radius=None):
+    """`(law, separation)`: as LAMMPS's (`limit_damping` is `limitForce on`)."""
+    clamped = bool(parameters.get("limit_damping", False))
+    return lammps.tsuji_response(parameters, m=m, radius=radius, clamped=clamped, engine=NAME)
 
 
 def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=False):

@@ -25,10 +25,13 @@ import numpy as np
 from scipy.optimize import brentq
 
 from . import _stepping
+from .materials import check_positive
 
 NAME = "mujoco"
 # the keys `engine-e` takes: (needed, optional)
 KEYS = (("solref",), ("timestep",))
+TWO_SPHERES = False  # the scene: a body of mass m on a plane
+DEFAULT_TIMECONST = 0.02  # s, MuJoCo's solref default
 SCENE = (
     "a free body of mass m on a fixed plane (MuJoCo scales the contact per unit mass: the "
     "promise holds for any mass), no gravity, approaching along the normal at v0"
@@ -106,11 +109,16 @@ def _nice_down(h: float) -> float:
     return float(f"{math.floor(h / scale * 10.0 * (1 + 1e-12)) / 10.0 * scale:.2g}")
 
 
-def design(e: float, T: float, v0: float, timestep: float | None = None):
-    """solref, solimp and time step that realise `e` and `T` (s) in MuJoCo, and what MuJoCo
-    realises with them: a dict with `parameters`, `e`, `T`, `e_range`, `T_range`, `warnings`,
-    `steps_per_contact`."""
+def design(e: float, T: float | None, *, v0: float, timestep: float | None = None, **_):
+    """solref, solimp and time step that realise `e` and `T` (s; None: MuJoCo's default
+    timeconst) at `v0` (m/s) in MuJoCo, and what MuJoCo realises with them: a dict with
+    `parameters`, `e`, `T`, `e_range`, `T_range`, `warnings`, `steps_per_contact`,
+    `timestep`, `separation`. The contact per unit mass does not depend on the mass."""
     warnings = []
+    if T is None:
+        zeta = dampratio_for(e)
+        T = DEFAULT_TIMECONST * (continuous(zeta)[1] * zeta if zeta > 0 else math.pi)
+        warnings.append(f"no T given: MuJoCo's default timeconst 0.02 s, T = {T:.4g} s")
     zeta = dampratio_for(e)
     tau = continuous(zeta)[1]
     w0 = tau / T
@@ -175,6 +183,9 @@ def design(e: float, T: float, v0: float, timestep: float | None = None):
         T_range=(float(Ts.min()), float(Ts.max())),
         steps_per_contact=steps_per_contact,
         warnings=warnings,
+        timestep=h,
+        separation="force",
+        target_T=T,
     )
 
 
@@ -204,6 +215,22 @@ def law(parameters, m: float):
 
     stiffness, damping = effective(parameters["solref"], parameters["timestep"])
     return make_law("kelvin_voigt", c=m * stiffness, b=m * damping)
+
+
+def response(parameters, *, m: float, radius=None):
+    """`(law, separation)`: the continuous law of `parameters` (`solref`, `timestep`,
+    default 0.002 s, for refsafe) for a body of mass `m` (kg), each value checked."""
+    solref = check_solref(parameters["solref"])
+    timestep = check_positive("timestep", parameters.get("timestep", 0.002), "s")
+    return law({"solref": solref, "timestep": timestep}, m), "force"
+
+
+def stepper(parameters, *, m: float, radius=None):
+    """`(timestep, run)`: MuJoCo's Euler step at `parameters["timestep"]` (default 0.002 s);
+    `run(v)` gives `(e, T)` per start phase at speed `v` (m/s)."""
+    h = check_positive("timestep", parameters.get("timestep", 0.002), "s")
+    solref = check_solref(parameters["solref"])
+    return h, lambda v: replica(solref, h, v)
 
 
 def simulate(

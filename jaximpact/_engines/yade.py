@@ -31,10 +31,12 @@ import numpy as np
 
 from . import _stepping, mujoco
 from .lammps import nice_down
+from .materials import check_positive, check_restitution
 
 NAME = "yade"
 # the keys `engine-e` takes: (needed, optional)
 KEYS = (("tc", "en"), ("timestep", "damping"))
+TWO_SPHERES = True  # the scene: two equal spheres head-on (effective mass m/2)
 SCENE = (
     "two equal spheres of ViscElMat, each of mass m and radius `radius`, colliding head-on at "
     "relative speed v0 (no gravity, NewtonIntegrator(damping=0))"
@@ -153,6 +155,7 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Tru
         steps_per_contact=float(Ts.mean() / h),
         warnings=warnings,
         separation="force",
+        timestep=h,
     )
 
 
@@ -184,6 +187,29 @@ def law(parameters, m: float):
 
     kn, cn = stiffness_damping(parameters["tc"], parameters["en"], m / 2.0)
     return make_law("kelvin_voigt", c=kn, b=cn)
+
+
+def response(parameters, *, m: float, radius=None):
+    """`(law, separation)` that `parameters` (`tc` s > 0, `en` in (0, 1]) give two spheres of
+    mass `m` (kg)."""
+    tc = check_positive("tc", parameters["tc"], "s")
+    en = check_restitution(parameters["en"], "en")
+    return law({"tc": tc, "en": en}, m), "force"
+
+
+def stepper(parameters, *, m: float, radius=None):
+    """`(timestep, run)`: NewtonIntegrator's leapfrog at `parameters["timestep"]` (s) with its
+    `damping` (default 0), or None without a timestep."""
+    if parameters.get("timestep") is None:
+        return None
+    h = check_positive("timestep", parameters["timestep"], "s")
+    damping = float(parameters.get("damping", 0.0))
+    if not 0.0 <= damping < 1.0:
+        raise ValueError(f"NewtonIntegrator damping must lie in [0, 1), got {damping!r}")
+    tc = check_positive("tc", parameters["tc"], "s")
+    en = check_restitution(parameters["en"], "en")
+    stepping = {"tc": tc, "en": en, "timestep": h, "damping": damping}
+    return h, lambda v: replica(stepping, m, v)
 
 
 _SCRIPT = """
