@@ -483,7 +483,9 @@ def test_cli_export_json_and_engine_e_round_trip(capsys):
     )
     out = json.loads(capsys.readouterr().out)
     assert abs(out["e"] / 0.6 - 1) < 1e-3 and len(out["parameters"]["solimp"]) == 5
-    params = json.dumps({"solref": out["parameters"]["solref"]})
+    params = json.dumps(
+        {"solref": out["parameters"]["solref"], "timestep": out["parameters"]["timestep"]}
+    )
     main(
         [
             "engine-e",
@@ -500,7 +502,11 @@ def test_cli_export_json_and_engine_e_round_trip(capsys):
         ]
     )
     back = json.loads(capsys.readouterr().out)
-    assert back["e"][0] == pytest.approx(out["e_engine"][3], rel=1e-9)
+    # export's e(v) is what MuJoCo's step realises (speeds 0.5 and 1 are its 3rd and 4th)
+    assert back["stepped"]["e"] == pytest.approx(out["e_engine"][2:4], rel=1e-12)
+    assert back["stepped"]["e"][1] == pytest.approx(out["e"], rel=1e-12)
+    # and the continuous law is within the recommended step's 0.5 %
+    assert back["e"] == pytest.approx(out["e_engine"][2:4], rel=5e-3)
 
 
 def test_engine_e_stepped_response_converges_to_the_continuous_law():
@@ -656,3 +662,25 @@ def test_cli_yade_export_and_engine_e_round_trip(capsys):
     back = json.loads(capsys.readouterr().out)
     assert back["e"][0] == pytest.approx(0.5, rel=1e-6)
     assert back["stepped"]["e"][0] == pytest.approx(out["e"], rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    "engine, kwargs",
+    [
+        ("mujoco", {}),
+        ("drake", {"timestep": 2e-4}),
+        ("drake", {}),
+        ("lammps", {"radius": 0.01}),
+        ("liggghts", {"radius": 0.01, "limit_damping": True}),
+        ("yade", {"radius": 0.01}),
+        ("chrono", {"radius": 0.01}),
+    ],
+)
+def test_export_curve_at_v0_is_the_promise(engine, kwargs):
+    """The engine's e(v) that export gives is what it promises at v0: its stepping where
+    replicated (MuJoCo, Drake discrete, LAMMPS, LIGGGHTS, Yade), else the continuous law
+    (Drake's continuous plant; Chrono), to 1e-6."""
+    x = ji.export(None, engine, m=1.0, v0=1.0, e=0.7, T=0.02, **kwargs)
+    assert x.speeds[3] == 1.0
+    assert x.e_engine[3] == pytest.approx(x.e, rel=1e-6)
+    assert x.T_engine[3] == pytest.approx(x.T, rel=1e-6)

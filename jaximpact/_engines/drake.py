@@ -130,6 +130,7 @@ def design(e, T, *, m, v0, timestep=None, **_):
         warnings=warnings,
         timestep=h,
         separation="force",
+        stepping=params,
     )
 
 

@@ -38,8 +38,10 @@ class Export:
     - `timestep` (s): the recommended (or given) step; `steps_per_contact`.
     - `target_e`, `target_T`: what was asked (the law's e and T at `v0`, or the targets).
     - `law`: the engine's law as a jaximpact law, `separation`: its end of contact.
-    - `speeds` (m/s), `e_engine`, `T_engine`, `e_target`, `T_target`: e(v) and T(v) of the
-      engine's law and of the given law (None when targets were given) over a range of speeds.
+    - `speeds` (m/s), `e_engine`, `T_engine`, `e_target`, `T_target`: e(v) and T(v) that the
+      engine realises (its time stepping included where it is replicated, as `e` is; else
+      its continuous law) and of the given law (None when targets were given) over a range
+      of speeds.
     - `warnings`: where the engine will not do what was asked, or only with care.
     """
 
@@ -186,9 +188,16 @@ def export(
     engine_law = module.law(out["parameters"], m)
     m_engine = m / 2.0 if module.TWO_SPHERES else m
     speeds, e_engine, T_engine, e_target, T_target = (), (), (), None, None
+    stepped = None if out.get("stepping") is None else module.stepper(out["stepping"], m=m,
+                                                                         radius=radius)  # fmt: skip
     if curves:
         speeds = tuple(v0 * f for f in _SPEED_FACTORS)
-        e_engine, T_engine = _curve(engine_law, m_engine, speeds, separation)
+        if stepped is None:  # the continuous plant, or a stepper not replicated (Chrono)
+            e_engine, T_engine = _curve(engine_law, m_engine, speeds, separation)
+        else:  # what the engine's stepping realises: the mean over first-touch phases
+            runs = [stepped[1](v) for v in speeds]
+            e_engine = tuple(float(np.mean(es)) for es, _ in runs)
+            T_engine = tuple(float(np.mean(Ts)) for _, Ts in runs)
         if source is not None:
             e_target, T_target = _curve(source, m, speeds, "force")
             spread = max(abs(a - b) for a, b in zip(e_engine, e_target, strict=True))

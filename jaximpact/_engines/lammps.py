@@ -152,6 +152,13 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Fal
         warnings=warnings,
         separation=separation,
         timestep=h,
+        stepping=dict(
+            E=E,
+            coeff_restitution=coefficient,
+            poisson=poisson,
+            limit_damping=limit_damping,
+            timestep=h,
+        ),  # fmt: skip
     )
 
 

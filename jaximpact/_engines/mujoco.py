@@ -186,6 +186,7 @@ def design(e: float, T: float | None, *, v0: float, timestep: float | None = Non
         timestep=h,
         separation="force",
         target_T=T,
+        stepping=parameters,
     )
 
 

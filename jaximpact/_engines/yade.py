@@ -156,6 +156,7 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Tru
         warnings=warnings,
         separation="force",
         timestep=h,
+        stepping=parameters,
     )
 
 
