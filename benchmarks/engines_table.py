@@ -15,23 +15,35 @@ import jaximpact as ji  # noqa: E402
 from jaximpact._engines import drake, lammps, liggghts, mujoco, yade  # noqa: E402
 
 PHASES = (0.05, 0.3, 0.55, 0.8, 0.95)
-print("| engine | asked e | asked T (s) | promised e | engine e (5 start phases) | "
-      "promised T (s) | engine T (s) | step (s) |")
+print(
+    "| engine | asked e | asked T (s) | promised e | engine e (5 start phases) | "
+    "promised T (s) | engine T (s) | step (s) |"
+)
 print("|---|---|---|---|---|---|---|---|")
 for e, T in [(0.95, 0.02), (0.75, 0.01), (0.5, 2e-3), (0.2, 5e-3), (0.05, 1e-3)]:
     x = ji.export(None, "mujoco", m=0.05, v0=1.0, e=e, T=T, curves=False)
     es, Ts = mujoco.simulate(x.parameters, 1.0, m=0.05, phases=PHASES)
-    print(f"| MuJoCo {__import__('mujoco').__version__} | {e} | {T:g} | {x.e:.5f} | "
-          f"{es.min():.5f} to {es.max():.5f} | {x.T:.5g} | {Ts.min():.5g} to {Ts.max():.5g} | "
-          f"{x.timestep:g} |")
-for e, T, limit in [(0.9, 1e-3, False), (0.5, 5e-4, False), (0.1, 1e-4, False),
-                    (0.8, 5e-4, True), (0.3, 2e-4, True)]:
-    x = ji.export(None, "lammps", m=0.004, v0=1.0, radius=0.005, e=e, T=T, limit_damping=limit,
-                  curves=False)
+    print(
+        f"| MuJoCo {__import__('mujoco').__version__} | {e} | {T:g} | {x.e:.5f} | "
+        f"{es.min():.5f} to {es.max():.5f} | {x.T:.5g} | {Ts.min():.5g} to {Ts.max():.5g} | "
+        f"{x.timestep:g} |"
+    )
+for e, T, limit in [
+    (0.9, 1e-3, False),
+    (0.5, 5e-4, False),
+    (0.1, 1e-4, False),
+    (0.8, 5e-4, True),
+    (0.3, 2e-4, True),
+]:
+    x = ji.export(
+        None, "lammps", m=0.004, v0=1.0, radius=0.005, e=e, T=T, limit_damping=limit, curves=False
+    )
     es, Ts = lammps.simulate(x.parameters, m=0.004, v0=1.0, radius=0.005, phases=PHASES)
     name = "LAMMPS 22Jul2025" + (" limit_damping" if limit else "")
-    print(f"| {name} | {e} | {T:g} | {x.e:.5f} | {es.min():.5f} to {es.max():.5f} | "
-          f"{x.T:.5g} | {Ts.min():.5g} to {Ts.max():.5g} | {x.timestep:g} |")
+    print(
+        f"| {name} | {e} | {T:g} | {x.e:.5f} | {es.min():.5f} to {es.max():.5f} | "
+        f"{x.T:.5g} | {Ts.min():.5g} to {Ts.max():.5g} | {x.timestep:g} |"
+    )
 try:
     import importlib.metadata
 
@@ -42,27 +54,46 @@ try:
     for e, T in [(0.8, 1e-3), (0.5, 5e-3), (0.3, 2e-3)]:
         x = ji.export(None, "drake", m=0.05, v0=1.0, e=e, T=T, curves=False)
         e_d, T_d = drake.simulate(x.parameters, m=0.05, v0=1.0)
-        print(f"| Drake {DRAKE} "
-              f"continuous | {e} | {T:g} | {x.e:.5f} | {e_d:.5f} | {x.T:.5g} | {T_d:.5g} | 0 |")
+        print(
+            f"| Drake {DRAKE} "
+            f"continuous | {e} | {T:g} | {x.e:.5f} | {e_d:.5f} | {x.T:.5g} | {T_d:.5g} | 0 |"
+        )
     for e, T, steps in [(0.6, 0.01, 40), (0.9, 0.02, 100), (0.9, 0.01, 10)]:
         h = T / steps
         x = ji.export(None, "drake", m=1.0, v0=1.0, e=e, T=T, timestep=h, curves=False)
-        runs = np.array([drake.simulate(x.parameters, m=1.0, v0=1.0, time_step=h,
-                                        gap=phase * h) for phase in PHASES])
-        print(f"| Drake {DRAKE} "
-              f"discrete (Lagged){' NOT REACHABLE' if x.e < 0.995 * e else ''} | {e} | {T:g} | "
-              f"{x.e:.5f} | {runs[:, 0].min():.5f} to {runs[:, 0].max():.5f} | {x.T:.5g} | "
-              f"{runs[:, 1].min():.5g} to {runs[:, 1].max():.5g} | {h:g} |")
+        runs = np.array(
+            [
+                drake.simulate(x.parameters, m=1.0, v0=1.0, time_step=h, gap=phase * h)
+                for phase in PHASES
+            ]
+        )
+        print(
+            f"| Drake {DRAKE} "
+            f"discrete (Lagged){' NOT REACHABLE' if x.e < 0.995 * e else ''} | {e} | {T:g} | "
+            f"{x.e:.5f} | {runs[:, 0].min():.5f} to {runs[:, 0].max():.5f} | {x.T:.5g} | "
+            f"{runs[:, 1].min():.5g} to {runs[:, 1].max():.5g} | {h:g} |"
+        )
 except ImportError as error:
     print(f"\nDrake not run: {error}")
 if shutil.which("liggghts"):
     for e, T, limit in [(0.9, 1e-3, False), (0.5, 5e-4, False), (0.3, 1e-3, True)]:
-        x = ji.export(None, "liggghts", m=0.004, v0=1.0, radius=0.005, e=e, T=T,
-                      limit_damping=limit, curves=False)
+        x = ji.export(
+            None,
+            "liggghts",
+            m=0.004,
+            v0=1.0,
+            radius=0.005,
+            e=e,
+            T=T,
+            limit_damping=limit,
+            curves=False,
+        )
         es, Ts = liggghts.simulate(x.parameters, m=0.004, v0=1.0, radius=0.005, phases=PHASES)
         name = "LIGGGHTS 3.8.0" + (" limitForce" if limit else "")
-        print(f"| {name} | {e} | {T:g} | {x.e:.5f} | {es.min():.5f} to {es.max():.5f} | "
-              f"{x.T:.5g} | {Ts.min():.5g} to {Ts.max():.5g} | {x.timestep:g} |")
+        print(
+            f"| {name} | {e} | {T:g} | {x.e:.5f} | {es.min():.5f} to {es.max():.5f} | "
+            f"{x.T:.5g} | {Ts.min():.5g} to {Ts.max():.5g} | {x.timestep:g} |"
+        )
 else:
     print("\nLIGGGHTS not run: no liggghts executable")
 if shutil.which("yade"):
@@ -71,22 +102,34 @@ if shutil.which("yade"):
     for e, T in [(0.8, 5e-4), (0.5, 1e-3), (0.2, 1e-3)]:
         x = ji.export(None, "yade", m=0.01, v0=1.0, radius=0.01, e=e, T=T, curves=False)
         es, Ts = yade.simulate(x.parameters, m=0.01, v0=1.0, radius=0.01, phases=PHASES)
-        print(f"| Yade {version} | {e} | {T:g} | {x.e:.5f} | {es.min():.5f} to {es.max():.5f} | "
-              f"{x.T:.5g} | {Ts.min():.5g} to {Ts.max():.5g} | {x.timestep:g} |")
+        print(
+            f"| Yade {version} | {e} | {T:g} | {x.e:.5f} | {es.min():.5f} to {es.max():.5f} | "
+            f"{x.T:.5g} | {Ts.min():.5g} to {Ts.max():.5g} | {x.timestep:g} |"
+        )
     x = ji.export(None, "yade", m=0.01, v0=1.0, radius=0.01, e=0.5, T=1e-3, curves=False)
     es, _ = yade.simulate(x.parameters, m=0.01, v0=1.0, radius=0.01, phases=(0.5,), damping=0.2)
-    print(f"\nYade with NewtonIntegrator's default damping 0.2 (the export sets 0): asked 0.5, "
-          f"Yade gives e = {es[0]:.4f}")
+    print(
+        f"\nYade with NewtonIntegrator's default damping 0.2 (the export sets 0): asked 0.5, "
+        f"Yade gives e = {es[0]:.4f}"
+    )
 else:
     print("\nYade not run: no yade executable")
 # the requested-vs-realised gap of LAMMPS's own formulas (what users meet)
 print("\n| LAMMPS input | coefficient given | realised e (LAMMPS) |")
 print("|---|---|---|")
-for damping, limit in [("coeff_restitution", ""), ("coeff_restitution", " limit_damping"),
-                       ("tsuji", ""), ("tsuji", " limit_damping")]:
+for damping, limit in [
+    ("coeff_restitution", ""),
+    ("coeff_restitution", " limit_damping"),
+    ("tsuji", ""),
+    ("tsuji", " limit_damping"),
+]:
     for cor in (0.1, 0.5, 0.9):
-        params = dict(pair_style="pair_style granular", timestep="timestep 2e-8", timestep_s=2e-8,
-                      pair_coeff=f"pair_coeff * * hertz/material 1e8 {cor} 0.3 damping {damping} "
-                      f"tangential linear_nohistory 0 0{limit}")
+        params = dict(
+            pair_style="pair_style granular",
+            timestep="timestep 2e-8",
+            timestep_s=2e-8,
+            pair_coeff=f"pair_coeff * * hertz/material 1e8 {cor} 0.3 damping {damping} "
+            f"tangential linear_nohistory 0 0{limit}",
+        )
         es, _ = lammps.simulate(params, m=0.004, v0=1.0, radius=0.005, phases=(0.5,))
         print(f"| {damping}{limit} | {cor} | {es[0]:.4f} |")

@@ -369,9 +369,17 @@ def _start(argv, processes: int, **popen):
     port = _free_port()
     return [
         subprocess.Popen(
-            [*command, "--coordinator", f"localhost:{port}", "--num-processes",
-             str(processes), "--process-id", str(k)],
-            env=_env(), **popen,
+            [
+                *command,
+                "--coordinator",
+                f"localhost:{port}",
+                "--num-processes",
+                str(processes),
+                "--process-id",
+                str(k),
+            ],
+            env=_env(),
+            **popen,
         )  # fmt: skip
         for k in range(processes)
     ]
