@@ -34,7 +34,10 @@ def add_batch(subparsers):
         "source", type=Path, metavar="IN", help="CSV or Parquet file, one body per row"
     )
     parser.add_argument("--law", required=True, metavar="NAME", help="see `jaximpact laws`")
-    parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE")
+    parser.add_argument(
+        "--param", action="append", default=[], metavar="NAME=VALUE",
+        help="a law parameter for every row, SI units (repeat --param for each)",
+    )  # fmt: skip
     parser.add_argument("--mass", type=float, metavar="KG", help="m for every row, kg")
     parser.add_argument("--v0", type=float, metavar="M/S", help="impact speed for every row")
     parser.add_argument("--g", type=float, default=0.0, metavar="M/S^2", help="gravity")
@@ -42,8 +45,15 @@ def add_batch(subparsers):
         "--separation", choices=("force", "penetration"), default="force", help="end of contact"
     )
     parser.add_argument("--out", required=True, type=Path, metavar="OUT", help="file to write")
-    parser.add_argument("--chunk-rows", type=int, default=100_000, metavar="N")
-    parser.add_argument("--resume", action="store_true", help="reuse finished chunks")
+    parser.add_argument(
+        "--chunk-rows", type=int, default=100_000, metavar="N",
+        help="rows per chunk (default 100000): the unit of memory, of work and of --resume",
+    )  # fmt: skip
+    parser.add_argument(
+        "--resume", action="store_true",
+        help="reuse the chunks an interrupted run left in OUT.parts/ whose inputs and "
+        "settings are unchanged (a finished run leaves none)",
+    )  # fmt: skip
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
     group = parser.add_argument_group("several processes (jax.distributed)")
     group.add_argument(
