@@ -1,4 +1,5 @@
-"""Replicas of the engines' time stepping for one head-on contact, in numpy.
+"""Replicas of the engines' time stepping for one head-on contact, in numpy, and the time step
+an export recommends from them.
 
 They predict what an engine realises (its discretisation included) without running it; the
 engine tests check them against the engines themselves. Each contact is started at several
@@ -6,17 +7,30 @@ phases inside a time step (the first touch falls `phase * h` after a step's star
 the realised e depends on it at first order in the step.
 """
 
+import math
+
 import numpy as np
 
 PHASES = (np.arange(16) + 0.5) / 16
+E_RANGE_TOL = 0.002  # half-spread of e over start phases (relative) a recommended step allows
+_BIAS_TOL = 0.001  # relative error of the phase-mean e and T a recommended step allows
+_WARN_TOL = 0.005  # spread or bias (relative) above which an export warns about its step
+_MIN_STEPS, _MAX_STEPS = 400, 51200  # steps per contact a recommended step searches
 
 
-def _finish(x, v, h, v0, force_of, update, max_steps):
+def step_until_separated(step, h, v0, phases=PHASES, max_steps=2_000_000):
+    """`(e, T)` per start phase of a contact stepped by `step(x, v) -> (x1, v1, pushing)`
+    (arrays: penetration `x` in m, approach speed `v` in m/s, whether the step's force is
+    non-zero) from `x = -phase v0 h` until the force is zero again; `T` (s) is the number of
+    steps with a non-zero force times `h`."""
+    x = -v0 * h * np.asarray(phases, float)
+    v = np.full_like(x, v0)
     steps = np.zeros_like(x)
     started = np.zeros(x.shape, bool)
     done = np.zeros(x.shape, bool)
     for _ in range(max_steps):
-        x, v, pushing = update(x, v, done)
+        x1, v1, pushing = step(x, v)
+        x, v = np.where(done, x, x1), np.where(done, v, v1)
         started |= pushing
         done |= started & ~pushing
         steps += pushing & ~done
@@ -30,32 +44,85 @@ def semi_implicit_euler(accel, h, v0, phases=PHASES, max_steps=2_000_000):
     active while `x > 0` at a step's start. `accel(x, v)` is the contact acceleration along
     the penetration `x` (<= 0, it never pulls). Returns `(e, T)` per phase, `T` the number of
     steps with a non-zero force times `h`."""
-    x = -v0 * h * np.asarray(phases, float)
-    v = np.full_like(x, v0)
 
-    def update(x, v, done):
+    def step(x, v):
         a = np.where(x > 0, accel(np.maximum(x, 0.0), v), 0.0)
-        v_new = np.where(done, v, v + h * a)
-        return np.where(done, x, x + h * v_new), v_new, a != 0
+        v_new = v + h * a
+        return x + h * v_new, v_new, a != 0
 
-    return _finish(x, v, h, v0, accel, update, max_steps)
+    return step_until_separated(step, h, v0, phases, max_steps)
 
 
 def velocity_verlet(accel, h, v0, phases=PHASES, max_steps=2_000_000):
     """LAMMPS's `fix nve` (and `nve/sphere`): half kick, drift, force from the new
     positions and the half-step velocities, half kick. `accel(x, v)` as above."""
-    x = -v0 * h * np.asarray(phases, float)
-    v = np.full_like(x, v0)
-    a = np.zeros_like(x)
+    a = np.zeros(np.shape(phases))
 
-    def update(x, v, done):
+    def step(x, v):
         nonlocal a
         v_half = v + 0.5 * h * a
         x_new = x + h * v_half
-        a_new = np.where(x_new > 0, accel(np.maximum(x_new, 0.0), v_half), 0.0)
-        v_new = v_half + 0.5 * h * a_new
-        pushing = a_new != 0
-        a = np.where(done, 0.0, a_new)
-        return np.where(done, x, x_new), np.where(done, v, v_new), pushing
+        a = np.where(x_new > 0, accel(np.maximum(x_new, 0.0), v_half), 0.0)
+        return x_new, v_half + 0.5 * h * a, a != 0
 
-    return _finish(x, v, h, v0, accel, update, max_steps)
+    return step_until_separated(step, h, v0, phases, max_steps)
+
+
+def nice_down(h: float) -> float:
+    """`h` (s) rounded down to two significant digits (a number one types into an input)."""
+    scale = 10.0 ** math.floor(math.log10(h))
+    return float(f"{math.floor(h / scale * 10.0 * (1 + 1e-12)) / 10.0 * scale:.2g}")
+
+
+def step_and_response(run, e: float, T: float, timestep, *, engine: str, step: str):
+    """`(h, es, Ts, warnings)` for an engine whose stepping `run(h) -> (e, T)` per start phase
+    realises the target `e` and `T` (s): `h` the given `timestep` (s) or, when None, the
+    recommended one (`nice_down(T / N)`, N = 400, 800, ... 51200 steps per contact, the first
+    whose phases spread e by at most `E_RANGE_TOL` of its mean and whose phase means are
+    within 0.1 % of `e` and `T`), what `run` realises at `h`, and a warning (its step called
+    `step` in `engine`'s words) where e spreads or misses `e` by more than 0.5 %."""
+    h = recommended_step(run, T, e) if timestep is None else float(timestep)
+    es, Ts = run(h)
+    spread = (es.max() - es.min()) / 2
+    if spread <= _WARN_TOL * es.mean() and abs(es.mean() / e - 1) <= _WARN_TOL:
+        return h, es, Ts, []
+    return (
+        h,
+        es,
+        Ts,
+        [
+            f"{step} {h:.3g} s gives {Ts.mean() / h:.0f} steps per contact: {engine} realises "
+            f"e = {es.min():.4g} to {es.max():.4g} (asked {e:.4g}); use {nice_down(T / 400):.3g} s "
+            "or less"
+        ],
+    )
+
+
+def recommended_step(run, T: float, e: float | None = None) -> float:
+    """The time step (s) an export recommends for a contact of duration `T` (s): the first of
+    `nice_down(T / N)`, N = 400, 800, ... 51200 steps per contact, at which `run(h) -> (e, T)`
+    per start phase spreads e by at most `E_RANGE_TOL` of its mean and, when the target `e`
+    is given, whose phase means are within 0.1 % of `e` and `T`."""
+    steps = _MIN_STEPS
+    while True:
+        h = nice_down(T / steps)
+        es, Ts = run(h)
+        ok = (es.max() - es.min()) / 2 <= E_RANGE_TOL * es.mean()
+        if e is not None:
+            ok = ok and abs(es.mean() / e - 1) < _BIAS_TOL and abs(Ts.mean() / T - 1) < _BIAS_TOL
+        if ok or steps >= _MAX_STEPS:
+            return h
+        steps *= 2
+
+
+def realised(es, Ts, h: float) -> dict:
+    """What an engine stepping at `h` (s) realises, from its start phases `es`, `Ts`: the
+    means `e` and `T` (s), their ranges and the steps per contact."""
+    return dict(
+        e=float(es.mean()),
+        T=float(Ts.mean()),
+        e_range=(float(es.min()), float(es.max())),
+        T_range=(float(Ts.min()), float(Ts.max())),
+        steps_per_contact=float(Ts.mean() / h),
+        timestep=h,
+    )

@@ -23,7 +23,7 @@ a large one). (3) `cr_eff` is the smaller of the two materials' restitutions.
 
 import math
 
-from . import lammps
+from . import _stepping, lammps
 
 NAME = "chrono"
 SCENE = lammps.SCENE
@@ -49,7 +49,7 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Tru
     c = m_eff * v0**2 * (tau / (T * v0)) ** 2.5
     E = c * 3.0 / (4.0 * math.sqrt(R_eff)) * 2.0 * (1.0 - poisson**2)
     b = lammps.damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
-    h = lammps.nice_down(T / 100.0) if timestep is None else float(timestep)
+    h = _stepping.nice_down(T / 100.0) if timestep is None else float(timestep)
     warnings = [
         f"set the effective curvature radius to {R_eff:.6g} m (the snippet does): Chrono's "
         "default Bullet collision system uses 0.1 m for every contact",

@@ -23,6 +23,7 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
+from . import _stepping
 from .materials import check_positive
 
 NAME = "drake"
@@ -122,13 +123,8 @@ def design(e, T, *, m, v0, timestep=None, **_):
     )
     return dict(
         parameters=params,
-        e=float(es.mean()),
-        T=float(Ts.mean()),
-        e_range=(float(es.min()), float(es.max())),
-        T_range=(float(Ts.min()), float(Ts.max())),
-        steps_per_contact=steps,
+        **_stepping.realised(es, Ts, h),
         warnings=warnings,
-        timestep=h,
         separation="force",
         stepping=params,
     )
@@ -171,26 +167,13 @@ def replica(parameters, m: float, v0: float, timestep: float, phases=None):
     `parameters` for a body of mass `m` (kg) at `v0` (m/s): `discrete_step` from first touch,
     `phase * timestep` after a step's start, to the step where the contact is no longer
     found. Checked against Drake's TAMSI, Lagged and Similar in tests/test_engines.py."""
-    from . import _stepping
-
     phases = _stepping.PHASES if phases is None else phases
     k = parameters["point_contact_stiffness"]
     d = parameters["hunt_crossley_dissipation"]
     h = float(timestep)
-    x = -v0 * h * np.asarray(phases, float)
-    v = np.full_like(x, v0)
-    steps = np.zeros_like(x)
-    started = np.zeros(x.shape, bool)
-    done = np.zeros(x.shape, bool)
-    for _ in range(2_000_000):
-        x1, v1, pushing = discrete_step(x, v, k, d, m, h)
-        x, v = np.where(done, x, x1), np.where(done, v, v1)
-        started |= pushing
-        done |= started & ~pushing
-        steps += pushing & ~done
-        if done.all():
-            return -v / v0, steps * h
-    raise RuntimeError("the replica did not finish the contact; the time step is far too small")
+    return _stepping.step_until_separated(
+        lambda x, v: discrete_step(x, v, k, d, m, h), h, v0, phases
+    )
 
 
 def snippet(parameters) -> str:

@@ -31,7 +31,6 @@ SCENE = (
     "two equal spheres, each of mass m and radius `radius`, colliding head-on at relative "
     "speed v0 (no gravity, no friction effect on a head-on impact)"
 )
-_E_RANGE_TOL = 0.002
 
 
 def impact_at_unit_scales(e_coefficient: float, separation: str):
@@ -84,17 +83,11 @@ def replica(parameters, m: float, v0: float, phases=_stepping.PHASES):
     )
 
 
-def nice_down(h: float) -> float:
-    scale = 10.0 ** math.floor(math.log10(h))
-    return float(f"{math.floor(h / scale * 10.0 * (1 + 1e-12)) / 10.0 * scale:.2g}")
-
-
 def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=False):
     """`pair_style granular` with `hertz/material ... damping coeff_restitution` for target
     `e` and `T` (s), two spheres of mass `m` (kg) and radius `radius` (m) at relative speed
     `v0` (m/s): a dict with `parameters`, `e`, `T` (the replica's mean over start phases),
     `e_range`, `T_range`, `steps_per_contact`, `warnings`, `timestep`, `separation`."""
-    warnings = []
     separation = "force" if limit_damping else "penetration"
     coefficient = coefficient_for(e, limit_damping)
     _, tau = impact_at_unit_scales(coefficient, separation)
@@ -104,27 +97,14 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Fal
     assert abs(hertz_stiffness(E, poisson, radius, R2=radius) / c - 1) < 1e-12
     b = damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
     params = dict(k=c, b=b, limit_damping=limit_damping)
-    if timestep is None:
-        steps = 100
-        while True:
-            params["timestep"] = nice_down(T / steps)
-            es, Ts = replica(params, m, v0)
-            ok_e = (es.max() - es.min()) / 2 <= _E_RANGE_TOL * es.mean()
-            ok_bias = abs(es.mean() / e - 1) < 0.001 and abs(Ts.mean() / T - 1) < 0.001
-            if (ok_e and ok_bias and steps >= 400) or steps >= 51200:
-                break
-            steps *= 2
-    else:
-        params["timestep"] = float(timestep)
-    h = params["timestep"]
-    es, Ts = replica(params, m, v0)
-    if (es.max() - es.min()) / 2 > 0.005 * es.mean() or abs(es.mean() / e - 1) > 0.005:
-        warnings.append(
-            f"timestep {h:.3g} s gives {Ts.mean() / h:.0f} steps per contact: LAMMPS realises "
-            f"e = {es.min():.4g} to {es.max():.4g} (asked {e:.4g}); "
-            f"use {nice_down(T / 400):.3g} s "
-            "or less"
-        )
+    h, es, Ts, warnings = _stepping.step_and_response(
+        lambda h: replica({**params, "timestep": h}, m, v0),
+        e,
+        T,
+        timestep,
+        engine="LAMMPS",
+        step="timestep",
+    )
     extra = " limit_damping" if limit_damping else ""
     parameters = {
         "pair_style": "pair_style granular",
@@ -144,14 +124,9 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Fal
     }
     return dict(
         parameters=parameters,
-        e=float(es.mean()),
-        T=float(Ts.mean()),
-        e_range=(float(es.min()), float(es.max())),
-        T_range=(float(Ts.min()), float(Ts.max())),
-        steps_per_contact=float(Ts.mean() / h),
+        **_stepping.realised(es, Ts, h),
         warnings=warnings,
         separation=separation,
-        timestep=h,
         stepping=dict(
             E=E,
             coeff_restitution=coefficient,

@@ -37,7 +37,6 @@ SCENE = (
     "promise holds for any mass), no gravity, approaching along the normal at v0"
 )
 SOLIMP = (0.99, 0.99, 0.001, 0.5, 2.0)  # constant impedance: the contact is linear
-_E_RANGE_TOL = 0.002  # half-spread of e over start phases the recommended step allows
 _MAX_DAMPRATIO = 1e3
 
 
@@ -103,12 +102,6 @@ def replica(solref, timestep: float, v0: float, phases=_stepping.PHASES):
     return _stepping.semi_implicit_euler(acceleration(stiffness, damping), timestep, v0, phases)
 
 
-def _nice_down(h: float) -> float:
-    """`h` rounded down to two significant digits (a number one types into an MJCF)."""
-    scale = 10.0 ** math.floor(math.log10(h))
-    return float(f"{math.floor(h / scale * 10.0 * (1 + 1e-12)) / 10.0 * scale:.2g}")
-
-
 def design(e: float, T: float | None, *, v0: float, timestep: float | None = None, **_):
     """solref, solimp and time step that realise `e` and `T` (s; None: MuJoCo's default
     timeconst) at `v0` (m/s) in MuJoCo, and what MuJoCo realises with them: a dict with
@@ -123,13 +116,7 @@ def design(e: float, T: float | None, *, v0: float, timestep: float | None = Non
     tau = continuous(zeta)[1]
     w0 = tau / T
     if timestep is None:
-        steps = 400
-        while True:
-            h = _nice_down(T / steps)
-            es, _ = replica(_solref(w0, zeta), h, v0)
-            if (es.max() - es.min()) / 2 <= _E_RANGE_TOL * es.mean() or steps >= 51200:
-                break
-            steps *= 2
+        h = _stepping.recommended_step(lambda h: replica(_solref(w0, zeta), h, v0), T)
     else:
         h = float(timestep)
     # correct the damping ratio and the frequency for the step's own bias (phase means)
@@ -159,7 +146,7 @@ def design(e: float, T: float | None, *, v0: float, timestep: float | None = Non
         warnings.append(
             f"time step {h:.3g} s gives {steps_per_contact:.0f} steps per contact: e ranges "
             f"{es.min():.4g} to {es.max():.4g} with where contact starts inside a step; "
-            f"use a step of {_nice_down(T / 400):.3g} s or less"
+            f"use a step of {_stepping.nice_down(T / 400):.3g} s or less"
         )
     if abs(es.mean() / e - 1) > 0.005 or abs(Ts.mean() / T - 1) > 0.005:
         warnings.append(
@@ -177,13 +164,8 @@ def design(e: float, T: float | None, *, v0: float, timestep: float | None = Non
     }
     return dict(
         parameters=parameters,
-        e=float(es.mean()),
-        T=float(Ts.mean()),
-        e_range=(float(es.min()), float(es.max())),
-        T_range=(float(Ts.min()), float(Ts.max())),
-        steps_per_contact=steps_per_contact,
+        **_stepping.realised(es, Ts, h),
         warnings=warnings,
-        timestep=h,
         separation="force",
         target_T=T,
         stepping=parameters,

@@ -30,7 +30,6 @@ import math
 import numpy as np
 
 from . import _stepping, mujoco
-from .lammps import nice_down
 from .materials import check_positive, check_restitution
 
 NAME = "yade"
@@ -41,7 +40,6 @@ SCENE = (
     "two equal spheres of ViscElMat, each of mass m and radius `radius`, colliding head-on at "
     "relative speed v0 (no gravity, NewtonIntegrator(damping=0))"
 )
-_E_RANGE_TOL = 0.002
 CUNDALL_DEFAULT = 0.2  # NewtonIntegrator.damping's default (pkg/dem/NewtonIntegrator.hpp)
 
 
@@ -97,29 +95,17 @@ def replica(parameters, m: float, v0: float, phases=_stepping.PHASES):
 def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=True):
     """ViscElMat inputs and O.dt for target `e` and `T` (s): a dict with `parameters`, `e`,
     `T` (the mean over start phases of the replica), `e_range`, `T_range`, `warnings`."""
-    warnings = []
     en, tc, zeta = inputs_for(e, T)
     params = {"tc": tc, "en": en, "damping": 0.0}
-    if timestep is None:
-        steps = 100
-        while True:
-            params["timestep"] = nice_down(T / steps)
-            es, Ts = replica(params, m, v0)
-            ok_e = (es.max() - es.min()) / 2 <= _E_RANGE_TOL * es.mean()
-            ok_bias = abs(es.mean() / e - 1) < 0.001 and abs(Ts.mean() / T - 1) < 0.001
-            if (ok_e and ok_bias and steps >= 400) or steps >= 51200:
-                break
-            steps *= 2
-    else:
-        params["timestep"] = float(timestep)
-    h = params["timestep"]
-    es, Ts = replica(params, m, v0)
-    if (es.max() - es.min()) / 2 > 0.005 * es.mean() or abs(es.mean() / e - 1) > 0.005:
-        warnings.append(
-            f"O.dt = {h:.3g} s gives {Ts.mean() / h:.0f} steps per contact: Yade realises "
-            f"e = {es.min():.4g} to {es.max():.4g} (asked {e:.4g}); use {nice_down(T / 400):.3g} "
-            "s or less"
-        )
+    h, es, Ts, warnings = _stepping.step_and_response(
+        lambda h: replica({**params, "timestep": h}, m, v0),
+        e,
+        T,
+        timestep,
+        engine="Yade",
+        step="O.dt =",
+    )
+    params["timestep"] = h
     warnings.append(
         f"en = {en:.6g} is not the e Yade realises: its force is kept non-attractive, so "
         f"en = {en:.4g} and tc = {tc:.4g} s give e = {e:.4g}, T = {T:.4g} s"
@@ -148,14 +134,9 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Tru
     }
     return dict(
         parameters=parameters,
-        e=float(es.mean()),
-        T=float(Ts.mean()),
-        e_range=(float(es.min()), float(es.max())),
-        T_range=(float(Ts.min()), float(Ts.max())),
-        steps_per_contact=float(Ts.mean() / h),
+        **_stepping.realised(es, Ts, h),
         warnings=warnings,
         separation="force",
-        timestep=h,
         stepping=parameters,
     )
 
