@@ -5,6 +5,7 @@ PATH, for example Debian's `liggghts` and `yade` packages), each skipped with it
 the engine is not installed."""
 
 import math
+import os
 import shutil
 
 import numpy as np
@@ -158,7 +159,10 @@ def _require(module):
             return
         __import__(module)
     except Exception as error:  # noqa: BLE001 - the reason is printed by the skip
-        pytest.skip(f"{module} is not usable here ({type(error).__name__}: {error})")
+        reason = f"{module} is not usable here ({type(error).__name__}: {error})"
+        if os.environ.get("JAXIMPACT_REQUIRE_ENGINES"):  # set by .ci/run once they installed
+            pytest.fail(reason)
+        pytest.skip(reason)
 
 
 @pytest.mark.engines
