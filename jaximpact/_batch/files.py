@@ -112,8 +112,16 @@ def batch_file(
     fixed.update({k: v for k, v in (("m", m), ("v0", v0), ("g", g)) if v is not None})
     unknown = sorted(set(params or {}) - set(spec.parameters))
     if unknown:
+        own = [k for k in unknown if k in (*KINEMATICS, *TEXT_COLUMNS)]
+        hint = (
+            f" ({', '.join(own)}: not a law parameter; pass it as its own argument, "
+            "m=, v0=, g=, separation= (the command line's --mass, --v0, --g, --separation), "
+            "or as a column)"
+            if own
+            else ""
+        )
         raise ValueError(f"law {law!r} has no parameter {', '.join(unknown)}; it takes "
-                         f"{', '.join(spec.parameters)}")  # fmt: skip
+                         f"{', '.join(spec.parameters)}{hint}")  # fmt: skip
     check_fixed(law, fixed)
     allowed = (*spec.parameters, *KINEMATICS, *TEXT_COLUMNS)
     table = open_table(source, allowed) if from_file else open_chunks(source, allowed)

@@ -103,10 +103,11 @@ def _run_export(args):
             *(f"  {line}" for line in x.snippet.splitlines()),
         ]
         if x.speeds:
-            lines.append("speed (m/s)   e engine   e law")
+            with_law = x.e_target is not None  # an export from targets has no law to compare
+            lines.append("speed (m/s)   e engine" + ("   e law" if with_law else ""))
             for i, v in enumerate(x.speeds):
-                law_e = "" if x.e_target is None else f"{x.e_target[i]:.5g}"
-                lines.append(f"  {format_number(v):>9}   {x.e_engine[i]:.5g}   {law_e}")
+                law_e = f"   {x.e_target[i]:.5g}" if with_law else ""
+                lines.append(f"  {format_number(v):>9}   {x.e_engine[i]:.5g}{law_e}")
         lines += [f"warning: {w}" for w in x.warnings]
         return "\n".join(lines)
 
