@@ -29,9 +29,10 @@ from .parts import FLOAT_OUTPUTS, OUTPUTS, Parts
 from .processes import ProcessGroup
 from .readers import TEXT_COLUMNS, is_parquet, open_chunks, open_table, require_pyarrow
 from .row_checks import KINEMATICS, check_fixed, check_rows
+from .runner import GLOBAL
 
 __all__ = ["OUTPUTS", "BatchFile", "batch_file"]
-_FORMAT = 2  # bump when the output of a chunk changes for the same inputs
+_FORMAT = 3  # bump when the output of a chunk changes for the same inputs
 _STATUS_NAMES = np.array([Status(i).name if i in set(map(int, Status)) else "" for i in
                           range(max(map(int, Status)) + 1)], object)  # fmt: skip
 
@@ -66,6 +67,7 @@ def batch_file(
     chunk_rows: int = 100_000,
     resume: bool = False,
     progress: bool = True,
+    mesh: str = "global",
     **impact_options,
 ) -> BatchFile:
     """Run `impact_batch` over the rows of the file `source` and write `out`.
@@ -88,15 +90,23 @@ def batch_file(
 
     A `ValueError` names the first bad column or row (CSV line numbers count the header as
     1) before anything is computed or written. Rows that fail (stuck, captured, out of steps,
-    results float64 cannot hold) are kept with their status. Under `jax.distributed` (call
-    `jax.distributed.initialize()` first) each process computes the chunks `k` with
-    `k % process_count == process_index` and process 0 writes `out`.
+    results float64 cannot hold) are kept with their status.
+
+    Under `jax.distributed` (call `jax.distributed.initialize()` first) the chunks go round
+    robin, chunk `k` to process `k % process_count`, each process reads and writes its own,
+    and process 0 joins them into `out`. `mesh="global"` (default): the processes take one
+    round of chunks at a time and compute them together, one jitted program over a mesh of
+    every process's devices (`run_batch(devices="global")`); `mesh="local"`: each process
+    computes its chunks on its own devices, never waiting for the others. Either way the file
+    is the one a single process writes, bit for bit.
 
     **Example**: `batch_file("bodies.csv", "impacts.csv", "hertz_rate", params={"b1": 800.0},
     m=1.0)`.
     """
     if law not in LAWS:
         raise ValueError(f"unknown law {law!r}; see `jaximpact laws`")
+    if mesh not in ("global", "local"):
+        raise ValueError(f"mesh must be 'global' or 'local', got {mesh!r}")
     if isinstance(chunk_rows, bool) or not (isinstance(chunk_rows, int) and chunk_rows >= 1):
         raise ValueError(f"chunk_rows must be a positive integer, got {chunk_rows!r}")
     from_file = isinstance(source, (str, os.PathLike))
@@ -178,38 +188,47 @@ def batch_file(
     if not from_file and not one_pass:
         sizes = [table.size(chunk) for chunk in table.chunks(chunk_rows)]  # cheap: no parsing
         own_rows = sum(sizes[i] for i in own)
+    together = mesh == "global" and group.count > 1  # one program over every process
     computed = reused = done_rows = 0
     start = time.perf_counter()
     failed = True
     try:
         with Progress(max(len(own), 1), f"batch {law}{tag}", enabled=progress) as bar:
-            for index, chunk in enumerate(table.chunks(chunk_rows)):
+            for round_ in _rounds(enumerate(table.chunks(chunk_rows)), group.count):
                 if one_pass:
-                    rows += table.size(chunk)
-                    chunks += 1
+                    rows += sum(table.size(chunk) for _, chunk in round_)
+                    chunks += len(round_)
                     bar.total = max(bar.total, -(-chunks // group.count))
-                if not group.owns(index):
-                    continue
-                cells = None
-                if one_pass:
-                    cells = table.parse(chunk)
-                    check_rows(law, cells.values, fixed, cells.where)
-                    digests[index] = _digest(settings, cells.digest)
-                if not (resume and parts.done(index, digests[index])):
-                    cells = cells or table.parse(chunk)
-                    results = _compute(law, cells.values, cells.rows, fixed, impact_options)
-                    parts.write(index, digests[index], columns, cells, results)
+                mine = next(((i, chunk) for i, chunk in round_ if group.owns(i)), None)
+                todo, problem = None, None  # the cells of this process's chunk to compute
+                if mine is not None:
+                    try:
+                        todo = _cells_to_compute(*mine, table, law, fixed, settings, digests,
+                                                 parts if resume else None, one_pass)  # fmt: skip
+                    except ValueError as error:
+                        problem = str(error)
+                if together:  # every process learns of a bad chunk before the program runs
+                    problem = next((p for p in group.gather(problem) if p is not None), None)
+                if problem is not None:
+                    raise ValueError(problem)
+                if todo is not None or together:  # `together`: each process takes part
+                    results = _compute(law, todo, fixed, impact_options,
+                                       group if together else None)  # fmt: skip
+                if todo is not None:
+                    parts.write(mine[0], digests[mine[0]], columns, todo, results)
                     computed += 1
-                else:
+                elif mine is not None:
                     reused += 1
-                done_rows += table.size(chunk)
-                bar.update(_rate(done_rows, own_rows, time.perf_counter() - start))
+                if mine is not None:
+                    done_rows += table.size(mine[1])
+                    bar.update(_rate(done_rows, own_rows, time.perf_counter() - start))
         if one_pass and rows == 0:
             raise ValueError("chunks: no rows in any chunk")
         failed = False
     finally:  # every process says how it went, so that none waits for a dead one's parts
-        failures = group.gather(failed)
-    if any(failures):
+        if not group.peer_failed:
+            failed = group.report(failed)
+    if failed or group.peer_failed:
         raise RuntimeError("another process of the batch failed; run again with --resume")
     if one_pass and group.count > 1:  # each process counted the chunks it read
         chunks = max(group.gather(chunks))
@@ -224,6 +243,33 @@ def batch_file(
         parts.remove()
     statuses = group.gather(statuses)[0]  # and every process waits for the joined file
     return BatchFile(str(out), rows, chunks, computed, reused, statuses, group.index, group.count)
+
+
+def _rounds(items, size: int):
+    """`items` in lists of `size` (the last may be shorter): the rounds of chunks, one
+    chunk per process."""
+    batch = []
+    for item in items:
+        batch.append(item)
+        if len(batch) == size:
+            yield batch
+            batch = []
+    if batch:
+        yield batch
+
+
+def _cells_to_compute(index, chunk, table, law, fixed, settings, digests, parts, one_pass):
+    """The parsed cells of chunk `index`, or None where `parts` (None: no resuming) holds it
+    finished with the same inputs and settings; a chunk read once (`one_pass`) is checked
+    here (a ValueError naming its row)."""
+    cells = None
+    if one_pass:
+        cells = table.parse(chunk)
+        check_rows(law, cells.values, fixed, cells.where)
+        digests[index] = _digest(settings, cells.digest)
+    if parts is not None and parts.done(index, digests[index]):
+        return None
+    return cells or table.parse(chunk)
 
 
 def _digest(settings: str, inputs: bytes) -> str:
@@ -241,42 +287,77 @@ def _rate(done: int, total: int, seconds: float) -> str:
     return f"{done:,} rows, {rate:,.0f} rows/s, {left // 60}m{left % 60:02d}s left"
 
 
-def _compute(law: str, values: dict, rows: int, fixed: dict, options: dict) -> dict:
-    """`impact_batch` over one chunk; rows grouped by separation, by whether gravity is
-    zero and by the law's shape parameters, so that each row's path depends on that row
-    alone (not on the chunk it falls in). Returns `OUTPUTS` -> one entry per row."""
+def _compute(law: str, cells, fixed: dict, options: dict, group: ProcessGroup | None) -> dict:
+    """`impact_batch` over one chunk (`cells`); rows grouped by separation, by whether
+    gravity is zero and by the law's shape parameters, so that each row's path depends on
+    that row alone (not on the chunk it falls in). Returns `OUTPUTS` -> one entry per row.
+
+    With `group`, every process of it calls `_compute` at once (`cells` None where it has
+    nothing to compute): the processes agree on the row groups of the round, and each row
+    group runs as one program over the devices of them all (`devices="global"`), every
+    process giving the same number of rows: the group's first row of the first process
+    that has it (so that every process takes the same path and shapes), its own rows, and
+    that first row again as padding."""
     spec = LAWS[law]
+    rows = 0 if cells is None else cells.rows
+    values = {} if cells is None else cells.values
     given = {k: np.broadcast_to(np.asarray(v, float), (rows,)) for k, v in fixed.items()
              if k != "separation"}  # fmt: skip
     given.update({k: v for k, v in values.items() if k != "separation"})
     given.setdefault("g", np.zeros(rows))
     sep = values.get("separation", np.full(rows, fixed.get("separation", "force"), object))
-    keys = [np.unique(sep, return_inverse=True)[1]] if "separation" in values else []
-    keys += [given["g"] == 0.0] if "g" in values else []
-    keys += [np.unique(values[k], return_inverse=True)[1] for k in spec.shape_parameters
-             if k in values]  # fmt: skip
-    group_of = np.zeros(rows, int)
-    if keys:
-        _, group_of = np.unique(np.stack(keys, axis=1), axis=0, return_inverse=True)
-        group_of = group_of.reshape(-1)
+    columns = (*spec.parameters, "m", "v0", "g")
+    local = {}  # group key -> this process's rows of it
+    if rows:
+        keys = [np.unique(sep, return_inverse=True)[1]] if "separation" in values else []
+        keys += [given["g"] == 0.0] if "g" in values else []
+        keys += [np.unique(values[k], return_inverse=True)[1] for k in spec.shape_parameters
+                 if k in values]  # fmt: skip
+        group_of = np.zeros(rows, int)
+        if keys:
+            _, group_of = np.unique(np.stack(keys, axis=1), axis=0, return_inverse=True)
+            group_of = group_of.reshape(-1)
+        for number in range(int(group_of.max()) + 1):
+            idx = np.flatnonzero(group_of == number)
+            shape = [float(given[k][idx[0]]) for k in spec.shape_parameters]
+            key = json.dumps([str(sep[idx[0]]), bool(given["g"][idx[0]] == 0.0), shape])
+            local[key] = idx
+    plan = {key: (None, idx.size) for key, idx in local.items()}  # key -> (first row, rows)
+    if group is not None:  # every process's groups, each with its first row and size
+        plan = {}
+        shared = {key: ([float(given[k][idx[0]]) for k in columns], int(idx.size))
+                  for key, idx in local.items()}  # fmt: skip
+        for theirs in group.gather(shared):
+            for key, (first, size) in theirs.items():
+                known_first, known_size = plan.get(key, (first, 0))
+                plan[key] = (known_first, max(known_size, size))
     results = {k: np.full(rows, np.nan) for k in FLOAT_OUTPUTS}
     status = np.empty(rows, object)
     path = np.empty(rows, object)
-    for group in range(int(group_of.max()) + 1):
-        idx = np.flatnonzero(group_of == group)
-        separation = str(sep[idx[0]])
-        params = {k: given[k][idx] for k in spec.parameters}
+    for key in sorted(plan):
+        separation = json.loads(key)[0]
+        idx = local.get(key, np.zeros(0, int))
+        inputs = {k: given[k][idx] for k in columns}
+        first, size = plan[key]
+        if group is not None:
+            pad = size - idx.size + 1
+            inputs = {k: np.concatenate([[first[j]], inputs[k], np.full(pad - 1, first[j])])
+                      for j, k in enumerate(columns)}  # fmt: skip
         with warnings.catch_warnings():  # invalid rows are counted in the statuses
             warnings.simplefilter("ignore")
             out = impact_batch(
-                law, params, m=given["m"][idx], v0=given["v0"][idx], g=given["g"][idx],
-                separation=separation, fields=(*FLOAT_OUTPUTS, "status"), progress=False,
-                invalid="mark", **options,
+                law, {k: inputs[k] for k in spec.parameters}, m=inputs["m"], v0=inputs["v0"],
+                g=inputs["g"], separation=separation, fields=(*FLOAT_OUTPUTS, "status"),
+                progress=False, invalid="mark",
+                **({"devices": GLOBAL} if group is not None else {}), **options,
             )  # fmt: skip
+        if not idx.size:
+            continue
+        mine = slice(1, 1 + idx.size) if group is not None else slice(None)
         for k in FLOAT_OUTPUTS:
-            results[k][idx] = out[k]
-        status[idx] = _STATUS_NAMES[out["status"]]
-        first = make_law(law, **{k: float(v[0]) for k, v in params.items()})
+            results[k][idx] = out[k][mine]
+        status[idx] = _STATUS_NAMES[out["status"][mine]]
+        first_law = make_law(law, **{k: float(given[k][idx[0]]) for k in spec.parameters})
         zero_g = bool(given["g"][idx[0]] == 0.0)
-        path[idx] = batch_path(first, separation, g_is_zero=zero_g, **options)
+        path[idx] = batch_path(first_law, separation, g_is_zero=zero_g, **options)
     return {**results, "status": status.tolist(), "path": path.tolist()}

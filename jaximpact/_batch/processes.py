@@ -18,11 +18,23 @@ _WAIT_MS = 7 * 24 * 3600 * 1000  # a process may wait for the others' chunks tha
 _CALLS = itertools.count()  # the same sequence in every process: unique keys per call
 
 
+_FAILED, _OK = "jaximpact: a process failed", "jaximpact: a process finished"
+
+
+class PeerFailed(RuntimeError):
+    """Another process of the batch failed (it said so at a `gather` of this one)."""
+
+    def __init__(self):
+        super().__init__("another process of the batch failed; run again with --resume")
+
+
 class ProcessGroup:
-    """`index` of this process among `count`; one process: no communication at all."""
+    """`index` of this process among `count`; one process: no communication at all.
+    `peer_failed`: another process said it failed (then this one must not wait for it)."""
 
     def __init__(self, index: int = 0, count: int = 1):
         self.index, self.count = index, count
+        self.peer_failed = False
 
     @classmethod
     def current(cls) -> "ProcessGroup":
@@ -37,7 +49,22 @@ class ProcessGroup:
 
     def gather(self, value) -> list:
         """`value` (anything `json` writes) of every process, in process order; returns when
-        every process has given its own."""
+        every process has given its own. Raises `PeerFailed` where another process has
+        reported a failure (`report`) instead of giving its value."""
+        values = self._exchange(value)
+        if any(v == _FAILED for k, v in enumerate(values) if k != self.index):
+            self.peer_failed = True
+            raise PeerFailed()
+        return values
+
+    def report(self, failed: bool) -> bool:
+        """Say whether this process failed, and learn whether any did: the last exchange of
+        a batch. A process still at an earlier `gather` takes the report for its value and
+        raises `PeerFailed`, so that nobody waits for a process that has stopped."""
+        values = self._exchange(_FAILED if failed else _OK)
+        return failed or any(v != _OK for v in values)
+
+    def _exchange(self, value) -> list:
         if self.count == 1:
             return [value]
         key = f"jaximpact/batch/{next(_CALLS)}"

@@ -41,8 +41,13 @@ from .._progress import Progress
 _AXIS = "batch"
 
 
+GLOBAL = "global"  # `devices=GLOBAL`: one mesh over the devices of every process
+
+
 def _resolve_devices(devices) -> tuple:
     local = jax.local_devices()
+    if isinstance(devices, str) and devices == GLOBAL:
+        return tuple(local)  # this process's blocks; the mesh is `jax.devices()`
     if devices is None:
         return tuple(local)
     if isinstance(devices, int):
@@ -58,12 +63,14 @@ def _resolve_devices(devices) -> tuple:
 def block_length(n: int, chunk_size: int, n_devices: int) -> int:
     """Rows per device per compiled call for a batch of `n` rows: `chunk_size`, or for a
     batch smaller than `n_devices * chunk_size` the next power of two above
-    `n / n_devices` (so that small batches compile for a few shapes only and run at most
-    twice the rows they need)."""
+    `n / n_devices`, at least 2 (so that small batches compile for a few shapes only and
+    run at most twice the rows they need)."""
     per_device = math.ceil(max(n, 1) / n_devices)
     if per_device >= chunk_size:
         return chunk_size
-    return min(1 << (per_device - 1).bit_length(), chunk_size)
+    # at least 2 rows: XLA compiles a vmap over one row otherwise (measured: an integrated
+    # impact's e then differs in the last bits from the same row in any larger block)
+    return min(max(1 << (per_device - 1).bit_length(), 2), chunk_size)
 
 
 @functools.lru_cache(maxsize=64)
@@ -169,7 +176,11 @@ def run_batch(
       every block has one shape and compiles once; a batch smaller than one chunk runs in
       blocks of the next power of two above `n / devices`.
     - `devices`: `None` for all of `jax.local_devices()`, an integer for the first that many,
-      or a sequence of devices.
+      or a sequence of devices. `"global"`: one SPMD program over a mesh of the devices of
+      every process of a `jax.distributed` job (`jax.devices()`), each process giving its
+      own rows (one block per local device) and getting back their results; every process
+      must then call `run_batch` with the same `fn`, `chunk_size` and number of rows `n`
+      (the program's collectives pair the calls), and `exact` does not apply.
     - `exact`: `True` (default): every device runs the same one-device program on its blocks,
       so the results are bitwise those of `devices=1` (whenever the block length is the same:
       always for `n >= devices * chunk_size`), and each device stops as soon as its own
@@ -206,6 +217,7 @@ def run_batch(
         raise ValueError(f"every input needs the same number of rows; got shapes {shapes}")
     if not isinstance(chunk_size, int) or chunk_size < 1:
         raise ValueError(f"chunk_size must be a positive integer, got {chunk_size!r}")
+    spans_processes = isinstance(devices, str) and devices == GLOBAL
     devices = _resolve_devices(devices)
     order = _ordering(cost, n)
     if order is not None:
@@ -227,12 +239,13 @@ def run_batch(
         )
         return jax.tree.map(lambda s: np.empty((0,) + s.shape[1:], s.dtype), struct)
 
-    sharding = _sharding(devices)
-    if exact:
+    mesh_devices = tuple(jax.devices()) if spans_processes else devices
+    sharding = _sharding(mesh_devices)
+    if exact and not spans_processes:
         struct = unflatten([jax.ShapeDtypeStruct((block,) + a.shape[1:], a.dtype) for a in leaves])
         executables = _executables(fn, batched, devices, struct)
     else:
-        spmd = _spmd(fn, batched, devices)
+        spmd = _spmd(fn, batched, mesh_devices)
 
     def launch(r):
         """Place round r (one block per device) with the mesh sharding, start it, and return
@@ -240,9 +253,16 @@ def run_batch(
         first = r * len(devices)
         live = min(len(devices), blocks - first)
         rows = [block_rows(b) for b in range(first, first + len(devices))]
-        chunk = jax.device_put(
-            unflatten([np.concatenate(p) for p in zip(*rows, strict=True)]), sharding
-        )
+        local = unflatten([np.concatenate(p) for p in zip(*rows, strict=True)])
+        if spans_processes:  # this process's blocks, placed on its devices of the mesh
+            chunk = jax.tree.map(
+                lambda a: jax.make_array_from_process_local_data(
+                    sharding, a, (block * jax.device_count(),) + a.shape[1:]
+                ),
+                local,
+            )
+            return _local_blocks(spmd(chunk), live)
+        chunk = jax.device_put(local, sharding)
         if exact:  # the same one-device program on each device's shard
             shards = [_shard(chunk, k, block) for k in range(live)]
             return [executables[k](shards[k]) for k in range(live)]
@@ -281,6 +301,17 @@ def run_batch(
         inverse[order] = np.arange(n)
         out_leaves = [leaf[inverse] for leaf in out_leaves]
     return jax.tree_util.tree_unflatten(out_def, out_leaves)
+
+
+def _local_blocks(result, count: int) -> list:
+    """The first `count` blocks of a result over a mesh of several processes that this
+    process holds (one per local device), in row order: its own rows' results."""
+    leaves, treedef = jax.tree.flatten(result)
+    shards = [
+        [s.data for s in sorted(leaf.addressable_shards, key=lambda s: s.index[0].start or 0)]
+        for leaf in leaves
+    ]
+    return [jax.tree.unflatten(treedef, [leaf[k] for leaf in shards]) for k in range(count)]
 
 
 def _shard(chunk, k: int, block: int):

@@ -22,9 +22,11 @@ def add_batch(subparsers):
         "--resume reuses the chunks of an interrupted run whose inputs did not change.\n\n"
         "Several processes (jax.distributed): start one per process with --coordinator "
         "HOST:PORT --num-processes N --process-id K, or with --distributed alone under "
-        "SLURM or Open MPI (srun, mpirun), which tell JAX the rest. Process K computes the "
-        "chunks k with k mod N = K; process 0 writes OUT, the same file as one process "
-        "writes. OUT must be on a file system all processes see.",
+        "SLURM or Open MPI (srun, mpirun), which tell JAX the rest. Process K reads and "
+        "writes the chunks k with k mod N = K; with --mesh global (default) each round of N "
+        "chunks runs as one jitted program over the devices of all processes, with --mesh "
+        "local each process runs its own. Process 0 writes OUT, the same file as one "
+        "process writes. OUT must be on a file system all processes see.",
         example="jaximpact batch bodies.csv --law hertz_rate --param b1=800 --mass 1 "
         "--out impacts.csv\n"
         "jaximpact batch bodies.csv --law hertz_rate --param b1=800 --out impacts.csv "
@@ -64,6 +66,12 @@ def add_batch(subparsers):
     group.add_argument("--coordinator", metavar="HOST:PORT", help="process 0's address")
     group.add_argument("--num-processes", type=int, metavar="N", help="processes in all")
     group.add_argument("--process-id", type=int, metavar="K", help="this process, 0 .. N-1")
+    group.add_argument(
+        "--mesh", choices=("global", "local"), default="global",
+        help="global (default): each round of chunks, one per process, runs as one jitted "
+        "program over a mesh of every process's devices; local: each process computes its "
+        "chunks on its own devices without waiting for the others (the same file either way)",
+    )  # fmt: skip
     parser.set_defaults(handler=run_batch_command)
 
 
@@ -121,6 +129,7 @@ def run_batch_command(args):
         chunk_rows=args.chunk_rows,
         resume=args.resume,
         progress=progress_enabled(),
+        mesh=args.mesh,
     )
     counts = ", ".join(f"{n} {k}" for k, n in result.statuses.items() if n)
     where = f"process {result.process} of {result.processes}: " if result.processes > 1 else ""

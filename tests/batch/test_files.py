@@ -393,14 +393,20 @@ def _finish(procs, timeout=400):
 
 
 @pytest.mark.slow
-def test_two_processes_write_the_file_of_one_bit_for_bit(tmp_path):
-    """Integrated (gravity on some rows) and curves rows, 2 processes against 1."""
+@pytest.mark.parametrize("mesh", ["global", "local"])
+def test_two_processes_write_the_file_of_one_bit_for_bit(tmp_path, mesh):
+    """Integrated (gravity on some rows) and curves rows under both criteria, 2 processes
+    against 1: one program over both processes' devices (`global`, row groups a process
+    lacks in a round included) or each process on its own (`local`)."""
     rng = np.random.default_rng(7)
-    _bodies(tmp_path / "in.csv", n=300, g=np.where(rng.random(300) < 0.2, 9.81, 0.0))
+    separation = np.where(rng.random(300) < 0.3, "penetration", "force")
+    _bodies(tmp_path / "in.csv", n=300, g=np.where(rng.random(300) < 0.2, 9.81, 0.0),
+            separation=separation)  # fmt: skip
     argv = [str(tmp_path / "in.csv"), "--law", "hertz_rate", "--chunk-rows", "40"]
     pipes = dict(stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     one = _finish(_start([*argv, "--out", str(tmp_path / "one.csv")], 1, **pipes))
-    two = _finish(_start([*argv, "--out", str(tmp_path / "two.csv")], 2, **pipes))
+    two = _finish(_start([*argv, "--out", str(tmp_path / "two.csv"), "--mesh", mesh], 2,
+                         **pipes))  # fmt: skip
     assert "300 impacts written" in one[0] and "8 chunks computed" in one[0]
     assert "process 0 of 2" in two[0] and "4 chunks computed" in two[0]
     assert "process 1 of 2" in two[1] and "4 chunks computed" in two[1]
@@ -410,6 +416,7 @@ def test_two_processes_write_the_file_of_one_bit_for_bit(tmp_path):
     assert set(np.asarray(out["path"])[g > 0]) == {"integrated"}
     assert set(np.asarray(out["path"])[g == 0]) == {"similarity"}
     rows = g > 0  # the integrated rows against the batch in memory
+    rows &= np.asarray(out["separation"]) == "force"
     want = ji.impact_batch(
         "hertz_rate",
         {k: np.asarray(out[k], float)[rows] for k in ("c", "b1")},
