@@ -6,7 +6,8 @@ memory: rows per second, the share of reading and writing, and peak memory per f
 Each size runs in a fresh process (peak resident memory from `resource`), twice: the first
 call compiles, the second is timed. Curves path (law 14 without gravity, chunks of 100,000)
 from 1e4 to 1e7 rows, and the integrated path (gravity on) at 1e5 rows. Then one process
-against two (`jaximpact batch --coordinator ... --num-processes 2`, on this machine), wall
+against two (`jaximpact batch --coordinator ... --num-processes 2`, `--mesh global` and
+`--mesh local`, on this machine), wall
 clock of the whole command (start-up and compiling included, as a user sees it).
 """
 
@@ -77,8 +78,9 @@ def _run(mode, n, folder, g=0.0):
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
-def _processes(n, folder, g, count):
-    """Wall clock (s) of `jaximpact batch` on `count` processes, and the output's bytes."""
+def _processes(n, folder, g, count, mesh="global"):
+    """Wall clock (s) of `jaximpact batch` on `count` processes (`--mesh mesh`), and the
+    output's bytes."""
     source = os.path.join(folder, f"bodies-{n}.csv")
     out = os.path.join(folder, f"impacts-{n}-{count}p.csv")
     command = ["jaximpact", "batch", source, "--law", "hertz_rate", "--out", out,
@@ -87,7 +89,8 @@ def _processes(n, folder, g, count):
         with socket.socket() as probe:
             probe.bind(("localhost", 0))
             port = probe.getsockname()[1]
-        command += ["--coordinator", f"localhost:{port}", "--num-processes", str(count)]
+        command += ["--coordinator", f"localhost:{port}", "--num-processes", str(count),
+                    "--mesh", mesh]  # fmt: skip
     env = {**os.environ, "JAXIMPACT_PROGRESS": "0"}
     start = time.perf_counter()
     procs = [
@@ -119,9 +122,10 @@ def main():
             print(rows[-1], flush=True)
         for path, n, g in PROCESS_CASES:
             one, one_bytes = _processes(n, folder, g, 1)
-            two, two_bytes = _processes(n, folder, g, 2)
-            process_rows.append(dict(path=path, n=n, one=one, two=two,
-                                     same=one_bytes == two_bytes))  # fmt: skip
+            two, two_bytes = _processes(n, folder, g, 2, "global")
+            local, local_bytes = _processes(n, folder, g, 2, "local")
+            process_rows.append(dict(path=path, n=n, one=one, two=two, local=local,
+                                     same=one_bytes == two_bytes == local_bytes))  # fmt: skip
             print(process_rows[-1], flush=True)
     load = os.getloadavg()[0]
     lines = [
@@ -152,20 +156,25 @@ def main():
         "",
         "## One process against two (`jaximpact batch`, this machine)",
         "",
-        "| path | rows | 1 process (s) | 2 processes (s) | speed-up | same file, bit for bit |",
-        "|---|---|---|---|---|---|",
+        "| path | rows | 1 process (s) | 2 processes, `--mesh global` (s) | speed-up | "
+        "2 processes, `--mesh local` (s) | speed-up | same file, bit for bit (all three) |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for r in process_rows:
         lines.append(
             f"| {r['path']} | {r['n']:,} | {r['one']:.1f} | {r['two']:.1f} | "
-            f"{r['one'] / r['two']:.2f} | {'yes' if r['same'] else 'NO'} |"
+            f"{r['one'] / r['two']:.2f} | {r['local']:.1f} | {r['one'] / r['local']:.2f} | "
+            f"{'yes' if r['same'] else 'NO'} |"
         )
     lines += [
         "",
-        "Wall clock of the whole command, start-up and compiling included. Both processes "
-        "share this machine's 2 cores: the gain comes from each process parsing and writing "
-        "its own chunks (single-threaded Python and numpy work) while the other computes; on "
-        "separate machines each process brings its own cores.",
+        "Wall clock of the whole command, start-up and compiling included. `global`: each "
+        "round of chunks (one per process) is one jitted program over a mesh of both "
+        "processes' devices (on the CPU, XLA's collectives go through gloo); `local`: each "
+        "process runs its chunks on its own device and never waits for the other. Both "
+        "processes share this machine's 2 cores: the gain comes from each process parsing "
+        "and writing its own chunks (single-threaded Python and numpy work) while the other "
+        "computes; on separate machines each process brings its own cores.",
     ]
     with open(os.path.join(HERE, "batch_files.md"), "w") as handle:
         handle.write("\n".join(lines) + "\n")

@@ -7,8 +7,10 @@ column); each chunk is written whole or not at all into `OUT.parts/` with a reco
 SHA-256 of its inputs and of the run's settings (`parts`); `resume=True` skips the chunks
 whose part and hash are there and recomputes those whose input changed; the parts are joined
 into `OUT` (renamed into place) only when all are done. Memory holds one chunk at a time.
-Under `jax.distributed` every process computes its own chunks (`processes`) and process 0
-joins them: the same file, bit for bit, as one process writes.
+Under `jax.distributed` chunk `k` is process `k mod N`'s to read, check and write
+(`processes`); each round of chunks, one per process, runs as one program over the devices
+of all processes (`mesh="global"`), or each process runs its own (`mesh="local"`); process 0
+joins the parts: the same file, bit for bit, as one process writes.
 """
 
 import dataclasses

@@ -12,8 +12,10 @@ benchmarks/batch.md has the measurements.
 
 Multi-host use follows JAX's multi-process model: start one process per host, call
 `jax.distributed.initialize()` first in each (coordinator address, number of processes and
-process id from the cluster's scheduler or as arguments), and let each process run its own
-share of the rows on its own devices:
+process id from the cluster's scheduler or as arguments). Either each process gives its
+own rows, the same number in every process, to `run_batch(fn, rows, devices="global")`,
+which runs one SPMD program over a mesh of all processes' devices (what `batch_file` does
+by default), or each process runs its own share of the rows on its own devices:
 
 ```python
 jax.distributed.initialize()  # before any other JAX call
@@ -23,8 +25,9 @@ out = run_batch(fn, share)  # devices=None: this process's jax.local_devices()
 write_table(f"part-{jax.process_index()}.csv", {"row": rows, **out})
 ```
 
-The members of a batch are independent, so no device ever needs another one's data: the
-processes do not communicate after start-up, and the parts concatenate to the whole table.
+The members of a batch are independent, so no device ever needs another one's data: in the
+second form the processes do not communicate after start-up, and the parts concatenate to
+the whole table.
 """
 
 import collections
