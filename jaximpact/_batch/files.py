@@ -338,8 +338,9 @@ def _compute(law: str, cells, fixed: dict, options: dict, group: ProcessGroup | 
     path = np.empty(rows, object)
     for key in sorted(plan):
         separation = json.loads(key)[0]
-        idx = local.get(key, np.zeros(0, int))
-        inputs = {k: given[k][idx] for k in columns}
+        idx = local.get(key)
+        inputs = {k: given[k][idx] if idx is not None else np.zeros(0) for k in columns}
+        idx = np.zeros(0, int) if idx is None else idx
         first, size = plan[key]
         if group is not None:
             pad = size - idx.size + 1
