@@ -8,8 +8,9 @@ SHA-256 of its inputs and of the run's settings (`parts`); `resume=True` skips t
 whose part and hash are there and recomputes those whose input changed; the parts are joined
 into `OUT` (renamed into place) only when all are done. Memory holds one chunk at a time.
 Under `jax.distributed` chunk `k` is process `k mod N`'s to read, check and write
-(`processes`); each round of chunks, one per process, runs as one program over the devices
-of all processes (`mesh="global"`), or each process runs its own (`mesh="local"`); process 0
+(`processes`); each process runs its own chunks on its own devices (`mesh="local"`), or each
+round of chunks, one per process, runs as one program over the devices of all processes
+(`mesh="global"`); process 0
 joins the parts: the same file, bit for bit, as one process writes.
 """
 
@@ -69,7 +70,7 @@ def batch_file(
     chunk_rows: int = 100_000,
     resume: bool = False,
     progress: bool = True,
-    mesh: str = "global",
+    mesh: str = "local",
     **impact_options,
 ) -> BatchFile:
     """Run `impact_batch` over the rows of the file `source` and write `out`.
@@ -96,11 +97,13 @@ def batch_file(
 
     Under `jax.distributed` (call `jax.distributed.initialize()` first) the chunks go round
     robin, chunk `k` to process `k % process_count`, each process reads and writes its own,
-    and process 0 joins them into `out`. `mesh="global"` (default): the processes take one
-    round of chunks at a time and compute them together, one jitted program over a mesh of
-    every process's devices (`run_batch(devices="global")`); `mesh="local"`: each process
-    computes its chunks on its own devices, never waiting for the others. Either way the file
-    is the one a single process writes, bit for bit.
+    and process 0 joins them into `out`. `mesh="local"` (default): each process computes its
+    chunks on its own devices, never waiting for the others; `mesh="global"`: the processes
+    take one round of chunks at a time and compute them together, one jitted program over a
+    mesh of every process's devices (`run_batch(devices="global")`), in lockstep (slower
+    where an integrated solve all-reduces its loop condition at every step:
+    benchmarks/batch_files.md). Either way the file is the one a single process writes, bit
+    for bit.
 
     **Example**: `batch_file("bodies.csv", "impacts.csv", "hertz_rate", params={"b1": 800.0},
     m=1.0)`.

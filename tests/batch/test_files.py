@@ -431,7 +431,8 @@ def test_two_processes_write_the_file_of_one_bit_for_bit(tmp_path, mesh):
 
 
 @pytest.mark.slow
-def test_a_killed_run_of_two_processes_is_completed_by_resume(tmp_path):
+@pytest.mark.parametrize("mesh", ["global", "local"])
+def test_a_killed_run_of_two_processes_is_completed_by_resume(tmp_path, mesh):
     """Process 1 killed midway (SIGKILL), process 0 then stopped; `--resume` on two
     processes finishes the file: equal, bit for bit, to a run never stopped."""
     _bodies(tmp_path / "in.csv", n=4000)
@@ -441,7 +442,7 @@ def test_a_killed_run_of_two_processes_is_completed_by_resume(tmp_path):
     out = tmp_path / "out.csv"
     parts = Path(f"{out}.parts")
     quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    procs = _start([*argv, "--out", str(out)], 2, **quiet)
+    procs = _start([*argv, "--out", str(out), "--mesh", mesh], 2, **quiet)
     deadline = time.monotonic() + 300
     while not list(parts.glob("part-*1.json")) and time.monotonic() < deadline:
         time.sleep(0.01)  # until process 1 has finished a few chunks
@@ -451,7 +452,8 @@ def test_a_killed_run_of_two_processes_is_completed_by_resume(tmp_path):
     done = len(list(parts.glob("part-*.json")))
     assert 0 < done < 800 and not out.exists()
     pipes = dict(stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    texts = _finish(_start([*argv, "--out", str(out), "--resume"], 2, **pipes))
+    texts = _finish(_start([*argv, "--out", str(out), "--resume", "--mesh", mesh], 2,
+                           **pipes))  # fmt: skip
     reused = sum(int(t.split(" reused")[0].rsplit(", ", 1)[1]) for t in texts)
     assert reused == done
     assert out.read_bytes() == (tmp_path / "whole.csv").read_bytes()
