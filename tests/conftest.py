@@ -8,6 +8,10 @@
 - Strict about shapes: implicit rank promotion raises (`jax_numpy_rank_promotion`), so a
   broadcast that was not meant fails here. Dtype promotion stays standard: strict promotion
   fails inside optax's L-BFGS, whose counters mix int32 and int64 under float64.
+- Hypothesis draws new examples on every run here, so that the fuzz tests keep searching;
+  `.ci/run` sets `HYPOTHESIS_PROFILE=ci` (`derandomize`: the same examples on every run),
+  so that a landing does not depend on the draw. A failure found by chance locally becomes
+  an `@example` of its test.
 - The command line's progress reports (on stderr, also when it is not a terminal) are turned
   off for the tests, which check stderr line by line; tests of the progress turn it on.
 """
@@ -19,6 +23,10 @@ os.environ.setdefault("XLA_FLAGS", "--xla_backend_optimization_level=0")
 os.environ.setdefault("JAXIMPACT_PROGRESS", "off")
 
 import jax  # noqa: E402
+from hypothesis import settings  # noqa: E402
+
+settings.register_profile("ci", derandomize=True, database=None)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
 
 jax.config.update("jax_enable_x64", True)
 jax.config.update("jax_numpy_rank_promotion", "raise")

@@ -7,6 +7,7 @@ together by `x` (m) repel with `F = c x^1.5`, `c = (4/3) E* sqrt(R*)`, where
 """
 
 import math
+import sys
 
 import numpy as np
 
@@ -70,7 +71,7 @@ def effective_radius(R1, R2=math.inf) -> float:
         return R1
     if math.isinf(R1):
         return R2
-    return R1 * R2 / (R1 + R2)
+    return _representable("R*", R1 / (1.0 + R1 / R2), "m")
 
 
 def effective_modulus(E, nu, E2=None, nu2=None) -> float:
@@ -83,8 +84,11 @@ def effective_modulus(E, nu, E2=None, nu2=None) -> float:
     nu = check_poisson("nu", nu)
     E2 = E if E2 is None else _positive("E2", E2, "Pa", infinite_ok=True)
     nu2 = nu if nu2 is None else check_poisson("nu2", nu2)
-    compliance = (1.0 - nu**2) / E + (0.0 if math.isinf(E2) else (1.0 - nu2**2) / E2)
-    return 1.0 / compliance
+    # p / (1 + p/q) with p = E/(1 - nu^2), q = E2/(1 - nu2^2): no sum of compliances to
+    # overflow, and (1 - nu)(1 + nu) keeps its digits as nu nears -1
+    p = E / ((1.0 - nu) * (1.0 + nu))
+    q = math.inf if math.isinf(E2) else E2 / ((1.0 - nu2) * (1.0 + nu2))
+    return _representable("E*", p / (1.0 + p / q), "Pa")
 
 
 def hertz_stiffness(E, nu, R, E2=None, nu2=None, R2=None) -> float:
@@ -107,7 +111,20 @@ def hertz_stiffness(E, nu, R, E2=None, nu2=None, R2=None) -> float:
     """
     R = _positive("R", R, "m")
     R_star = R if R2 is None else effective_radius(R, R2)
-    return 4.0 / 3.0 * effective_modulus(E, nu, E2, nu2) * math.sqrt(R_star)
+    return _representable("c", 4.0 / 3.0 * effective_modulus(E, nu, E2, nu2) * math.sqrt(R_star),
+                          "N/m^1.5")  # fmt: skip
+
+
+def _representable(name: str, value: float, unit: str) -> float:
+    """`value` if float64 holds it to full precision (finite, not below the smallest normal
+    number); a one-line ValueError otherwise (inputs whose result over- or underflows:
+    E = 1e158 Pa with R = 1e300 m gave c = inf)."""
+    if not (math.isfinite(value) and value >= sys.float_info.min):
+        raise ValueError(
+            f"{name} = {value:g} {unit}: float64 cannot hold it for these inputs; are they in "
+            "SI units (E in Pa, R in m)?"
+        )
+    return value
 
 
 def check_restitution(e, name: str = "e") -> float:
