@@ -14,8 +14,9 @@ Multi-host use follows JAX's multi-process model: start one process per host, ca
 `jax.distributed.initialize()` first in each (coordinator address, number of processes and
 process id from the cluster's scheduler or as arguments). Either each process gives its
 own rows, the same number in every process, to `run_batch(fn, rows, devices="global")`,
-which runs one SPMD program over a mesh of all processes' devices (what `batch_file` does
-by default), or each process runs its own share of the rows on its own devices:
+which runs one SPMD program over a mesh of all processes' devices (`batch_file`'s
+`mesh="global"`), or each process runs its own share of the rows on its own devices (its
+default):
 
 ```python
 jax.distributed.initialize()  # before any other JAX call
@@ -49,10 +50,8 @@ GLOBAL = "global"  # `devices=GLOBAL`: one mesh over the devices of every proces
 
 def _resolve_devices(devices) -> tuple:
     local = jax.local_devices()
-    if isinstance(devices, str) and devices == GLOBAL:
-        return tuple(local)  # this process's blocks; the mesh is `jax.devices()`
-    if devices is None:
-        return tuple(local)
+    if devices is None or (isinstance(devices, str) and devices == GLOBAL):
+        return tuple(local)  # under GLOBAL: this process's blocks; the mesh is jax.devices()
     if isinstance(devices, int):
         if not 1 <= devices <= len(local):
             raise ValueError(f"devices={devices}: this process has {len(local)} local devices")
