@@ -32,9 +32,10 @@ class ProcessGroup:
     """`index` of this process among `count`; one process: no communication at all.
     `peer_failed`: another process said it failed (then this one must not wait for it)."""
 
-    def __init__(self, index: int = 0, count: int = 1):
+    def __init__(self, index: int = 0, count: int = 1, calls=None):
         self.index, self.count = index, count
         self.peer_failed = False
+        self._calls = _CALLS if calls is None else calls  # numbers the exchanges
 
     @classmethod
     def current(cls) -> "ProcessGroup":
@@ -67,7 +68,7 @@ class ProcessGroup:
     def _exchange(self, value) -> list:
         if self.count == 1:
             return [value]
-        key = f"jaximpact/batch/{next(_CALLS)}"
+        key = f"jaximpact/batch/{next(self._calls)}"
         client = _client()
         if client is None:
             return _gather_on_devices(value, self.count)
