@@ -10,8 +10,8 @@ into `OUT` (renamed into place) only when all are done. Memory holds one chunk a
 Under `jax.distributed` chunk `k` is process `k mod N`'s to read, check and write
 (`processes`); each process runs its own chunks on its own devices (`mesh="local"`), or each
 round of chunks, one per process, runs as one program over the devices of all processes
-(`mesh="global"`); process 0
-joins the parts: the same file, bit for bit, as one process writes.
+(`mesh="global"`); process 0 joins the parts: the same file, bit for bit, as one process
+writes.
 """
 
 import dataclasses
@@ -312,42 +312,20 @@ def _compute(law: str, cells, fixed: dict, options: dict, group: ProcessGroup | 
     given.setdefault("g", np.zeros(rows))
     sep = values.get("separation", np.full(rows, fixed.get("separation", "force"), object))
     columns = (*spec.parameters, "m", "v0", "g")
-    local = {}  # group key -> this process's rows of it
-    if rows:
-        keys = [np.unique(sep, return_inverse=True)[1]] if "separation" in values else []
-        keys += [given["g"] == 0.0] if "g" in values else []
-        keys += [np.unique(values[k], return_inverse=True)[1] for k in spec.shape_parameters
-                 if k in values]  # fmt: skip
-        group_of = np.zeros(rows, int)
-        if keys:
-            _, group_of = np.unique(np.stack(keys, axis=1), axis=0, return_inverse=True)
-            group_of = group_of.reshape(-1)
-        for number in range(int(group_of.max()) + 1):
-            idx = np.flatnonzero(group_of == number)
-            shape = [float(given[k][idx[0]]) for k in spec.shape_parameters]
-            key = json.dumps([str(sep[idx[0]]), bool(given["g"][idx[0]] == 0.0), shape])
-            local[key] = idx
+    local = _row_groups(spec, given, sep, values) if rows else {}  # key -> this chunk's rows
     plan = {key: (None, idx.size) for key, idx in local.items()}  # key -> (first row, rows)
-    if group is not None:  # every process's groups, each with its first row and size
-        plan = {}
-        shared = {key: ([float(given[k][idx[0]]) for k in columns], int(idx.size))
-                  for key, idx in local.items()}  # fmt: skip
-        for theirs in group.gather(shared):
-            for key, (first, size) in theirs.items():
-                known_first, known_size = plan.get(key, (first, 0))
-                plan[key] = (known_first, max(known_size, size))
+    if group is not None:
+        plan = _shared_plan(group, local, given, columns)
     results = {k: np.full(rows, np.nan) for k in FLOAT_OUTPUTS}
     status = np.empty(rows, object)
     path = np.empty(rows, object)
     for key in sorted(plan):
         separation = json.loads(key)[0]
-        idx = local.get(key)
-        inputs = {k: given[k][idx] if idx is not None else np.zeros(0) for k in columns}
-        idx = np.zeros(0, int) if idx is None else idx
+        idx = local.get(key, np.zeros(0, int))
+        inputs = {k: given.get(k, np.zeros(0))[idx] for k in columns}
         first, size = plan[key]
-        if group is not None:
-            pad = size - idx.size + 1
-            inputs = {k: np.concatenate([[first[j]], inputs[k], np.full(pad - 1, first[j])])
+        if group is not None:  # the first row, this process's rows, the first row as padding
+            inputs = {k: np.concatenate([[first[j]], inputs[k], np.full(size - idx.size, first[j])])
                       for j, k in enumerate(columns)}  # fmt: skip
         with warnings.catch_warnings():  # invalid rows are counted in the statuses
             warnings.simplefilter("ignore")
@@ -367,3 +345,36 @@ def _compute(law: str, cells, fixed: dict, options: dict, group: ProcessGroup | 
         zero_g = bool(given["g"][idx[0]] == 0.0)
         path[idx] = batch_path(first_law, separation, g_is_zero=zero_g, **options)
     return {**results, "status": status.tolist(), "path": path.tolist()}
+
+
+def _row_groups(spec, given: dict, sep, values: dict) -> dict:
+    """The rows of a chunk by group, `json` key `[separation, g == 0, shape parameters]` ->
+    row indices: the rows that share a path and a compiled program."""
+    keys = [np.unique(sep, return_inverse=True)[1]] if "separation" in values else []
+    keys += [given["g"] == 0.0] if "g" in values else []
+    keys += [np.unique(values[k], return_inverse=True)[1] for k in spec.shape_parameters
+             if k in values]  # fmt: skip
+    group_of = np.zeros(len(sep), int)
+    if keys:
+        _, group_of = np.unique(np.stack(keys, axis=1), axis=0, return_inverse=True)
+        group_of = group_of.reshape(-1)
+    groups = {}
+    for number in range(int(group_of.max()) + 1):
+        idx = np.flatnonzero(group_of == number)
+        shape = [float(given[k][idx[0]]) for k in spec.shape_parameters]
+        groups[json.dumps([str(sep[idx[0]]), bool(given["g"][idx[0]] == 0.0), shape])] = idx
+    return groups
+
+
+def _shared_plan(group: ProcessGroup, local: dict, given: dict, columns) -> dict:
+    """Every process's row groups of the round (`local`: this one's), each key -> (the values
+    of `columns` in its first row on the first process that has it, the most rows any
+    process has of it): the same on every process."""
+    shared = {key: ([float(given[k][idx[0]]) for k in columns], int(idx.size))
+              for key, idx in local.items()}  # fmt: skip
+    plan = {}
+    for theirs in group.gather(shared):
+        for key, (first, size) in theirs.items():
+            known_first, known_size = plan.get(key, (first, 0))
+            plan[key] = (known_first, max(known_size, size))
+    return plan
