@@ -76,26 +76,19 @@ def nice_down(h: float) -> float:
 
 def step_and_response(run, e: float, T: float, timestep, *, engine: str, step: str):
     """`(h, es, Ts, warnings)` for an engine whose stepping `run(h) -> (e, T)` per start phase
-    realises the target `e` and `T` (s): `h` the given `timestep` (s) or, when None, the
-    recommended one (`nice_down(T / N)`, N = 400, 800, ... 51200 steps per contact, the first
-    whose phases spread e by at most `E_RANGE_TOL` of its mean and whose phase means are
-    within 0.1 % of `e` and `T`), what `run` realises at `h`, and a warning (its step called
-    `step` in `engine`'s words) where e spreads or misses `e` by more than 0.5 %."""
+    realises the target `e` and `T` (s): `h` the given `timestep` (s) or, when None,
+    `recommended_step`; what `run` realises at `h`; and a warning (its step called `step` in
+    `engine`'s words) where e spreads or misses `e` by more than 0.5 %."""
     h = recommended_step(run, T, e) if timestep is None else float(timestep)
     es, Ts = run(h)
-    spread = (es.max() - es.min()) / 2
-    if spread <= _WARN_TOL * es.mean() and abs(es.mean() / e - 1) <= _WARN_TOL:
-        return h, es, Ts, []
-    return (
-        h,
-        es,
-        Ts,
-        [
+    warnings = []
+    if (es.max() - es.min()) / 2 > _WARN_TOL * es.mean() or abs(es.mean() / e - 1) > _WARN_TOL:
+        warnings.append(
             f"{step} {h:.3g} s gives {Ts.mean() / h:.0f} steps per contact: {engine} realises "
             f"e = {es.min():.4g} to {es.max():.4g} (asked {e:.4g}); use {nice_down(T / 400):.3g} s "
             "or less"
-        ],
-    )
+        )
+    return h, es, Ts, warnings
 
 
 def recommended_step(run, T: float, e: float | None = None) -> float:
