@@ -35,22 +35,36 @@ class CustomLaw(AbstractLaw):
         return CustomLaw(self.fn, {**self.params, **_finite_arrays(params)}, self.name)
 
     def dynamics(self, *, m, v0, g):
-        return scaled_dynamics(self.fn, self.params, m=m, v0=v0, g=g)
+        return scaled_dynamics(self, m=m, v0=v0, g=g)
 
     def force(self, x, v, **_):
-        """Contact force (N) at penetration `x` (m) and velocity `v` (m/s)."""
-        return self.fn(jnp.asarray(x, dtype=float), jnp.asarray(v, dtype=float), self.params)
+        """Contact force (N) at penetration `x` (m) and velocity `v` (m/s); 0 outside the
+        surface (`x < 0`).
+
+        The user's function is only ever called inside the surface: at `x` itself where
+        `x > 0`, at the smallest positive float where `0 <= x` is smaller (its limit at
+        first touch, e.g. `b v` for `c x + b v`), and below the surface the force is 0 with
+        gradient 0. So `x**1.5`, `jnp.sqrt(x)` or `jnp.power(x, n)` need no guard: neither
+        the value nor the gradient is ever NaN."""
+        x = jnp.asarray(x, dtype=float)
+        v = jnp.asarray(v, dtype=float)
+        tiny = jnp.finfo(x.dtype).tiny
+        inside = jnp.where(x > tiny, x, tiny)
+        return jnp.where(x >= 0, self.fn(inside, v, self.params), 0.0)
 
 
 def custom_law(fn: Callable, **params) -> CustomLaw:
     """Wrap a user's force law `fn(x, v, params) -> F` (SI units, N, positive pushing out).
 
     `fn` must be a pure JAX function of the penetration `x` (m), the velocity `v` (m/s)
-    and the dict `params`; it is called with `x` slightly below 0 by the solver's last
-    step, so guard fractional powers with `jaximpact.safe_pow`.
+    and the dict `params`, written as force laws are written: `x**1.5`, `jnp.sqrt(x)`,
+    `jnp.power(x, n)` need no guard, since the library only calls `fn` with `x > 0` (the
+    force is 0 outside the surface; `CustomLaw.force`). Contact ends where the force
+    returns to zero inside the surface, or at `x = 0` for a force that only vanishes there
+    (both separation criteria then agree).
 
     **Example**:
-    `custom_law(lambda x, v, p: p["k"] * x + p["d"] * safe_pow(x, 0.5) * v, k=2e6, d=800.0)`.
+    `custom_law(lambda x, v, p: p["c"] * x**1.5 * (1 + p["a"] * v), c=2e6, a=0.2)`.
     """
     if not callable(fn):
         raise ValueError("custom_law needs a function f(x, v, params) as its first argument")

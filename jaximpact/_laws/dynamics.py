@@ -54,6 +54,12 @@ class AbstractDynamics(eqx.Module):
         """Positive while the contact pushes; crosses zero transversally where it stops
         pushing (the `"force"` separation criterion)."""
 
+    def surface_gap(self, y: Array) -> Array | None:
+        """`None`, or a condition that crosses zero where the body leaves the surface
+        (`X = 0`) and that ends contact under the force criterion besides `force_gap` (a
+        user's law whose force may vanish only at `X = 0`, degenerately)."""
+        return None
+
     def force_rate(self, y: Array, compressing) -> Array:
         """`dF/dtau` along the motion (zero at a force peak)."""
         return jax.jvp(lambda z: self.force(z, compressing), (y,), (self.rhs(y, compressing),))[1]
@@ -207,15 +213,18 @@ class MaxwellDynamics(AbstractDynamics):
 
 
 class ScaledDynamics(AbstractDynamics):
-    """A user's force law `f(x, v, params)`, rescaled: `X'' = -f(x* X, v0 V)/(m v0^2/x*) + gamma`.
+    """A user's force law, rescaled: `X'' = -F(x* X, v0 V)/(m v0^2/x*) + gamma`.
 
-    The scale `x*` solves `x* f(x*, v0) = m v0^2` (work of the contact force over `x*`
-    equals the kinetic energy), found by bisection; the force criterion uses `f` itself
-    while `X > 0` and `X` below, so a law vanishing like `x^1.5` still ends at `X = 0`.
+    The scale `x*` solves `x* F(x*, v0) = m v0^2` (work of the contact force over `x*`
+    equals the kinetic energy), found by bisection. The law is evaluated through
+    `law.force`, which is 0 outside the surface, so a trial step below `X = 0` never
+    meets a NaN. Under the force criterion contact ends at the first zero of `F` inside
+    the surface (`force_gap`) or at `X = 0` (`surface_gap`): a force that vanishes only
+    at `X = 0`, like `x^1.5`, has a degenerate zero there that no root finder places
+    well, while `X` crosses 0 transversally.
     """
 
-    fn: object = eqx.field(static=True)
-    params: dict
+    law: eqx.Module
     v0: Array
     gamma: Array
     x_star: Array
@@ -235,13 +244,22 @@ class ScaledDynamics(AbstractDynamics):
         return y[1]
 
     def force(self, y, compressing):
-        return self.fn(self.x_star * y[0], self.v0 * y[1], self.params) / self.force_scale
+        return self.law.force(self.x_star * y[0], self.v0 * y[1]) / self.force_scale
 
     def rhs(self, y, compressing):
         return jnp.stack([y[1], -self.force(y, compressing) + self.gamma])
 
     def force_gap(self, y, compressing):
-        return jnp.where(y[0] > 0, self.force(y, compressing), y[0])
+        # inside: the force itself (its zeros inside the surface are transversal for the
+        # laws that go tensile there, e.g. c x + b v); at and below X = 0 the force's limit
+        # at the surface where that pulls (so a zero crossed within the step that also
+        # crosses X = 0 is still seen), else +1: the surface event ends those contacts
+        at_surface = self.force(jnp.stack([jnp.zeros_like(y[0]), y[1]]), compressing)
+        below = jnp.where(at_surface < 0, at_surface, 1.0)
+        return jnp.where(y[0] > 0, self.force(y, compressing), below)
+
+    def surface_gap(self, y):
+        return y[0]
 
 
 def power_dynamics(
@@ -280,13 +298,13 @@ def maxwell_dynamics(c, b, *, m, v0, g) -> MaxwellDynamics:
     )
 
 
-def _energy_length(fn, params, m, v0):
-    """`x*` with `x* f(x*, v0) = m v0^2`, by bisection on `log10 x*` in [-30, 10]."""
+def _energy_length(law, m, v0):
+    """`x*` with `x* F(x*, v0) = m v0^2`, by bisection on `log10 x*` in [-30, 10]."""
     target = jnp.log(m * v0**2)
 
     def excess(log10_x):
         x = 10.0**log10_x
-        return jnp.log(jnp.maximum(x * fn(x, v0, params), 1e-300)) - target
+        return jnp.log(jnp.maximum(x * law.force(x, v0), 1e-300)) - target
 
     def step(_, bounds):
         lo, hi = bounds
@@ -298,12 +316,11 @@ def _energy_length(fn, params, m, v0):
     return jax.lax.stop_gradient(10.0 ** (0.5 * (lo + hi)))
 
 
-def scaled_dynamics(fn, params, *, m, v0, g) -> ScaledDynamics:
-    """Build `ScaledDynamics` for a user's law `fn(x, v, params)` (SI units)."""
-    x_star = _energy_length(fn, jax.lax.stop_gradient(params), m, v0)
+def scaled_dynamics(law, *, m, v0, g) -> ScaledDynamics:
+    """Build `ScaledDynamics` for a user's law (`law.force(x, v)` in SI units)."""
+    x_star = _energy_length(jax.lax.stop_gradient(law), m, v0)
     return ScaledDynamics(
-        fn=fn,
-        params=params,
+        law=law,
         v0=jnp.asarray(v0, dtype=float),
         gamma=jnp.asarray(g * x_star / v0**2, dtype=float),
         x_star=x_star,

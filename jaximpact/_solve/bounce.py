@@ -129,7 +129,7 @@ def chain(law, m, g, drag, start, t_end, min_flight, ts, options: BounceOptions)
         go_on = hit & separated
         rests = active & ~too_late & too_short
         held = hit & ~separated
-        failed = contact.status == Status.out_of_steps
+        failed = (contact.status == Status.out_of_steps) | (contact.status == Status.failed)
         code = jnp.where(active & too_late, BounceStatus.t_end, code)
         code = jnp.where(rests, BounceStatus.at_rest, code)
         code = jnp.where(held, jnp.where(failed, BounceStatus.failed, BounceStatus.at_rest), code)

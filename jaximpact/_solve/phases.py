@@ -63,7 +63,16 @@ def _event_conditions(dynamics, separation, plan, rest_tol):
         net_force = dynamics.force(y, args < _TO_SEPARATION) - dynamics.gamma
         return jnp.abs(dynamics.velocity(y)) + jnp.abs(net_force) - rest_tol
 
-    return first, second, at_rest
+    conditions = (first, second, at_rest)
+    if separation == "force" and dynamics.surface_gap(dynamics.y0()) is not None:
+        # a user's law: the surface ends contact too (after the force's own zero in order,
+        # since where both cross in one step diffrax takes the first condition in order)
+
+        def surface(t, y, args, **kwargs):
+            return jnp.where(args < _TO_SEPARATION, 1.0, dynamics.surface_gap(y))
+
+        conditions = conditions + (surface,)
+    return conditions
 
 
 def integrate_phases(
@@ -85,10 +94,11 @@ def integrate_phases(
     (nondimensional), stacked along a leading axis. `hold` (a boolean): skip every phase
     (a contact known in closed form never to return, see `AbstractDynamics.creeping`)."""
     term = dfx.ODETerm(lambda t, y, args: dynamics.rhs(y, args < _TO_SEPARATION))
+    conditions = _event_conditions(dynamics, separation, plan, rest_tol)
     event = dfx.Event(
-        _event_conditions(dynamics, separation, plan, rest_tol),
+        conditions,
         root_finder=optx.Newton(rtol=1e-13, atol=1e-13),
-        direction=(False, False, False),
+        direction=(False,) * len(conditions),
     )
     controller = dfx.PIDController(rtol=rtol, atol=atol)
     tau_max = jnp.asarray(tau_max, dtype=float)
@@ -122,25 +132,39 @@ def integrate_phases(
             max_steps=max_steps,
             throw=False,
         )
-        fired = sol.event_mask[0] | sol.event_mask[1] | sol.event_mask[2]
+        # the surface (a user's law under the force criterion) ends contact as the force
+        # does: it counts as the first condition
+        first = sol.event_mask[0] if len(conditions) == 3 else sol.event_mask[0] | sol.event_mask[3]
+        fired = first | sol.event_mask[1] | sol.event_mask[2]
         out_of_steps = sol.result == dfx.RESULTS.max_steps_reached
         y_end, tau_end = sol.ys[0][-1], sol.ts[0][-1]
+        # the solve itself failed, or its state is not a number; a root finder that did
+        # not meet its 1e-13 (an ill-conditioned event, e.g. heavy Kelvin-Voigt damping
+        # where F crosses zero with slope c v_out ~ 0) still placed the event: not a failure
+        broke = (
+            (sol.result == dfx.RESULTS.dt_min_reached)
+            | (sol.result == dfx.RESULTS.max_steps_rejected)
+            | (sol.result == dfx.RESULTS.internal_error)
+        )
+        failed = ~skip & ~out_of_steps & (broke | ~jnp.all(jnp.isfinite(y_end)))
         record = dict(
             y=y_end,
             tau=tau_end,
             tau_start=tau,
             skipped=skip,
             alive=alive,
-            first=sol.event_mask[0],
+            first=first,
             second=sol.event_mask[1],
             rest=sol.event_mask[2],
             out_of_steps=out_of_steps,
+            failed=failed,
             steps=sol.stats["num_steps"],
         )
         if tau_grid is not None:
             record["grid"] = sol.ys[1]
         at_rest = sol.event_mask[2]
-        return (y_end, tau_end, alive & (skip | fired) & ~at_rest & ~out_of_steps), record
+        going_on = alive & (skip | fired) & ~at_rest & ~out_of_steps & ~failed
+        return (y_end, tau_end, going_on), record
 
     carry = (dynamics.y0(), jnp.zeros_like(tau_max), jnp.asarray(True))
     if len(plan) == 1:
@@ -162,12 +186,17 @@ def assemble_integrated(dynamics, phases, plan, *, m, v0, g, tau_grid, creep=Non
     rested = phases["second"][last] | stuck_at_max | jnp.any(phases["rest"])
     # a force that vanishes while the body is not moving out (creeping to rest) is a capture
     separated = phases["first"][last] & ~rested & (dynamics.velocity(phases["y"][last]) < 0)
-    out_of_steps = jnp.any(phases["out_of_steps"])
+    out_of_steps = jnp.any(phases["out_of_steps"] & phases["alive"])
+    failed = jnp.any(phases["failed"] & phases["alive"])
     held = Status.stuck if dynamics.has_dry else Status.captured
     status = jnp.where(
         out_of_steps,
         Status.out_of_steps,
-        jnp.where(separated, Status.separated, jnp.where(rested, held, Status.captured)),
+        jnp.where(
+            failed,
+            Status.failed,
+            jnp.where(separated, Status.separated, jnp.where(rested, held, Status.captured)),
+        ),
     )
     v_end = dynamics.velocity(y_end)
     e = jnp.where(status == Status.separated, -v_end, 0.0)
@@ -206,7 +235,25 @@ def assemble_integrated(dynamics, phases, plan, *, m, v0, g, tau_grid, creep=Non
             result["F_max"] = jnp.where(held, creep["force_peak"] * scale, result["F_max"])
     if tau_grid is not None:
         result.update(_histories(dynamics, phases, plan, tau_grid, v0, g))
-    return ImpactResult(**result, path="integrated")
+    return ImpactResult(**without_failures(result), path="integrated")
+
+
+_NOT_RESULTS = ("status", "num_steps")
+
+
+def without_failures(fields: dict) -> dict:
+    """Every result field of a failed solve (`out_of_steps`, `failed`) set to NaN: a
+    failure is never presented as a number (its status says why)."""
+    status = fields["status"]
+    failure = (status == Status.out_of_steps) | (status == Status.failed)
+    out = dict(fields)
+    for key, value in fields.items():
+        if key in _NOT_RESULTS or value is None:
+            continue
+        shape = jnp.shape(failure) + (1,) * (jnp.ndim(value) - jnp.ndim(failure))
+        mask = jnp.reshape(failure, shape)
+        out[key] = jnp.where(mask, jnp.nan, value)
+    return out
 
 
 def _histories(dynamics, phases, plan, tau_grid, v0, g):
