@@ -7,21 +7,27 @@ The first use also turns on JAX's persistent compilation cache (`_cache`; opt ou
 `JAXIMPACT_CACHE_DIR=`), so a second process reuses the compiled programs.
 """
 
-import importlib
-import os
-import sys
+import importlib as _importlib
+import os as _os
+import sys as _sys
 
-if os.path.basename(sys.argv[0]) == "jaximpact":
+if _os.path.basename(_sys.argv[0]) == "jaximpact":
     # the command line: XLA's CPU compiler logs harmless "algebraic simplifier ... circular"
     # notes at error level for diffrax's loops; the level is read when jax loads, so it is
     # set here, before anything imports jax, and only for the `jaximpact` console script
-    os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "3")
+    _os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "3")
     # equinox's run-time checks inside the compiled fits (lineax's, in the implicit
     # derivative of diffrax's event times) are host callbacks, and JAX does not store a
     # program with host callbacks in its persistent cache; as NaN instead (which the fits
     # already report as a failed solve) the second `jaximpact calibrate` skips XLA's
     # compilation: 14 s -> 8 s (benchmarks/first_calls.md). Inputs are checked before.
-    os.environ.setdefault("EQX_ON_ERROR", "nan")
+    _os.environ.setdefault("EQX_ON_ERROR", "nan")
+    # Ctrl-C or SIGTERM while the command line starts (importing JAX takes a second):
+    # nothing is written yet, so stop at once with one line; `main` installs the handlers
+    # that stop a running command cleanly (`_interrupt`)
+    from ._interrupt import stop_at_once as _stop_at_once
+
+    _stop_at_once()
 
 # public name -> the private module that defines it, grouped as the package is layered:
 # force laws, one impact, one drop, fitting, many impacts, studies, figures, the paper
@@ -92,9 +98,9 @@ def __getattr__(name):
 
         enable_persistent_cache()  # compiled programs kept between processes (_cache)
     if name in _PUBLIC:
-        value = getattr(importlib.import_module(f".{_PUBLIC[name]}", __name__), name)
+        value = getattr(_importlib.import_module(f".{_PUBLIC[name]}", __name__), name)
     elif name in _SUBMODULES:
-        value = importlib.import_module(f".{name}", __name__)
+        value = _importlib.import_module(f".{name}", __name__)
     else:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     globals()[name] = value  # later look-ups skip this function
@@ -102,7 +108,10 @@ def __getattr__(name):
 
 
 def __dir__():
-    return sorted([*globals(), *_PUBLIC, *_SUBMODULES])
+    """The public names (`__all__`) and the module's dunder attributes: not the modules
+    it imports for itself, nor the private subpackages that loading a name brings in."""
+    dunder = [k for k in globals() if k.startswith("__") and k.endswith("__")]
+    return sorted({*__all__, *dunder})
 
 
 from ._version import __version__ as __version__  # noqa: E402

@@ -68,3 +68,37 @@ def _show(value, bad) -> str:
         return f"an array of {array.size} values"
     i = int(wrong[0])
     return f"{array.ravel()[i]} at index {i} (of {array.size} values; {wrong.size} bad)"
+
+
+# A magnitude inside [1 / SCALE_LIMIT, SCALE_LIMIT] keeps the products of two of them (an
+# energy m v0^2, a stiffness times a power of a length) inside float64's normal range
+# (2.2e-308 to 1.8e308); beyond it an impact's results underflow to 0 or overflow to inf.
+SCALE_LIMIT = 1e150
+
+
+def out_of_scale(value) -> bool:
+    """Whether a concrete number is finite, not 0, and outside [1e-150, 1e150] in size."""
+    try:
+        x = abs(float(value))
+    except (TypeError, ValueError, OverflowError):
+        return False
+    return 0.0 < x < float("inf") and not (1.0 / SCALE_LIMIT <= x <= SCALE_LIMIT)
+
+
+def check_scale(name: str, value, unit: str = ""):
+    """Return `value`; a one-line `ValueError` if it is a concrete number whose size lies
+    outside [1e-150, 1e150] (0, NaN, inf and traced values are left to the other checks):
+    such an input puts an impact's scales (energy, penetration, duration, force) where
+    float64 underflows or overflows, 1e-300 kg as 1e300 kg."""
+    if not _is_concrete(value):
+        return value
+    array = np.asarray(value, dtype=float)
+    bad = [x for x in array.ravel().tolist() if out_of_scale(x)]
+    if bad:
+        unit = f" {unit}" if unit else ""
+        raise ValueError(
+            f"{name} = {bad[0]:g}{unit}: float64 cannot hold the products of an impact at "
+            "this size (they under- or overflow; inputs from 1e-150 to 1e150 in SI units "
+            "keep them in range); express the inputs in other units"
+        )
+    return value

@@ -1,5 +1,6 @@
 """Numbers and quantities as people read them, and values as JSON can hold them: shared by
-the library's tables and reports and by the command line."""
+the library's tables and reports, the results' `repr`, `summary()` and `to_dict()`
+(`ImpactResult`, `Fit`, `Ranking`) and the command line."""
 
 import math
 
@@ -41,3 +42,93 @@ def jsonable(value):
     if isinstance(value, float):
         return value if math.isfinite(value) else None
     return str(value)
+
+
+def is_traced(value) -> bool:
+    """Whether `value` is a JAX tracer (inside `jit`, `vmap`, `grad`): it has no numbers."""
+    return any(c.__name__ == "Tracer" for c in type(value).__mro__)
+
+
+def _shape_text(value) -> str:
+    dtype = str(getattr(value, "dtype", "float"))
+    short = {"float64": "f64", "float32": "f32", "int32": "i32", "int64": "i64", "bool": "bool"}
+    return f"{short.get(dtype, dtype)}[{','.join(map(str, getattr(value, 'shape', ())))}]"
+
+
+def format_value(value, unit: str | None = "", digits: int = 4) -> str:
+    """One field of a result as text, whatever it holds:
+
+    - a number with its unit (`0.007845, "s"` -> `7.845 ms`; `unit=""`: a pure number,
+      `unit=None`: as it is, a word or a count);
+    - an array of several, as a batch of results is: `5 values, 7.1 ms to 8.2 ms` (the
+      smallest and largest finite ones; all of them up to 4; NaN counted apart);
+    - `traced f64[5]` for a tracer (inside `jit` or `vmap` there are no numbers to show);
+    - `-` for None.
+    """
+    if value is None:
+        return "-"
+    if is_traced(value):
+        return f"traced {_shape_text(value)}"
+    if isinstance(value, str):
+        return value
+    import numpy as np
+
+    try:
+        array = np.asarray(value)
+    except Exception:  # something that is not an array of numbers
+        return str(value)
+    if array.dtype.kind not in "biuf":
+        return str(value)
+
+    def one(x):
+        if unit is None or array.dtype.kind in "biu":
+            return str(x.item() if hasattr(x, "item") else x)
+        if unit == "":
+            return format_number(x, digits)
+        return format_quantity(x, unit, digits)
+
+    if array.ndim == 0:
+        return one(array)
+    flat = array.ravel()
+    if flat.size <= 4:
+        return "[" + ", ".join(one(x) for x in flat) + "]"
+    shown = flat[np.isfinite(flat)] if flat.dtype.kind == "f" else flat
+    missing = flat.size - shown.size
+    text = f"{flat.size} values"
+    if shown.size:
+        text += f", {one(shown.min())} to {one(shown.max())}"
+    return text + (f" ({missing} not finite)" if missing else "")
+
+
+def format_fields(title: str, rows) -> str:
+    """`title`, then one aligned line `name = text` per `(name, text)` of `rows` (texts
+    from `format_value`): the `summary()` of the results."""
+    rows = list(rows)
+    width = max((len(name) for name, _ in rows), default=0)
+    return "\n".join([title, *(f"  {name:<{width}} = {text}" for name, text in rows)])
+
+
+def concrete_units(spec, params: dict | None = None) -> dict[str, str]:
+    """The parameter units of one law (its row `spec` of the law table), with the family
+    exponents n and p filled in (`N/m^n` -> `N/m^1.5` for Hertz); an exponent that is itself
+    a parameter is filled in only from its value in `params`."""
+    units = {name: spec.units.get(name, "-") for name in spec.parameters}
+    if spec.coefficients is None:
+        return units
+    if "n" in spec.parameters:
+        if params is None or "n" not in params:
+            return units
+        n, p = float(params["n"]), None
+    else:
+        _, n, _, p, _, _ = spec.coefficients(dict.fromkeys(spec.parameters, 1.0), 1.0)
+
+    def power(unit, exponent):
+        exponent = float(exponent)
+        return unit + ("" if exponent == 1 else f"^{exponent:g}")
+
+    for name, unit in units.items():
+        if unit == "N/m^n":
+            units[name] = power("N/m", n)
+        elif unit == "N s/m^(p+1)" and p is not None:
+            units[name] = power("N s/m", float(p) + 1)
+    return units

@@ -164,9 +164,12 @@ def new_figure(**kwargs):
 
 
 def save_figure(fig, path):
-    """Write `fig` to `path` (format from the extension); an `OSError` that names the file if
-    that fails."""
+    """Write `fig` to `path` (format from the extension; a temporary name renamed into
+    place, `_files.atomic_output`); an `OSError` that names the file if that fails."""
+    from ._files import atomic_output
+
     try:
-        fig.savefig(path, dpi=150, bbox_inches="tight")
+        with atomic_output(path) as temporary:  # never a half-written figure under `path`
+            fig.savefig(temporary, dpi=150, bbox_inches="tight")
     except OSError as error:
         raise OSError(f"cannot write {path}: {error.strerror or error}") from None

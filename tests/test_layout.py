@@ -14,6 +14,7 @@ PACKAGE = Path(ji.__file__).parent
 # bottom to top; a unit may import only units of a lower rank
 RANK = {
     **dict.fromkeys(("_status", "_checks", "_powers", "_progress", "_format", "_cache"), 0),
+    **dict.fromkeys(("_files", "_interrupt"), 0),
     **dict.fromkeys(("_version", "_plotting"), 1),
     **dict.fromkeys(("_laws", "_curves"), 2),
     "closed_forms": 3,

@@ -24,17 +24,27 @@ from pathlib import Path
 
 import numpy as np
 
+from .._files import check_outputs, check_suffix, temporary_name
+from .._interrupt import check_interrupt, set_note
 from .._laws import LAWS, law as make_law
 from .._progress import Progress
 from .._status import Status
 from .impacts import batch_path, impact_batch
 from .parts import FLOAT_OUTPUTS, OUTPUTS, Parts
 from .processes import ProcessGroup
-from .readers import TEXT_COLUMNS, is_parquet, open_chunks, open_table, require_pyarrow
+from .readers import (
+    PARQUET_SUFFIXES,
+    TEXT_COLUMNS,
+    is_parquet,
+    open_chunks,
+    open_table,
+    require_pyarrow,
+)
 from .row_checks import KINEMATICS, check_fixed, check_rows
 from .runner import GLOBAL
 
-__all__ = ["OUTPUTS", "BatchFile", "batch_file"]
+__all__ = ["OUTPUTS", "OUT_SUFFIXES", "BatchFile", "batch_file"]
+OUT_SUFFIXES = (".csv", *PARQUET_SUFFIXES)  # what `out` may be: the extension says which
 _FORMAT = 3  # bump when the output of a chunk changes for the same inputs
 _STATUS_NAMES = np.array([Status(i).name if i in set(map(int, Status)) else "" for i in
                           range(max(map(int, Status)) + 1)], object)  # fmt: skip
@@ -118,8 +128,7 @@ def batch_file(
     out = Path(out)
     if from_file:
         source = Path(source)
-    if out.parent != Path("") and not out.parent.is_dir():
-        raise ValueError(f"{out}: directory {str(out.parent)!r} does not exist")
+    check_output_file(out, source if from_file else None)
     if is_parquet(out):
         require_pyarrow(out)
     spec = LAWS[law]
@@ -159,6 +168,7 @@ def batch_file(
     parts = Parts(out, parquet=is_parquet(out))
 
     # 1. every value checked (each process its own chunks) before anything is written
+    set_note(f"nothing computed yet, {out} not written")
     digests, rows, chunks, problem = {}, 0, 0, None
     estimate = max(1, -(-table.estimated_rows() // chunk_rows))
     with Progress(estimate, f"checking {label}{tag}", enabled=progress and not one_pass) as bar:
@@ -197,9 +207,11 @@ def batch_file(
     computed = reused = done_rows = 0
     start = time.perf_counter()
     failed = True
+    _note_kept(parts, out, 0, len(own))
     try:
         with Progress(max(len(own), 1), f"batch {law}{tag}", enabled=progress) as bar:
             for round_ in _rounds(enumerate(table.chunks(chunk_rows)), group.count):
+                check_interrupt()  # a safe point: Ctrl-C or SIGTERM stops here at the latest
                 if one_pass:
                     rows += sum(table.size(chunk) for _, chunk in round_)
                     chunks += len(round_)
@@ -224,6 +236,7 @@ def batch_file(
                     computed += 1
                 elif mine is not None:
                     reused += 1
+                _note_kept(parts, out, computed + reused, len(own))
                 if mine is not None:
                     done_rows += table.size(mine[1])
                     bar.update(_rate(done_rows, own_rows, time.perf_counter() - start))
@@ -244,10 +257,41 @@ def batch_file(
         for record in parts.records(chunks):
             for name, count in record["statuses"].items():
                 statuses[name] += count
+        check_interrupt()
         parts.assemble(chunks, columns)
+        set_note(f"{out} was written whole")
         parts.remove()
     statuses = group.gather(statuses)[0]  # and every process waits for the joined file
+    set_note(None)
     return BatchFile(str(out), rows, chunks, computed, reused, statuses, group.index, group.count)
+
+
+def check_output_file(out, source=None, label: str = "out"):
+    """Refuse, before any work, an output `out` that `batch_file` cannot write or that
+    would destroy the input file `source`: an extension other than `OUT_SUFFIXES`, a
+    directory that does not exist, `out` (or the temporary name it is written under) the
+    same file as `source` however spelled (links included), or `source` inside
+    `OUT.parts/`, which the run writes and removes. A one-line `ValueError` that names the
+    output as `label` (the command line's `--out`)."""
+    out = Path(out)
+    check_suffix(out, OUT_SUFFIXES, label)
+    if out.parent != Path("") and not out.parent.is_dir():
+        raise ValueError(f"{label} {out}: directory {str(out.parent)!r} does not exist")
+    if out.is_dir():
+        raise ValueError(f"{label} {out}: is a directory; name the file to write")
+    check_outputs(
+        [source],
+        {label: out, f"{label} (written first as)": temporary_name(out)},
+        {f"{label} (its parts directory)": Parts(out, parquet=is_parquet(out)).dir},
+    )
+
+
+def _note_kept(parts: Parts, out: Path, done: int, total: int):
+    """What an interrupt now keeps (printed by the command line, `_interrupt`)."""
+    set_note(
+        f"{done} of {total} chunks kept in {parts.dir}{os.sep}, {out} not written; run the "
+        "same command with --resume to continue"
+    )
 
 
 def _rounds(items, size: int):

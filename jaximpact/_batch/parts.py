@@ -10,11 +10,12 @@ place at the end). Memory holds one part at a time.
 """
 
 import json
-import os
 import shutil
 from pathlib import Path
 
 import numpy as np
+
+from .._files import atomic_output, write_text
 
 FLOAT_OUTPUTS = ("e", "T", "x_max", "t_max", "F_max")
 OUTPUTS = (*FLOAT_OUTPUTS, "status", "path")
@@ -53,42 +54,41 @@ class Parts:
         of `OUTPUTS` -> one array or list per row), then its record. Returns the record."""
         record_path = self._record(index)
         record_path.unlink(missing_ok=True)  # a stale record never outlives its part
-        part = self.part(index)
-        temporary = part.with_name(part.name + ".tmp")
-        if self.parquet:
-            _write_parquet(temporary, columns, cells, results)
-        else:
-            _write_csv(temporary, columns, cells, results)
-        os.replace(temporary, part)
+        with atomic_output(self.part(index)) as temporary:
+            if self.parquet:
+                _write_parquet(temporary, columns, cells, results)
+            else:
+                _write_csv(temporary, columns, cells, results)
         statuses = {}
         for name in results["status"]:
             statuses[name] = statuses.get(name, 0) + 1
         record = dict(sha256=digest, rows=cells.rows, statuses=statuses)
-        temporary = record_path.with_name(record_path.name + ".tmp")
-        temporary.write_text(json.dumps(record))
-        os.replace(temporary, record_path)
+        write_text(record_path, json.dumps(record))
         return record
 
     def assemble(self, chunks: int, columns):
-        """Join parts `0 .. chunks - 1` into `out` (a temporary name, then renamed)."""
-        temporary = self.out.with_name(self.out.name + ".tmp")
-        if self.parquet:
-            import pyarrow.parquet as pq
+        """Join parts `0 .. chunks - 1` into `out` (a temporary name, renamed into place
+        when complete: `_files.atomic_output`; an interrupted join leaves `out` as it was)."""
+        with atomic_output(self.out) as temporary:
+            if self.parquet:
+                import pyarrow.parquet as pq
 
-            writer = None
-            for index in range(chunks):
-                table = pq.read_table(self.part(index))
-                if writer is None:
-                    writer = pq.ParquetWriter(temporary, table.schema)
-                writer.write_table(table)
-            writer.close()
-        else:
-            with open(temporary, "w", newline="") as handle:
-                handle.write(",".join((*columns, *OUTPUTS)) + "\n")
-                for index in range(chunks):
-                    with open(self.part(index), newline="") as part:
-                        shutil.copyfileobj(part, handle, 1 << 20)
-        os.replace(temporary, self.out)
+                writer = None
+                try:
+                    for index in range(chunks):
+                        table = pq.read_table(self.part(index))
+                        if writer is None:
+                            writer = pq.ParquetWriter(temporary, table.schema)
+                        writer.write_table(table)
+                finally:
+                    if writer is not None:
+                        writer.close()
+            else:
+                with open(temporary, "w", newline="") as handle:
+                    handle.write(",".join((*columns, *OUTPUTS)) + "\n")
+                    for index in range(chunks):
+                        with open(self.part(index), newline="") as part:
+                            shutil.copyfileobj(part, handle, 1 << 20)
 
     def remove(self):
         shutil.rmtree(self.dir, ignore_errors=True)

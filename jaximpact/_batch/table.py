@@ -7,6 +7,8 @@ import os
 
 import numpy as np
 
+from .._files import atomic_output
+
 
 def write_table(path, columns: dict) -> str:
     """Write equal-length 1-D columns to `path` as CSV (`.csv`) or JSON (`.json`), without
@@ -35,20 +37,21 @@ def write_table(path, columns: dict) -> str:
     rows = lengths.pop()
     values = [array.tolist() for array in arrays]
     suffix = os.path.splitext(path)[1].lower()
-    if suffix == ".csv":
-        with open(path, "w", newline="") as handle:
-            writer = csv.writer(handle)
-            writer.writerow(names)
-            writer.writerows(zip(*values, strict=True))
-    elif suffix == ".json":
-        data = {
-            name: [_json_value(v) for v in column]
-            for name, column in zip(names, values, strict=True)
-        }
-        with open(path, "w") as handle:
-            json.dump({"columns": names, "rows": rows, "data": data}, handle)
-    else:
+    if suffix not in (".csv", ".json"):
         raise ValueError(f"write_table writes .csv or .json files, got {path!r}")
+    with atomic_output(path) as temporary:  # never a half-written table under `path`
+        if suffix == ".csv":
+            with open(temporary, "w", newline="") as handle:
+                writer = csv.writer(handle)
+                writer.writerow(names)
+                writer.writerows(zip(*values, strict=True))
+        else:
+            data = {
+                name: [_json_value(v) for v in column]
+                for name, column in zip(names, values, strict=True)
+            }
+            with open(temporary, "w") as handle:
+                json.dump({"columns": names, "rows": rows, "data": data}, handle)
     return path
 
 

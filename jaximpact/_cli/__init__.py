@@ -13,10 +13,26 @@ import os
 import sys
 import warnings
 
+from .._interrupt import (
+    Interrupted,
+    check_interrupt,
+    handle_interrupts,
+    mark_reported,
+    received,
+)
 from .batch import add_batch
 from .bench import add_bench
 from .calibrate import add_calibrate
-from .common import DEBUG_ENV, PROG, CLIError, Parser, configure_jax, fail, wrap_paragraphs
+from .common import (
+    DEBUG_ENV,
+    PROG,
+    CLIError,
+    Parser,
+    check_argument_scales,
+    configure_jax,
+    fail,
+    wrap_paragraphs,
+)
 from .export import add_engine_e, add_export
 from .fit import add_fit
 from .laws import add_laws
@@ -67,15 +83,35 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line on `argv` (default `sys.argv[1:]`); return 0 on success.
 
     Bad input exits with status 2 after one line on stderr; an unexpected failure exits with
-    status 1 and one line (set `JAXIMPACT_DEBUG=1` for the traceback).
+    status 1 and one line (set `JAXIMPACT_DEBUG=1` for the traceback); Ctrl-C (SIGINT) or
+    SIGTERM with status 130 or 143 and one line saying what was kept (`_interrupt`).
     """
     parser = build_parser()
     args = parser.parse_args(argv)
     configure_jax()
+    with handle_interrupts():
+        return _run(args)
+
+
+def _run(args) -> int:
+    """The command's handler: its errors as one line, and an interrupt (SIGINT, SIGTERM) as
+    one line and exit status 128 + the signal, however it surfaced (`_interrupt`)."""
     try:
-        with warnings.catch_warnings():
-            warnings.showwarning = _show_warning
-            status = args.handler(args)
+        try:
+            check_argument_scales(args)  # 1e-300 kg refused as 1e300 kg is, before any work
+            with warnings.catch_warnings():
+                warnings.showwarning = _show_warning
+                status = args.handler(args)
+            check_interrupt()  # a signal whose KeyboardInterrupt something swallowed
+        except BaseException as error:
+            signum = received()
+            if signum is not None and not isinstance(error, (Interrupted, SystemExit)):
+                # the interrupt came out as another error (raised inside a JAX callback)
+                raise Interrupted(signum) from None
+            raise
+    except Interrupted as error:
+        mark_reported()
+        fail(str(error), status=error.status)
     except (CLIError, ValueError, OSError) as error:
         fail(str(error), status=2)
     except ArithmeticError as error:  # a number of the input beyond float64 (1e300, 1e-300)
@@ -84,7 +120,7 @@ def main(argv: list[str] | None = None) -> int:
             "the units and sizes of the numbers given",
             status=2,
         )
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # outside `handle_interrupts` (not the main thread)
         fail("interrupted", status=130)
     except BrokenPipeError:  # e.g. `jaximpact laws | head`: stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

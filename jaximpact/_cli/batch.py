@@ -109,13 +109,13 @@ def _start_processes(args):
 
 
 def run_batch_command(args):
-    from .._batch.files import batch_file
+    from .._batch.files import batch_file, check_output_file
     from .._progress import progress_enabled
 
     if args.chunk_rows < 1:
         raise CLIError("--chunk-rows must be at least 1")
-    if args.out.parent != Path("") and not args.out.parent.is_dir():
-        raise CLIError(f"--out {args.out}: directory {str(args.out.parent)!r} does not exist")
+    # before any work: an OUT that cannot be written, or that is IN however spelled
+    check_output_file(args.out, args.source, "--out")
     params = parse_params(args.param)
     _start_processes(args)
     result = batch_file(

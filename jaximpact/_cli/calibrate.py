@@ -13,6 +13,7 @@ import sys
 from pathlib import Path
 
 from .._format import format_number, format_quantity
+from .._interrupt import check_interrupt, set_note
 from .._plotting import new_figure, save_figure
 from .._progress import Progress, is_terminal, progress_enabled
 from .common import (
@@ -261,7 +262,7 @@ def _progress(total, what, delay=None):
 
 
 def run_calibrate(args):
-    check_plot_path(args.plot)
+    check_plot_path(args.plot, inputs=[args.data])
     if not (math.isfinite(args.mass) and args.mass > 0):
         raise CLIError(f"--mass must be a finite number > 0 kg, got {args.mass:g}")
     if args.max_iter < 1:
@@ -384,13 +385,18 @@ def _run_all(args, data):
     kwargs = _fit_kwargs(args, data)
     rankings, failed = [], {}
     with _progress(len(laws), "fitting laws") as bar:
-        for name in laws:
+        for done, name in enumerate(laws):
+            set_note(f"{done} of {len(laws)} laws fitted, nothing written (the ranking is "
+                     "printed at the end)")  # fmt: skip
+            check_interrupt()  # a safe point between fits: a Ctrl-C stops here at the latest
             bar.label = name
             try:
                 rankings += compare_laws(laws=(name,), progress=False, **kwargs)
             except Exception as error:  # one law's failure must not hide the others' fits
+                check_interrupt()  # unless it was an interrupt that JAX reported as an error
                 failed[name] = f"{type(error).__name__}: {str(error).splitlines()[0]}"
             bar.update(name)
+    set_note(None)
     if not rankings:
         raise CLIError(
             "no law could be fitted: "

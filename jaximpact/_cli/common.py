@@ -123,6 +123,8 @@ def add_output_arguments(parser, *, plot: bool = True):
 
 def parse_params(items: Iterable[str]) -> dict[str, float]:
     """`["c=2e6", "b1=800"]` -> `{"c": 2e6, "b1": 800.0}`; a `CLIError` for anything else."""
+    from .._checks import check_scale
+
     params = {}
     for item in items:
         name, sep, value = item.partition("=")
@@ -137,8 +139,55 @@ def parse_params(items: Iterable[str]) -> dict[str, float]:
             raise CLIError(f"--param {item!r}: {value!r} is not a number") from None
         if name in params:
             raise CLIError(f"--param {name} is given twice")
+        check_scale(f"--param {name}", number)
         params[name] = number
     return params
+
+
+def check_argument_scales(args):
+    """Every number given as an option lies within [1e-150, 1e150] in size (or is 0, or
+    is left to the command's own checks: NaN, inf, a sign): a one-line error otherwise,
+    1e-300 kg as 1e300 kg (`_checks.check_scale`)."""
+    from .._checks import check_scale
+
+    for dest, value in vars(args).items():
+        for number in value if isinstance(value, list) else [value]:
+            if isinstance(number, float):
+                check_scale(f"--{dest.replace('_', '-')}", number)
+
+
+def check_contact_scales(law_name: str, params: dict, m: float, v0: float):
+    """The scales of an impact of the law `law_name` (parameters `params`), mass `m` (kg)
+    and speed `v0` (m/s): the energy `m v0^2` (J) and, for the family `F = c x^n + ...`,
+    the penetration `x* = (m v0^2 / c)^(1/(n+1))` (m), the duration `x*/v0` (s) and the
+    force `c x*^n` (N) must each lie within [1e-150, 1e150] (`_checks.check_scale`), so
+    that no result under- or overflows float64 (a one-line `ValueError` otherwise)."""
+    import math
+
+    from .._checks import check_scale
+    from .._laws import LAWS
+
+    energy = m * v0 * v0
+    if not (math.isfinite(m) and math.isfinite(v0) and m > 0 and v0 > 0):
+        return  # the library's own checks say what is wrong
+    what = f"for m = {m:g} kg and v0 = {v0:g} m/s, the contact's"
+    check_scale(f"{what} energy m v0^2", energy, "J")
+    spec = LAWS.get(law_name)
+    if spec is None or spec.coefficients is None:
+        return
+    try:
+        c, n = (float(a) for a in spec.coefficients({**spec.defaults, **params}, v0)[:2])
+    except (KeyError, TypeError, ValueError):
+        return  # a parameter missing or wrong: the law's own checks say so
+    if not (c > 0 and n > 0 and math.isfinite(c)):
+        return
+    log_x = (math.log(energy) - math.log(c)) / (n + 1)  # logs: no overflow on the way
+    for name, log_value, unit in (
+        ("penetration scale (m v0^2/c)^(1/(n+1))", log_x, "m"),
+        ("duration scale x*/v0", log_x - math.log(v0), "s"),
+        ("force scale c x*^n", math.log(c) + n * log_x, "N"),
+    ):
+        check_scale(f"{what} {name}", math.exp(max(min(log_value, 700.0), -700.0)), unit)
 
 
 def free_names(items) -> tuple[str, ...] | None:
@@ -160,10 +209,14 @@ def law_from_args(args):
     return law(args.law, **parse_params(args.param))
 
 
-def check_plot_path(path: Path | None):
-    """Fail early (before any computation) on a `--plot` file that cannot be written."""
+def check_plot_path(path: Path | None, inputs=()):
+    """Fail early (before any computation) on a `--plot` file that cannot be written, or
+    that is one of the command's `inputs` (files it reads), however spelled."""
     if path is None:
         return
+    from .._files import check_outputs
+
+    check_outputs(inputs, {"--plot": path})
     if not path.suffix:
         raise CLIError(f"--plot {path}: give the file an extension such as .png")
     if path.parent != Path("") and not path.parent.is_dir():

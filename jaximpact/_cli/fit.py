@@ -299,7 +299,7 @@ def _plot(fits, recording, path):
 
 
 def run_fit(args):
-    check_plot_path(args.plot)
+    check_plot_path(args.plot, inputs=[args.file])
     if not (math.isfinite(args.mass) and args.mass > 0):
         raise CLIError(f"--mass must be a number > 0 kg, got {args.mass}")
     if args.fit_drag and args.drag is None:

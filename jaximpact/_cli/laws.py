@@ -1,6 +1,6 @@
 """`jaximpact laws`: the force laws, their equations, parameters and units."""
 
-from .._format import format_number
+from .._format import concrete_units as concrete_units, format_number
 from .common import add_output_arguments, command_parser, emit
 
 # --------------------------------------------------------------------------------------
@@ -21,32 +21,6 @@ def add_laws(subparsers):
     )
     add_output_arguments(parser, plot=False)
     parser.set_defaults(handler=_run_laws)
-
-
-def concrete_units(spec, params: dict | None = None) -> dict[str, str]:
-    """The parameter units of one law, with the family exponents n and p filled in
-    (`N/m^n` -> `N/m^1.5` for Hertz); an exponent that is itself a parameter is filled in
-    only from its value in `params`."""
-    units = {name: spec.units.get(name, "-") for name in spec.parameters}
-    if spec.coefficients is None:
-        return units
-    if "n" in spec.parameters:
-        if params is None or "n" not in params:
-            return units
-        n, p = float(params["n"]), None
-    else:
-        _, n, _, p, _, _ = spec.coefficients(dict.fromkeys(spec.parameters, 1.0), 1.0)
-
-    def power(unit, exponent):
-        exponent = float(exponent)
-        return unit + ("" if exponent == 1 else f"^{exponent:g}")
-
-    for name, unit in units.items():
-        if unit == "N/m^n":
-            units[name] = power("N/m", n)
-        elif unit == "N s/m^(p+1)" and p is not None:
-            units[name] = power("N s/m", float(p) + 1)
-    return units
 
 
 def _law_rows():

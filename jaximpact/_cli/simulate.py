@@ -6,10 +6,12 @@ from .common import (
     add_impact_arguments,
     add_law_arguments,
     add_output_arguments,
+    check_contact_scales,
     check_plot_path,
     command_parser,
     emit,
     law_from_args,
+    parse_params,
 )
 from .laws import concrete_units
 
@@ -63,6 +65,7 @@ def _run_simulate(args):
     from .._solve.impact import impact
 
     law = law_from_args(args)
+    check_contact_scales(args.law, parse_params(args.param), args.mass, args.v0)
     conditions = dict(m=args.mass, v0=args.v0, separation=args.separation, g=args.gravity)
     result = impact(law, **conditions)
     status = result.status_name

@@ -12,9 +12,11 @@ import optax
 import optimistix as optx
 from jaxtyping import Array
 
+from .._checks import check_scale
 from .._curves.shapes import curve_key
 from .._curves.similarity import beta_for_restitution, curve_values
 from .._curves.store import curves_for
+from .._format import concrete_units, format_fields, format_value, is_traced, jsonable
 from .._laws import AbstractLaw, damping_parameter, shape_of
 from .._solve.impact import CURVES_RTOL, ImpactOptions, similarity_reason, solve_impact
 from .._status import Status
@@ -59,6 +61,72 @@ class Fit(eqx.Module):
     free: tuple[str, ...] = eqx.field(static=True)
     optimizer: str = eqx.field(static=True)
     undetermined: tuple[str, ...] = eqx.field(static=True, default=())
+
+    def summary(self) -> str:
+        """The fit as text: each parameter with its unit (and standard error, or `fixed`,
+        or `undetermined`), how the optimiser ended, then e and T predicted beside their
+        targets at each speed; inside `jit` the shapes (`traced f64[]`)."""
+        units = law_units(self.law)
+        order = [k for k in getattr(self.law, "parameters", {}) if k in self.params]
+        order += [k for k in self.params if k not in order]  # the law's order, not jit's
+        rows = []
+        for name in order:
+            value = self.params[name]
+            unit = units.get(name, "")
+            text = format_value(value, unit)
+            if name not in self.free:
+                text += " (fixed)"
+            elif name in self.undetermined:
+                text += " (undetermined by these data)"
+            elif self.stderr is not None and name in self.stderr:
+                text += f" ± {format_value(self.stderr[name], unit)}"
+            rows.append((name, text))
+        rows += [
+            ("converged", format_value(self.converged, None)),
+            ("iterations", format_value(self.iterations, None)),
+            ("loss", format_value(self.loss)),
+            ("v0", format_value(self.v0, "m/s")),
+            ("e", f"{format_value(self.e)} ({_target_text(self.e_target, '')})"),
+            ("T", f"{format_value(self.T, 's')} ({_target_text(self.T_target, 's')})"),
+        ]
+        name = getattr(self.law, "name", type(self.law).__name__)
+        return format_fields(f"Fit of {name} ({self.optimizer}; SI units)", rows)
+
+    def to_dict(self) -> dict:
+        """The fit as plain numbers and lists (SI units), NaN as None: `law` (name and
+        parameters), `params`, `stderr`, `free`, `undetermined`, `converged`, `iterations`,
+        `loss`, `history`, and per speed `v0`, `e`, `T`, `e_target`, `T_target`,
+        `residuals`. Concrete fits only (not inside `jit`)."""
+        names = ("params", "stderr", "converged", "iterations", "loss", "history", "v0", "e",
+                 "T", "e_target", "T_target", "residuals")  # fmt: skip
+        out = {k: jsonable(getattr(self, k)) for k in names}
+        law = {"name": getattr(self.law, "name", type(self.law).__name__)}
+        law["parameters"] = out["params"]
+        return {"law": law, **out, "free": list(self.free), "optimizer": self.optimizer,
+                "undetermined": list(self.undetermined)}  # fmt: skip
+
+    def __repr__(self) -> str:
+        return self.summary()
+
+
+def _target_text(target, unit: str) -> str:
+    """`target 7.8 ms`, or `not measured` where no row has one (NaN)."""
+    if not is_traced(target) and not np.any(np.isfinite(np.asarray(target))):
+        return "not measured"
+    return f"target {format_value(target, unit)}"
+
+
+def law_units(law) -> dict[str, str]:
+    """The units of `law`'s parameters (`{"c": "N/m^1.5", ...}`; "" for a pure number);
+    a user's own law has none to give."""
+    spec = getattr(law, "spec", None)
+    if spec is None:
+        return {}
+    try:
+        units = concrete_units(spec, law.parameters)
+    except Exception:  # an exponent that is traced: the family's own spelling (`N/m^n`)
+        units = {k: spec.units.get(k, "") for k in spec.parameters}
+    return {k: "" if u == "-" else u for k, u in units.items()}
 
 
 def _as_rows(name, value, rows, allow_missing=False):
@@ -109,6 +177,13 @@ def check_targets(m, v0, e, T, sigma_e, sigma_T):
             raise ValueError(f"{name} must be finite and > 0")
     if e is None and T is None:
         raise ValueError("give e, T or both to calibrate against")
+    # sizes float64 carries through a fit: 1e-300 kg refused as 1e300 kg is
+    check_scale("mass m", m, "kg")
+    check_scale("impact speed v0", v0, "m/s")
+    check_scale("contact energy m v0^2", np.asarray(m, float) * np.asarray(v0, float) ** 2, "J")
+    for name, value, unit in (("T", T, "s"), ("sigma_e", sigma_e, ""), ("sigma_T", sigma_T, "s")):
+        if value is not None:
+            check_scale(name, value, unit)
     if T is not None:
         span = np.asarray(v0) * np.asarray(T)  # the contact's reach: x_max < v0 T
         worst = int(np.nanargmax(span)) if np.any(np.isfinite(span)) else None

@@ -7,6 +7,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax.scipy.special import gammaln
 
+from .._format import format_fields, format_value, jsonable
 from .._laws import LAWS, exponents, law
 from .._progress import Progress
 from .calibrate import Fit, calibrate
@@ -87,6 +88,22 @@ class Ranking:
     k: int
     aic: float | None
     bic: float | None
+
+    def summary(self) -> str:
+        """The law's place in the comparison (chi2, k, AIC, BIC), then its fit
+        (`Fit.summary()`), every number with its unit."""
+        rows = [(k, format_value(getattr(self, k), None if k == "k" else ""))
+                for k in ("chi2", "k", "aic", "bic")]  # fmt: skip
+        return format_fields(f"Ranking of {self.name}", rows) + "\n" + self.fit.summary()
+
+    def to_dict(self) -> dict:
+        """`name`, `chi2`, `k`, `aic`, `bic` and the `fit` (`Fit.to_dict()`), as plain
+        numbers (NaN and missing as None)."""
+        head = {k: jsonable(getattr(self, k)) for k in ("name", "chi2", "k", "aic", "bic")}
+        return {**head, "fit": self.fit.to_dict()}
+
+    def __repr__(self) -> str:
+        return self.summary()
 
 
 def compare_laws(

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._files import write_text
 from .cases import (
     CRITERIA,
     DROP_DURATION,
@@ -145,11 +146,11 @@ def reproduce_paper(out_dir, *, only=None, figures: bool = True, progress: bool 
             bar.update(f"fig. {case.figure}")
         if rows:
             path = out_dir / "table.md"
-            path.write_text(table_markdown(rows))
+            write_text(path, table_markdown(rows))
             files.append(path)
         if only is None:
             path = out_dir / "hunt_crossley_variants.md"
-            path.write_text(hunt_crossley_variants_markdown())
+            write_text(path, hunt_crossley_variants_markdown())
             files.append(path)
             bar.update("Hunt-Crossley variants")
     return dict(rows=rows, files=[str(f) for f in files])

@@ -3,7 +3,13 @@
 import equinox as eqx
 from jaxtyping import Array
 
+from .._format import format_fields, format_value, is_traced, jsonable
 from .._status import Status
+
+# the fields of an impact as `summary()` shows them: name, unit (None: a count or a word)
+_SHOWN = (("e", ""), ("T", "s"), ("x_max", "m"), ("t_max", "s"), ("F_max", "N"),
+          ("dissipated", "J"), ("v_out", "m/s"), ("num_steps", None))  # fmt: skip
+_HISTORIES = ("ts", "x", "v", "F")
 
 
 class ImpactResult(eqx.Module):
@@ -54,3 +60,48 @@ class ImpactResult(eqx.Module):
     def status_name(self) -> str:
         """The status as a word (for a single impact, not a batch)."""
         return Status(int(self.status)).name
+
+    def _status_text(self) -> str:
+        """`separated`, or for a batch the count of each status (`separated 9, stuck 1`)."""
+        if is_traced(self.status):
+            return format_value(self.status)
+        import numpy as np
+
+        codes = np.asarray(self.status).ravel()
+        names = {int(s): s.name for s in Status}
+        if np.ndim(self.status) == 0:
+            return names.get(int(codes[0]), str(int(codes[0])))
+        found, counts = np.unique(codes, return_counts=True)
+        return ", ".join(f"{names.get(int(c), str(int(c)))} {n}" for c, n in
+                         zip(found, counts, strict=True))  # fmt: skip
+
+    def summary(self) -> str:
+        """The impact as text, every number with its unit (`T = 7.845 ms`); a batch of
+        impacts (arrays) by the range of each field and the count of each status; inside
+        `jit` the shapes (`traced f64[]`), as there are no numbers yet."""
+        rows = [(name, format_value(getattr(self, name), unit)) for name, unit in _SHOWN
+                if getattr(self, name) is not None]  # fmt: skip
+        rows.append(("status", self._status_text()))
+        rows.append(("path", self.path))
+        if self.ts is not None:
+            rows.append(("histories", f"ts, x, v, F at {format_value(self.ts, 's')}"))
+        return format_fields("ImpactResult (SI units)", rows)
+
+    def to_dict(self) -> dict:
+        """The fields as plain numbers and lists (SI units: s, m, N, J, m/s), NaN as None,
+        `status` as its name (a list of names for a batch), `path`; the time histories
+        only when they were asked for. Concrete results only (not inside `jit`)."""
+        out = {name: jsonable(getattr(self, name)) for name, _ in _SHOWN}
+        import numpy as np
+
+        names = {int(s): s.name for s in Status}
+        codes = np.asarray(self.status)
+        out["status"] = (names.get(int(codes), int(codes)) if codes.ndim == 0
+                         else [names.get(int(c), int(c)) for c in codes.ravel()])  # fmt: skip
+        out["path"] = self.path
+        out.update({k: jsonable(getattr(self, k)) for k in _HISTORIES
+                    if getattr(self, k) is not None})  # fmt: skip
+        return out
+
+    def __repr__(self) -> str:
+        return self.summary()

@@ -72,7 +72,7 @@ TEMPLATES = {
     "c power(x, 1.5) + b v": (
         _hertz_viscous_power,
         _np_hertz_viscous_power,
-        dict(c=(5.0, 8.0), b=(0.0, 2.5)),
+        dict(c=(5.0, 8.0), b=(0.0, 2.0)),  # e > 1e-3: T is ill-conditioned below
     ),
     "c (exp(k x) - 1)(1 + where(v > 0, a, a/2) v)": (
         _exponential_where,
@@ -153,7 +153,10 @@ def _check(name, params, m, v0, separation):
     ref = _reference(np_fn, params, m=m, v0=v0, separation=separation)
     assert r.status_name == "separated", (name, params, m, v0, r.status_name)
     assert r.path == "integrated"
-    for key, tol in (("e", 1e-9), ("T", 1e-9), ("x_max", 1e-9), ("F_max", 1e-8)):
+    # heavy damping makes T ill-conditioned: F crosses zero with a slope ~ e, so the
+    # solver's 1e-12 in the state moves T by ~1e-12 / e (also between two scipy runs)
+    T_tol = max(1e-9, 1e-11 / ref["e"])
+    for key, tol in (("e", 1e-9), ("T", T_tol), ("x_max", 1e-9), ("F_max", 1e-8)):
         got, want = float(getattr(r, key)), ref[key]
         assert abs(got - want) <= tol * abs(want) + (1e-10 if key == "e" else 0.0), (
             key,
