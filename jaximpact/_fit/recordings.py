@@ -1,6 +1,7 @@
 """Recorded bounces read from files: a video track or a list of impact times.
 
 Formats (detected from the file unless `fmt` says):
+
 - an ImageJ MTrack2 export (`Frame X1 Y1 Flag1 ...`, whitespace or commas): a video track,
   time in frames, `Y1` in pixels pointing down;
 - a CSV with a header: a time column (`t`, `time`, `time_s`, ...) and a height column (`y`,

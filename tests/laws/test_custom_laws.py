@@ -263,3 +263,35 @@ def test_a_failed_solve_is_never_a_number():
     batch = jax.vmap(lambda v0: ji.impact(law, m=1.0, v0=v0, max_steps=3))(jnp.array([1.0, 2.0]))
     assert np.all(np.isnan(batch.e)) and np.all(np.isnan(batch.T))
     assert np.all(np.asarray(batch.status) == int(ji.Status.out_of_steps))
+
+
+@pytest.mark.slow
+def test_every_entry_point_takes_a_plainly_written_law():
+    """calibrate, bounce, fit_bounces, impact_batch and export with `c x**1.5 (1 + a v)` as
+    written: each gives the table law's answer (they once gave converged=False, e = [0, nan,
+    nan] and e = 0 under status out_of_steps)."""
+    plain = ji.custom_law(_hunt_crossley_pow, c=2e6, n=1.5, a=0.3)
+    table = ji.law("hunt_crossley", c=2e6, a=0.2, n=1.5)
+    # calibrate: the plain law's own e and T at v0 = 2.5 m/s, from another start
+    r = ji.impact(plain, m=1.0, v0=2.5)
+    fit = ji.calibrate(plain.replace(c=1e6, a=0.1), m=1.0, v0=2.5, e=float(r.e), T=float(r.T),
+                       free=("c", "a"))
+    assert bool(fit.converged)
+    np.testing.assert_allclose([fit.params["c"], fit.params["a"]], [2e6, 0.3], rtol=1e-6)
+    # a drop: each contact as the table law's (integrated with gravity as well)
+    drop_plain = ji.bounce(plain, m=1.0, h0=0.6, t_end=2.0)
+    drop_table = ji.bounce(table, m=1.0, h0=0.6, t_end=2.0)
+    count = int(np.sum(np.isfinite(np.asarray(drop_table.e))))
+    assert count >= 3
+    np.testing.assert_allclose(np.asarray(drop_plain.e)[:count], np.asarray(drop_table.e)[:count],
+                               rtol=1e-7)
+    # timed impacts (audio) of that drop give back a
+    fitted = ji.fit_bounces(plain.replace(a=0.2), m=1.0, impact_times=drop_plain.impact_times[:6],
+                            free=("a",))
+    np.testing.assert_allclose(float(fitted.law.parameters["a"]), 0.3, rtol=1e-5)
+    # a batch of speeds
+    out = ji.impact_batch(plain, m=1.0, v0=np.array([1.0, 2.5]), progress=False)
+    np.testing.assert_allclose(out["e"][1], float(r.e), rtol=1e-9)
+    # an export of the plain law promises its e at v0
+    export = ji.export(plain, "mujoco", m=1.0, v0=2.5)
+    assert math.isfinite(export.e) and abs(export.e - float(r.e)) < 0.05
