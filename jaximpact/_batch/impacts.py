@@ -126,7 +126,8 @@ def batch_path(
     """The path every row of a batch of `law`'s impacts takes: `"closed_form"`,
     `"similarity"` (the universal curves) or `"integrated"` (the same choice as `impact`'s
     `method="auto"`, made once for the batch)."""
-    if g_is_zero and method != "integrate" and closed_form_for(law, separation) is not None:
+    closed = closed_form_for(law, separation, g_is_zero=g_is_zero)
+    if method != "integrate" and closed is not None:
         return "closed_form"
     if (
         g_is_zero

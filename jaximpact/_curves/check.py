@@ -12,8 +12,10 @@ import math
 RTOL = 1e-13
 
 
-def scipy_impact(beta, n, p, separation):
-    """(e, tau, x_max, t_max, F_max) of X'' = -X^n - beta X^p X' from (0, 1)."""
+def scipy_impact(beta, n, p, separation, gamma=0.0):
+    """(e, tau, x_max, t_max, F_max) of X'' = -X^n - beta X^p X' + gamma from (0, 1)
+    (`gamma = g x*/v0^2`: gravity pushing in); e = 0 where gravity holds the body (its
+    speed comes back to 0 before separation)."""
 
     def power(x, q):
         return 1.0 if q == 0 else max(x, 0.0) ** q
@@ -22,7 +24,7 @@ def scipy_impact(beta, n, p, separation):
         return power(y[0], n) + beta * power(y[0], p) * y[1]
 
     def rhs(t, y):
-        return [y[1], -force(y)]
+        return [y[1], -force(y) + gamma]
 
     def stop_at(fun, direction):
         fun.terminal, fun.direction = True, direction
@@ -30,7 +32,7 @@ def scipy_impact(beta, n, p, separation):
 
     def peak(t, y):  # dF/dt, times x^(1-q) where an exponent q < 1 would make it infinite
         x, v = max(y[0], 0.0), y[1]
-        a = -force(y)
+        a = -force(y) + gamma
         q = min(n, 1.0) if p == 0 else min(n, p, 1.0)
         s = lambda k: power(x, k + 1.0 - q)
         damping = beta * (p * s(p - 1) * v * v + s(p) * a) if p else beta * s(0.0) * a
@@ -54,5 +56,10 @@ def scipy_impact(beta, n, p, separation):
             gap = lambda t, y: min(y[0], y[0] + math.copysign((beta * abs(y[1])) ** (1 / k), y[1]))
     else:
         gap = lambda t, y: y[0]
-    two = solve_ivp(rhs, (t_max, 1e7), [y_max[0], 0.0], events=[stop_at(gap, -1)], **kw)
+    events = [stop_at(gap, -1)]
+    if gamma:
+        events.append(stop_at(lambda t, y: y[1], 1))
+    two = solve_ivp(rhs, (t_max, 1e7), [y_max[0], 0.0], events=events, **kw)
+    if gamma and len(two.t_events[1]):
+        return 0.0, two.t_events[1][0], y_max[0], t_max, max(forces)
     return -two.y_events[0][0][1], two.t_events[0][0], y_max[0], t_max, max(forces)

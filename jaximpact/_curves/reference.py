@@ -45,11 +45,11 @@ def _separation_gap(y, beta, n, p, separation):
     return jnp.minimum(x, reduced)
 
 
-def _peak_condition(y, beta, n, p):
+def _peak_condition(y, beta, n, p, gamma=0.0):
     """The sign of `dF/dtau` in compression, times `X^(1-q)` where an exponent `q < 1` of
     the law would make it infinite at first touch."""
     x, v = y[0], y[1]
-    acceleration = -_force(y, beta, n, p)
+    acceleration = -_force(y, beta, n, p) + gamma
     q = min(n, 1.0) if p == 0 else min(n, p, 1.0)
     scale = lambda k: _pow(x, k + 1.0 - q)  # x^k times x^(1-q)
     elastic = n * scale(n - 1.0) * v
@@ -61,9 +61,9 @@ def _peak_condition(y, beta, n, p):
     return elastic + damping
 
 
-def _solve(y0, t0, t1, condition, beta, n, p, *, rtol, max_steps):
+def _solve(y0, t0, t1, condition, beta, n, p, *, rtol, max_steps, gamma=0.0, direction=False):
     def rhs(t, y, args):
-        return jnp.stack([y[1], -_force(y, beta, n, p)])
+        return jnp.stack([y[1], -_force(y, beta, n, p) + gamma])
 
     sol = dfx.diffeqsolve(
         dfx.ODETerm(rhs),
@@ -79,7 +79,7 @@ def _solve(y0, t0, t1, condition, beta, n, p, *, rtol, max_steps):
             # step's end, beyond the crossing, where min(x, x^k + beta v) can be flat (T of
             # Hertz viscous at beta = 1e-12 was 4e-6 off)
             root_finder=optx.Bisection(rtol=1e-15, atol=1e-18),
-            direction=False,
+            direction=direction,
         ),
         saveat=dfx.SaveAt(t1=True),
         max_steps=max_steps,
@@ -89,24 +89,56 @@ def _solve(y0, t0, t1, condition, beta, n, p, *, rtol, max_steps):
 
 
 def reference_impact(
-    beta, *, n: float, p: float, separation: str, rtol=1e-13, tau_max=1e7, max_steps=400_000
+    beta,
+    *,
+    n: float,
+    p: float,
+    separation: str,
+    rtol=1e-13,
+    tau_max=1e7,
+    max_steps=400_000,
+    gamma=None,
 ):
-    """`dict` of the five `curve.OUTPUTS` (nondimensional), `separated` (bool) at `beta`."""
+    """`dict` of the five `curve.OUTPUTS` (nondimensional), `separated` (bool) at `beta`.
+
+    `gamma` (`g x*/v0^2`, gravity pushing in: `X'' = -X^n - beta X^p X' + gamma`): `None`
+    for none; with it, a restitution in which `V` comes back up to 0 before separation
+    (the body held in the surface: a second solve, up to the separation) is not
+    `separated`."""
     y0 = jnp.stack([jnp.zeros_like(beta), jnp.ones_like(beta)])
     options = dict(rtol=rtol, max_steps=max_steps)
+    if gamma is not None:
+        options["gamma"] = gamma
     y_max, t_max, _ = _solve(y0, 0.0, tau_max, lambda y: y[1], beta, n, p, **options)
     y_peak, _, peaked = _solve(
-        y0, 0.0, t_max, lambda y: _peak_condition(y, beta, n, p), beta, n, p, **options
+        y0,
+        0.0,
+        t_max,
+        lambda y: _peak_condition(y, beta, n, p, options.get("gamma", 0.0)),
+        beta,
+        n,
+        p,
+        **options,
     )
     at_touch = _force(y0, beta, n, p)
     later = jnp.maximum(
         _force(y_max, beta, n, p), jnp.where(peaked, _force(y_peak, beta, n, p), 0.0)
     )
     f_max = jnp.maximum(at_touch, later)
+    restitution = y_max.at[1].set(0.0)
+    end = tau_max
+    if gamma is not None:
+        # where V comes back up to 0 (upwards only): gravity holding the body, or, after
+        # a separation, its fall back; the separation must come before it. (V - 1e-14:
+        # negative at the start, where V = 0, so that the bracket is never [0, +])
+        _, end, _ = _solve(
+            restitution, t_max, tau_max, lambda y: y[1] - 1e-14, beta, n, p, direction=True,
+            **options,
+        )  # fmt: skip
     y_end, tau_end, ended = _solve(
-        y_max.at[1].set(0.0),
+        restitution,
         t_max,
-        tau_max,
+        end,
         lambda y: _separation_gap(y, beta, n, p, separation),
         beta,
         n,

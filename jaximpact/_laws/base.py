@@ -32,7 +32,8 @@ class LawSpec:
     `shape`: the exponents `(n, p)`, each a number or the name of the parameter that holds
     it (`shape_parameters`: those names, which must be known numbers, not traced values,
     for the curves to serve). `closed_form`: `impact` has an
-    exact solution for every parameter value (`_closed_forms.closed_form_for`).
+    exact solution for every parameter value without gravity (`closed_forms.closed_form_for`);
+    `closed_form_gravity`: that solution holds with gravity too (any `g >= 0`).
     `damping`: the parameter that sets the dissipation (what `restitution_map` varies and a
     fit frees first); `map_range`, `map_fixed`: the map's default range of it and the other
     parameters held (the seed paper's set m = 1 kg, v0 = 2.5 m/s, c = 2e6 lies inside, from
@@ -57,6 +58,7 @@ class LawSpec:
     defaults: dict[str, float] = dataclasses.field(default_factory=dict)
     one_group: bool = False
     closed_form: bool = False
+    closed_form_gravity: bool = False
     shape: tuple = ()
     damping: str | None = None
     map_range: tuple[float, float] | None = None

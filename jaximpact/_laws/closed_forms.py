@@ -1,7 +1,11 @@
 """Exact solutions: fast paths for `impact` and oracles for the tests.
 
 - Kelvin-Voigt `m x'' = -c x - b x'` under both separation criteria, for any damping.
-- Maxwell (eqs. 10-11) under the force criterion, under-damped (`4 b^2 > m c`).
+- Maxwell (eqs. 10-11) under the force criterion, under-damped (`4 b^2 > m c`): the
+  paper's formulas, kept as an oracle (`impact` uses `closed_forms_linear.maxwell_impact`,
+  which holds for every damping and both criteria).
+- `closed_form_for`: the exact impact `impact` takes for a law of the table (Kelvin-Voigt,
+  with gravity too; Bingham, eqs. 7 and 9, and Maxwell: `closed_forms_linear`).
 - The undamped power-law spring `F = c x^n`: `x_max` and `T`.
 - The restitution of the Hunt-Crossley family `F = c x^n (1 + D v)`, a function of
   `D v0` only (through the Lambert W function).
@@ -132,7 +136,7 @@ def maxwell(c, b, m, v0):
     `X = exp(-a tau)((w^2 - a^2)/w sin(w tau) - 2 a cos(w tau)) + 2 a`, and peak force
     `F_max = c x* exp(-a tau_p)` at `tau_p = atan(w/a)/w`, with `x* = v0 t*`.
     Outside its range (over-damped) the values are NaN-free but meaningless; `impact`
-    integrates those.
+    takes `closed_forms_linear.maxwell_impact`, which holds everywhere.
     """
     t_star = jnp.sqrt(m / c)
     x_star = v0 * t_star
@@ -326,16 +330,27 @@ def _hunt_crossley_restitution(alpha):
     return jnp.where(valid, e, jnp.where(alpha == jnp.inf, 0.0, jnp.nan))
 
 
-def closed_form_for(law, separation):
+def closed_form_for(law, separation, *, g_is_zero=True):
     """The closed form `impact` may use for `law`, or `None` (a static decision).
 
-    Kelvin-Voigt only: it is exact for every damping under both criteria. The Maxwell
-    formulas hold for under-damped values only, which is not known before run time, so
-    `impact` integrates Maxwell (the formulas stay as the tests' oracle)."""
-    name = getattr(law, "name", None)
-    if name == "kelvin_voigt":
-        return _kelvin_voigt_impact(separation)
-    return None
+    The law table owns the facts (`LawSpec.closed_form`: exact for every parameter value
+    without gravity; `closed_form_gravity`: with it too). The function returned,
+    `f(law, *, m, v0, g, rest_tol) -> dict` of `ImpactResult` fields, holds for every `g`
+    where the row says so (then `g_is_zero` does not change it), else for `g = 0` only
+    (`None` when `g_is_zero` is False):
+
+    - Kelvin-Voigt: eq. 5's formulas (`kelvin_voigt`) at `g = 0`, the piecewise
+      oscillator (`closed_forms_linear.linear_impact`) under gravity.
+    - Bingham (eq. 7) and Bingham in compression (eq. 9): `linear_impact`, any `g`.
+    - Maxwell (eqs. 10-11): `closed_forms_linear.maxwell_impact`, every damping, `g = 0`.
+    """
+    spec = getattr(law, "spec", None)
+    if spec is None or not spec.closed_form:
+        return None
+    if not (g_is_zero or spec.closed_form_gravity):
+        return None
+    build = _CLOSED_FORMS.get(law.name)
+    return None if build is None else build(separation)
 
 
 def exact_batch(name: str, params: dict, *, m, v0, separation: str) -> dict | None:
@@ -352,22 +367,84 @@ def exact_batch(name: str, params: dict, *, m, v0, separation: str) -> dict | No
     return {k: np.asarray(out[k]) for k in ("e", "T", "status")}
 
 
-def _finish(fields, m, v0):
+def _finish(fields, m, v0, g=0.0):
+    """The `ImpactResult` fields of a closed form's dict (`x_end`, m, where contact ended:
+    the work of gravity `m g x_end` is dissipated too, as on the integrated path)."""
     e = fields["e"]
     separated = fields["status"] == Status.separated
     fields = dict(fields)
+    x_end = fields.pop("x_end", 0.0)
     fields["status"] = jnp.asarray(fields["status"]).astype(jnp.int32)
-    fields["dissipated"] = 0.5 * m * v0**2 * (1.0 - e**2)
+    fields["dissipated"] = 0.5 * m * v0**2 * (1.0 - e**2) + m * g * x_end
     fields["v_out"] = jnp.where(separated, -e * v0, 0.0)
     fields["num_steps"] = jnp.asarray(0)
     return fields
 
 
 def _kelvin_voigt_impact(separation):
-    def impact_fields(law, *, m, v0, rest_tol):
-        fields = kelvin_voigt(
-            law.params["c"], law.params["b"], m, v0, separation, rest_tol=rest_tol
-        )
-        return _finish(fields, m, v0)
+    def impact_fields(law, *, m, v0, g=0.0, rest_tol):
+        from .closed_forms_linear import linear_impact
+
+        c, b = law.params["c"], law.params["b"]
+        g = jnp.asarray(g, dtype=jnp.result_type(float))
+
+        def without_gravity(args):
+            c, b, m, v0, g = args
+            fields = kelvin_voigt(c, b, m, v0, separation, rest_tol=rest_tol)
+            fields["status"] = jnp.asarray(fields["status"]).astype(jnp.int32)
+            return dict(fields, x_end=jnp.zeros_like(fields["T"]))
+
+        def with_gravity(args):
+            c, b, m, v0, g = args
+            zero = jnp.zeros_like(c)
+            fields = linear_impact(
+                c, b, zero, zero, m, v0, g, separation, dry=False, rest_tol=rest_tol
+            )
+            fields["status"] = jnp.asarray(fields["status"]).astype(jnp.int32)
+            return fields
+
+        args = jnp.broadcast_arrays(c, b, m, v0, g)
+        # eq. 5's formulas where g = 0 (a select under vmap, one branch otherwise)
+        fields = jax.lax.cond(jnp.all(g == 0), without_gravity, with_gravity, args)
+        return _finish(fields, m, v0, g)
 
     return impact_fields
+
+
+def _linear_impact(p_in, p_out, damped, dry):
+    """Bingham-type laws: `p_in(P)`, `p_out(P)` the dry force in each phase (N)."""
+
+    def build(separation):
+        def impact_fields(law, *, m, v0, g=0.0, rest_tol):
+            from .closed_forms_linear import linear_impact
+
+            c, pressure = law.params["c"], law.params["P"]
+            b = law.params["b"] if damped else jnp.zeros_like(c)
+            fields = linear_impact(
+                c, b, p_in(pressure), p_out(pressure), m, v0, g, separation,
+                dry=dry, rest_tol=rest_tol,
+            )  # fmt: skip
+            return _finish(fields, m, v0, g)
+
+        return impact_fields
+
+    return build
+
+
+def _maxwell_impact(separation):
+    def impact_fields(law, *, m, v0, g=0.0, rest_tol):
+        from .closed_forms_linear import maxwell_impact
+
+        fields = maxwell_impact(law.params["c"], law.params["b"], m, v0, separation,
+                                rest_tol=rest_tol)  # fmt: skip
+        return _finish(fields, m, v0, g)
+
+    return impact_fields
+
+
+_CLOSED_FORMS = {
+    "kelvin_voigt": _kelvin_voigt_impact,
+    "bingham": _linear_impact(lambda p: p, lambda p: p, damped=True, dry=True),
+    "bingham_compression": _linear_impact(lambda p: p, jnp.zeros_like, damped=False, dry=False),
+    "maxwell": _maxwell_impact,
+}

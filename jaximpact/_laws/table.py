@@ -44,6 +44,7 @@ _SPECS = [
         shape=(1.0, 0.0),
         one_group=True,
         closed_form=True,
+        closed_form_gravity=True,
     ),
     LawSpec(
         name="kelvin_voigt_modified",
@@ -74,6 +75,8 @@ _SPECS = [
         coefficients=lambda q, v0: _family(q["c"], 1, q["b"], 0, q["P"], -q["P"]),
         split=True,
         dry=True,
+        closed_form=True,
+        closed_form_gravity=True,
     ),
     LawSpec(
         name="bingham_modified",
@@ -103,6 +106,8 @@ _SPECS = [
         coefficients=lambda q, v0: _family(q["c"], 1, 0.0, 0, q["P"], 0.0),
         gap=1,
         split=True,
+        closed_form=True,
+        closed_form_gravity=True,
     ),
     LawSpec(
         name="maxwell",
@@ -116,6 +121,7 @@ _SPECS = [
         reference=f"{_PAPER}, eqs. 10-11",
         coefficients=None,
         positive=("c", "b"),
+        closed_form=True,  # without gravity: eqs. 10-11 are linear, any damping
     ),
     LawSpec(
         name="hertz_viscous",

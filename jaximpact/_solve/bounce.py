@@ -9,6 +9,7 @@ length `max_impacts`; contacts after the end are masked, so the whole drop is on
 program, differentiable in both modes (shared/notes/diffrax-impact-notes.md, section 6).
 """
 
+import dataclasses
 import enum
 import math
 
@@ -20,11 +21,13 @@ import numpy as np
 from jaxtyping import Array
 
 from .._checks import check_nonnegative, check_positive, check_values
-from .._laws import AbstractLaw
+from .._curves.gravity import WithGravity
+from .._curves.shapes import curve_key
+from .._laws import AbstractLaw, shape_of
 from .._status import Status
 from .adjoint import auto_adjoint
 from .flight import Flight
-from .impact import SEPARATIONS, ImpactOptions
+from .impact import CURVES_RTOL, SEPARATIONS, ImpactOptions, gravity_impact, similarity_reason
 from .phases import assemble_integrated, integrate_phases, phase_plan
 from .precision import resolvable_tolerances
 
@@ -60,11 +63,28 @@ class BounceOptions(eqx.Module):
     max_impacts: int = eqx.field(static=True)
 
 
+def _gravity_key(law, options: ImpactOptions):
+    """The two-group table's key where `impact(..., g=g)` would read it (a one-group law of
+    the table with a shipped gravity table, `rtol >= CURVES_RTOL`, the default solver
+    Tsit5), else `None` (static)."""
+    if options.rtol < CURVES_RTOL or type(options.solver) is not dfx.Tsit5:
+        return None
+    reason = similarity_reason(law, options.separation, g_is_zero=False, gravity_table=True)
+    if reason is not None:
+        return None
+    return WithGravity(curve_key(*shape_of(law), options.separation))
+
+
 def _contact(law, m, v_in, g, ts_local, options: ImpactOptions):
     """One contact at impact speed `v_in` with gravity `g`: the `ImpactResult`, the
     penetration at separation (m; > 0 when the force criterion ends contact inside the
-    surface), and, with `ts_local` (s from first touch), the histories on that grid."""
+    surface), and, with `ts_local` (s from first touch), the histories on that grid.
+    Without histories a contact whose `(beta, gamma)` the gravity table holds is read off
+    it, as `impact` does (`gravity_impact`; the others are integrated)."""
     dynamics = law.dynamics(m=m, v0=v_in, g=g)
+    key = None if ts_local is not None else _gravity_key(law, options)
+    if key is not None:
+        return gravity_impact(dynamics, m, v_in, g, dataclasses.replace(options, similarity=key))
     tau_grid = None if ts_local is None else ts_local / dynamics.t_star
     plan = phase_plan(dynamics, options.peaks or tau_grid is not None)
     phases = integrate_phases(

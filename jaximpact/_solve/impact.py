@@ -1,6 +1,7 @@
 """One impact: read off the universal curves, taken from a closed form, or integrated
 with diffrax and ended by events (`_integrate`, imported only when needed)."""
 
+import dataclasses
 import math
 import warnings
 
@@ -10,6 +11,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._checks import check_nonnegative, check_positive
+from .._curves.gravity import WithGravity, gravity_fields, table_for
 from .._curves.shapes import CurveKey, curve_key
 from .._curves.similarity import serves, similarity_fields
 from .._laws import AbstractLaw, shape_of
@@ -41,7 +43,7 @@ class ImpactOptions(eqx.Module):
     rest_tol: float = eqx.field(static=True)
     adjoint: object = eqx.field(static=True)  # a diffrax adjoint (None: not integrated)
     peaks: bool = eqx.field(static=True)
-    similarity: CurveKey | None = eqx.field(static=True, default=None)
+    similarity: CurveKey | WithGravity | None = eqx.field(static=True, default=None)
 
 
 @eqx.filter_jit
@@ -49,14 +51,17 @@ def solve_impact(law, m, v0, g, ts, options: ImpactOptions) -> ImpactResult:
     """The compiled part of `impact`, cached per law structure and options; no input
     checks (callers inside the library that have validated their inputs use it)."""
     dynamics = law.dynamics(m=m, v0=v0, g=g)
+    if isinstance(options.similarity, WithGravity):
+        return gravity_impact(dynamics, m, v0, g, options)[0]
     if options.similarity is not None:
         fields = similarity_fields(dynamics, options.similarity, m=m, v0=v0, peaks=options.peaks)
         return ImpactResult(**fields, path="similarity")
     if options.closed_form:
         from .._laws.closed_forms import closed_form_for
 
+        # gravity reaches here only for a law whose closed form holds for every g
         closed = closed_form_for(law, options.separation)
-        fields = closed(law, m=m, v0=v0, rest_tol=options.rest_tol)
+        fields = closed(law, m=m, v0=v0, g=g, rest_tol=options.rest_tol)
         return ImpactResult(**fields, path="closed_form")
     from .phases import assemble_integrated, integrate_phases, phase_plan
 
@@ -212,16 +217,65 @@ def _check_options(*, rtol, atol, rest_tol, max_steps, tau_max):
         raise ValueError(f"tau_max must be a finite number > 0 (units of t*), got {tau_max!r}")
 
 
-def similarity_reason(law, separation: str, *, g_is_zero: bool = True, ts=None) -> str | None:
+def gravity_impact(dynamics, m, v0, g, options: ImpactOptions):
+    """One contact with gravity from the two-group table (`_curves.gravity`) where
+    `(beta, gamma)` lies in it, else integrated with `options` (a `lax.cond`; under `vmap`
+    both run, and the integration skips the members the table serves, so a batch pays for
+    the solver only where some member is outside). Returns the `ImpactResult` (path
+    `"similarity"`) and the penetration at separation (m)."""
+    from .phases import assemble_integrated, integrate_phases, phase_plan
+
+    fields, x_end, in_range = gravity_fields(
+        dynamics, options.similarity.key, m=m, v0=v0, g=g, peaks=options.peaks
+    )
+
+    def same_types(values):
+        return {
+            k: jnp.asarray(v, jnp.int32 if k in ("status", "num_steps") else float)
+            for k, v in values.items()
+        }
+
+    def table(_):
+        return same_types(fields), jnp.asarray(x_end, float)
+
+    def integrated(_):
+        plan = phase_plan(dynamics, options.peaks)
+        phases = integrate_phases(
+            dynamics,
+            plan=plan,
+            separation=options.separation,
+            tau_grid=None,
+            solver=options.solver,
+            rtol=options.rtol,
+            atol=options.atol,
+            max_steps=options.max_steps,
+            tau_max=options.tau_max,
+            rest_tol=options.rest_tol,
+            adjoint=options.adjoint,
+            hold=in_range,
+        )
+        result = assemble_integrated(dynamics, phases, plan, m=m, v0=v0, g=g, tau_grid=None)
+        x = dynamics.position(phases["y"][-1]) * dynamics.x_star
+        return same_types({k: getattr(result, k) for k in fields}), jnp.asarray(x, float)
+
+    values, x = jax.lax.cond(in_range, table, integrated, None)
+    return ImpactResult(**values, path="similarity"), x
+
+
+def similarity_reason(
+    law, separation: str, *, g_is_zero: bool = True, ts=None, gravity_table: bool = False
+) -> str | None:
     """Why the universal curves cannot give this impact, or `None` if they can.
 
     They need a one-group law of the table (`F = c x^n + b x^p v`: no dry force, which adds
     the group `P/(c x*^n)`; not Maxwell; not a custom law), no gravity (which adds
-    `m g/(c x*^n)`), no time histories, exponents known as numbers, and a shape whose
-    impacts always separate (Hertz viscous under `"penetration"` is captured above a
-    threshold, near which the contact lasts for ever)."""
+    `gamma = g x*/v0^2`) unless `gravity_table` (the caller can read the two-group table
+    of `_curves.gravity` and integrate where it ends: `gravity_impact`) and the shape has
+    one, no time histories, exponents known as numbers, and a shape whose impacts always
+    separate (Hertz viscous under `"penetration"` is captured above a threshold, near which
+    the contact lasts for ever)."""
     name = getattr(law, "name", "custom")
-    if not g_is_zero:
+    if not g_is_zero and not gravity_table:
         return "gravity adds a second group m g/(c x*^n); pass g=0 (a Python 0) or integrate"
     if ts is not None:
         return "time histories (ts=...) need the integration"
@@ -242,6 +296,11 @@ def similarity_reason(law, separation: str, *, g_is_zero: bool = True, ts=None) 
         return (
             f"under separation={separation!r} the shape n={shape[0]:g}, p={shape[1]:g} is "
             "captured above a damping threshold, where the curves end; use method='integrate'"
+        )
+    if not g_is_zero and table_for(key) is None:
+        return (
+            f"gravity adds a second group g x*/v0^2, and the shape n={shape[0]:g}, "
+            f"p={shape[1]:g} under separation={separation!r} has no gravity table; integrate"
         )
     return None
 
@@ -327,10 +386,10 @@ def impact(
         raise ValueError("impact takes scalar m, v0 and g; use jax.vmap for a batch")
 
     closed = None
-    if ts is None and g_is_zero and getattr(getattr(law, "spec", None), "closed_form", False):
+    if ts is None and getattr(getattr(law, "spec", None), "closed_form", False):
         from .._laws.closed_forms import closed_form_for
 
-        closed = closed_form_for(law, separation)
+        closed = closed_form_for(law, separation, g_is_zero=g_is_zero)
     if method == "closed_form" and closed is None:
         raise ValueError(
             f"no closed form for law {getattr(law, 'name', 'custom')!r} with "
@@ -338,9 +397,11 @@ def impact(
         )
     key, reason = None, None
     if method == "similarity" or (method == "auto" and closed is None):
-        reason = similarity_reason(law, separation, g_is_zero=g_is_zero, ts=ts)
+        reason = similarity_reason(law, separation, g_is_zero=g_is_zero, ts=ts, gravity_table=True)
         if reason is None:
             key = curve_key(*shape_of(law), separation)
+            # with gravity: the two-group table, integrated where (beta, gamma) leaves it
+            key = key if g_is_zero else WithGravity(key)
         elif method == "similarity":
             raise ValueError(f"method='similarity' cannot serve this impact: {reason}")
     if method == "auto" and key is not None and (solver is not None or rtol < CURVES_RTOL):
@@ -352,7 +413,7 @@ def impact(
             raise ValueError("ts must be a 1-D array of times in seconds")
     rtol, atol, rest_tol = resolvable_tolerances(rtol, rtol if atol is None else atol, rest_tol)
     closed_form = closed is not None and method != "integrate"
-    if key is None and not closed_form:
+    if (key is None or isinstance(key, WithGravity)) and not closed_form:
         import diffrax as dfx
 
         from .adjoint import auto_adjoint
@@ -373,6 +434,10 @@ def impact(
         similarity=key,
     )
     result = solve_impact(law, m, v0, g, ts, options)
+    if isinstance(key, WithGravity) and not isinstance(result.num_steps, jax.core.Tracer):
+        if int(result.num_steps) > 0:  # outside the table: integrated, and said so
+            fields = {f.name: getattr(result, f.name) for f in dataclasses.fields(result)}
+            result = ImpactResult(**{**fields, "path": "integrated"})
     if throw is not False:
         raise_if_failed(result, max_steps=max_steps, rtol=rtol)
     _check_representable(result, m, v0, g)

@@ -197,7 +197,7 @@ def test_vmap_takes_the_curves():
         (ji.law("bingham", c=2e6, b=400.0, P=100.0), {}, "not one-group"),
         (ji.law("maxwell", c=2e6, b=4e3), {}, "not one-group"),
         (ji.custom_law(lambda x, v, p: p["k"] * x, k=1e6), {}, "not one-group"),
-        (ji.law("hertz_rate", c=2e6, b1=800.0), {"g": 9.81}, "gravity"),
+        (ji.law("kelvin_voigt_modified", c=2e6, b1=800.0), {"g": 9.81}, "gravity table"),
         (ji.law("hertz_rate", c=2e6, b1=800.0), {"ts": np.linspace(0, 1e-3, 5)}, "ts="),
         (ji.law("hertz_viscous", c=2e6, b=900.0), {"separation": "penetration"}, "captured"),
     ],
@@ -210,8 +210,13 @@ def test_similarity_is_refused_with_a_reason(law, kwargs, words):
 def test_auto_keeps_the_closed_form_and_integrates_what_the_curves_cannot_serve():
     assert ji.impact(ji.law("kelvin_voigt", c=2e6, b=400.0), m=M, v0=V0).path == "closed_form"
     law = ji.law("hertz_rate", c=2e6, b1=800.0)
-    assert ji.impact(law, m=M, v0=V0, g=9.81).path == "integrated"
+    # with gravity: the two-group table (tests/curves/test_gravity_curves.py)
+    assert ji.impact(law, m=M, v0=V0, g=9.81).path == "similarity"
+    assert ji.impact(law, m=M, v0=V0, g=9.81, rtol=1e-12).path == "integrated"
     assert ji.impact(law, m=M, v0=V0, rtol=1e-12).path == "integrated"
+    # a shape without a gravity table integrates with gravity
+    plain = ji.law("kelvin_voigt_modified", c=2e6, b1=800.0)
+    assert ji.impact(plain, m=M, v0=V0, g=9.81).path == "integrated"
 
 
 def _fake_curves(key):

@@ -274,7 +274,10 @@ def test_height_inside_contact_from_the_contact_solution():
             s1.sol(np.minimum(local, res["t_max"]))[0],
             s2.sol(np.maximum(local, res["t_max"]))[0],
         )
-        np.testing.assert_allclose(-y[inside], x_ref, rtol=1e-7, atol=1e-12)
+        # the drop's contacts are read off the gravity table; its histories integrate
+        # them (rtol 1e-10): the two chains' impact instants differ by ~5e-10 s, which is
+        # ~1.5e-9 m of penetration at ~3 m/s
+        np.testing.assert_allclose(-y[inside], x_ref, rtol=1e-7, atol=5e-9)
         assert np.all(F[inside] >= -1e-9)
     assert np.all(np.isfinite(y[ts <= float(b.t_rest)]))
 

@@ -244,12 +244,14 @@ def test_gravity_matches_scipy(name):
     assert r["x_max"] > without["x_max"] and r["e"] < without["e"]
 
 
-def test_gravity_switches_the_closed_form_off():
+def test_gravity_keeps_the_closed_form():
+    """Kelvin-Voigt under gravity is exact too (tests/laws/test_closed_forms_linear.py)."""
     law = ji.law("kelvin_voigt", c=2e6, b=400.0)
     r = ji.impact(law, m=M, v0=V0, g=9.81)
-    assert r.path == "integrated"
+    assert r.path == "closed_form" and int(r.num_steps) == 0
     ref = reference("kelvin_voigt", (("c", 2e6), ("b", 400.0)), "force", g=9.81)
-    assert_rel(r.e, ref["e"], 1e-8, "KV e with gravity")
+    assert_rel(r.e, ref["e"], 1e-9, "KV e with gravity")
+    assert_rel(r.T, ref["T"], 1e-9, "KV T with gravity")
 
 
 @pytest.mark.parametrize("separation", SEPARATIONS)
@@ -355,7 +357,11 @@ def test_vmap_over_speed_equals_the_loop_with_stuck_members():
     v0s = jnp.array([0.1, 0.3, 1.0, 2.5, 10.0])
     params = dict(c=2e6, b=200.0, P=400.0)
     law = ji.law("bingham", **params)
-    batched = jax.vmap(lambda v0: result_fields(ji.impact(law, m=M, v0=v0, rtol=1e-10)))(v0s)
+    # the integrated path (bingham's default is now its closed form, whose vmap with stuck
+    # members is tests/laws/test_closed_forms_linear.py::test_impact_fields_dissipated_...)
+    batched = jax.vmap(
+        lambda v0: result_fields(ji.impact(law, m=M, v0=v0, rtol=1e-10, method="integrate"))
+    )(v0s)
     statuses = np.asarray(batched["status"])
     assert list(statuses[:2]) == [ji.Status.stuck] * 2
     assert list(statuses[2:]) == [ji.Status.separated] * 3
