@@ -60,7 +60,11 @@ try:
         )
     for e, T, steps in [(0.6, 0.01, 40), (0.9, 0.02, 100), (0.9, 0.01, 10)]:
         h = T / steps
-        x = ji.export(None, "drake", m=1.0, v0=1.0, e=e, T=T, timestep=h, curves=False)
+        # 10 steps per contact is refused by default (realised e 0.66 for 0.9): measured
+        # here on purpose, so exported anyway
+        x = ji.export(
+            None, "drake", m=1.0, v0=1.0, e=e, T=T, timestep=h, curves=False, strict=False
+        )
         runs = np.array(
             [
                 drake.simulate(x.parameters, m=1.0, v0=1.0, time_step=h, gap=phase * h)

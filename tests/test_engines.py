@@ -273,9 +273,14 @@ def test_drake_discrete_realises_the_promise(e, T, steps):
 @pytest.mark.engines
 def test_drake_discrete_coarse_step_is_warned_and_realised():
     """At 10 steps per contact no d >= 0 gives e = 0.9 (the implicit step alone damps to
-    0.66): the export warns, and its promise is what Drake really gives."""
+    0.66): the export is refused (more than 5 % off), with strict=False it warns, and its
+    promise is what Drake really gives."""
     _require("pydrake")
-    x = ji.export(None, "drake", m=1.0, v0=1.0, e=0.9, T=0.01, timestep=0.001, curves=False)
+    with pytest.raises(ValueError, match="drake cannot realise"):
+        ji.export(None, "drake", m=1.0, v0=1.0, e=0.9, T=0.01, timestep=0.001, curves=False)
+    with pytest.warns(UserWarning, match="drake cannot realise"):
+        x = ji.export(None, "drake", m=1.0, v0=1.0, e=0.9, T=0.01, timestep=0.001,
+                      curves=False, strict=False)  # fmt: skip
     assert any("damps more than e = 0.9" in w for w in x.warnings)
     assert x.parameters["hunt_crossley_dissipation"] == 0.0
     es = [drake_engine.simulate(x.parameters, m=1.0, v0=1.0, time_step=0.001,
@@ -383,6 +388,8 @@ def test_yade_default_damping_is_the_public_report():
                 "1",
                 "--radius",
                 "0.01",
+                "--mass",
+                "0.01",
                 "--poisson",
                 "0.5",
             ],
@@ -414,6 +421,8 @@ def test_yade_default_damping_is_the_public_report():
                 '{"E": -1, "coeff_restitution": 0.5}',
                 "--radius",
                 "0.01",
+                "--mass",
+                "0.01",
                 "--speed",
                 "1",
             ],
@@ -444,6 +453,8 @@ def test_yade_default_damping_is_the_public_report():
                 "--v0",
                 "1",
                 "--radius",
+                "0.01",
+                "--mass",
                 "0.01",
             ],
             r"exp\(-2\)",

@@ -75,8 +75,8 @@ def batch_file(
     params: dict | None = None,
     m: float | None = None,
     v0: float | None = None,
-    g: float = 0.0,
-    separation: str = "force",
+    g: float | None = None,
+    separation: str | None = None,
     chunk_rows: int = 100_000,
     resume: bool = False,
     progress: bool = True,
@@ -94,7 +94,9 @@ def batch_file(
       each chunk checked just before it is computed.
     - `law`: a name of `LAW_NAMES`. The file's columns give, per row, any of its parameters
       and `m` (kg), `v0` (m/s), `g` (m/s^2), `separation`; `params`, `m`, `v0`, `g`,
-      `separation` give the rest (SI units).
+      `separation` give the rest (SI units; `g` 0 and `separation` "force" where neither
+      gives them). A column and an argument for the same name must agree on every row: a
+      `ValueError` names the first row where they do not.
     - `impact_options` (`method`, `rtol`, ...): as in `impact`.
     - `chunk_rows`: rows per chunk (the unit of memory, of work per process and of
       resumption).
@@ -132,8 +134,13 @@ def batch_file(
     if is_parquet(out):
         require_pyarrow(out)
     spec = LAWS[law]
-    fixed = {**spec.defaults, **(params or {}), "separation": separation}
+    # what the caller gave for every row: a column of the same name must agree with it
+    options = {**(params or {})}
+    options.update({k: v for k, v in (("m", m), ("v0", v0), ("g", g), ("separation",
+                    separation)) if v is not None})  # fmt: skip
+    fixed = {**spec.defaults, **(params or {}), "separation": separation or "force"}
     fixed.update({k: v for k, v in (("m", m), ("v0", v0), ("g", g)) if v is not None})
+    fixed.setdefault("g", 0.0)
     unknown = sorted(set(params or {}) - set(spec.parameters))
     if unknown:
         own = [k for k in unknown if k in (*KINEMATICS, *TEXT_COLUMNS)]
@@ -159,6 +166,7 @@ def batch_file(
             "column or a fixed value (--param NAME=VALUE, --mass, --v0)"
         )
     fixed = {k: v for k, v in fixed.items() if k not in columns}
+    options = {k: v for k, v in options.items() if k in columns}  # checked row by row
     settings = json.dumps(
         [_FORMAT, law, columns, sorted((k, repr(v)) for k, v in fixed.items()),
          sorted((k, repr(v)) for k, v in impact_options.items()), is_parquet(out)]
@@ -176,7 +184,7 @@ def batch_file(
             if group.owns(index) and problem is None:
                 try:
                     cells = table.parse(chunk)
-                    check_rows(law, cells.values, fixed, cells.where)
+                    check_rows(law, cells.values, fixed, cells.where, options)
                 except ValueError as error:
                     problem = (index, str(error))
                 else:
@@ -220,8 +228,9 @@ def batch_file(
                 todo, problem = None, None  # the cells of this process's chunk to compute
                 if mine is not None:
                     try:
-                        todo = _cells_to_compute(*mine, table, law, fixed, settings, digests,
-                                                 parts if resume else None, one_pass)  # fmt: skip
+                        todo = _cells_to_compute(*mine, table, law, fixed, options, settings,
+                                                 digests, parts if resume else None,
+                                                 one_pass)  # fmt: skip
                     except ValueError as error:
                         problem = str(error)
                 if together:  # every process learns of a bad chunk before the program runs
@@ -307,14 +316,16 @@ def _rounds(items, size: int):
         yield batch
 
 
-def _cells_to_compute(index, chunk, table, law, fixed, settings, digests, parts, one_pass):
+def _cells_to_compute(index, chunk, table, law, fixed, options, settings, digests, parts,
+                      one_pass):  # fmt: skip
     """The parsed cells of chunk `index`, or None where `parts` (None: no resuming) holds it
     finished with the same inputs and settings; a chunk read once (`one_pass`) is checked
-    here (a ValueError naming its row)."""
+    here (a ValueError naming its row; `options`: the arguments its columns must agree
+    with)."""
     cells = None
     if one_pass:
         cells = table.parse(chunk)
-        check_rows(law, cells.values, fixed, cells.where)
+        check_rows(law, cells.values, fixed, cells.where, options)
         digests[index] = _digest(settings, cells.digest)
     if parts is not None and parts.done(index, digests[index]):
         return None

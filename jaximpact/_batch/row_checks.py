@@ -38,12 +38,29 @@ def check_fixed(law: str, fixed: dict):
             raise ValueError(f"fixed value {key}: {key} = {value!s} must be a finite number {need}")
 
 
-def check_rows(law: str, values: dict, fixed: dict, where):
+# how a value given for every row is named: the command line's option (Python's argument)
+_OPTIONS = {
+    "m": "--mass (m=)",
+    "v0": "--v0 (v0=)",
+    "g": "--g (g=)",
+    "separation": "--separation (separation=)",
+}
+
+
+def option_name(key: str) -> str:
+    """The option (and argument) that gives `key` to every row, for messages."""
+    return _OPTIONS.get(key, f"--param {key}= (params={{{key!r}: ...}})")
+
+
+def check_rows(law: str, values: dict, fixed: dict, where, options=None):
     """Raise a one-line `ValueError` at the first row (file order) with a bad value in
-    `values` (column -> array); `fixed` completes the law's parameters; `where(i)` says where
-    row `i` is."""
+    `values` (column -> array), or whose column disagrees with the value `options` (name ->
+    value, the options the caller gave for every row) holds for it: a column and an option
+    that disagree are refused, never settled silently. `fixed` completes the law's
+    parameters; `where(i)` says where row `i` is."""
     spec = LAWS[law]
     positive = (*_POSITIVE, *spec.positive)
+    options = options or {}
     rows = len(next(iter(values.values())))
     first, message = rows, None
     for key, column in values.items():
@@ -59,6 +76,21 @@ def check_rows(law: str, values: dict, fixed: dict, where):
                 need = "> 0" if key in positive else ">= 0"
                 text = f"{key} = {float(column[i])!r} must be a finite number {need}"
             first, message = i, f"{where(i)}, column {key}: {text}"
+        if key in options:
+            given = options[key]
+            if key == "separation":
+                other = np.asarray(column, object) != given
+            else:
+                with np.errstate(invalid="ignore"):
+                    other = ~bad & (np.asarray(column, float) != float(given))
+            if other[:first].any():
+                i = int(np.argmax(other))
+                shown = repr(column[i]) if key == "separation" else f"{float(column[i])!r}"
+                text = (
+                    f"{key} = {shown} disagrees with {option_name(key)} {given!r} given for "
+                    "every row; drop the column or the option"
+                )
+                first, message = i, f"{where(i)}, column {key}: {text}"
     params = {k: np.broadcast_to(np.asarray(v, float), (rows,)) for k, v in
               {**fixed, **values}.items() if k in spec.parameters}  # fmt: skip
     bad = invalid_parameter_rows(law, params)

@@ -112,6 +112,9 @@ def _run(args) -> int:
     except Interrupted as error:
         mark_reported()
         fail(str(error), status=error.status)
+    except BrokenPipeError:  # e.g. `jaximpact laws | head`: stop quietly
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        raise SystemExit(1) from None
     except (CLIError, ValueError, OSError) as error:
         fail(str(error), status=2)
     except ArithmeticError as error:  # a number of the input beyond float64 (1e300, 1e-300)
@@ -122,9 +125,6 @@ def _run(args) -> int:
         )
     except KeyboardInterrupt:  # outside `handle_interrupts` (not the main thread)
         fail("interrupted", status=130)
-    except BrokenPipeError:  # e.g. `jaximpact laws | head`: stop quietly
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        raise SystemExit(1) from None
     except Exception as error:
         if os.environ.get(DEBUG_ENV):
             raise

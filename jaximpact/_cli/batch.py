@@ -14,8 +14,10 @@ def add_batch(subparsers):
         description="One impact per row of the file IN under the force law --law. The "
         "columns of IN give, per row, any of the law's parameters and m (kg), v0 (m/s), g "
         "(m/s^2), separation (force or penetration); --param NAME=VALUE, --mass, --v0, --g "
-        "and --separation give the rest (SI units). OUT gets the inputs and e, T (s), x_max "
-        "(m), t_max (s), F_max (N), status and path, in the order of IN. CSV always; Parquet "
+        "and --separation give the rest (SI units); a column and an option for the same "
+        "name must agree on every row (the first row where they do not is an error). OUT "
+        "gets the inputs and e, T (s), x_max (m), t_max (s), F_max (N), status and path, "
+        "in the order of IN. CSV always; Parquet "
         "(.parquet, .pq) with pyarrow installed (pip install 'jaximpact[parquet]'). Every "
         "value is checked before any work; chunks of --chunk-rows rows are written whole "
         "into OUT.parts/ with a SHA-256 of their inputs and joined into OUT at the end; "
@@ -37,15 +39,18 @@ def add_batch(subparsers):
     )
     parser.add_argument("--law", required=True, metavar="NAME", help="see `jaximpact laws`")
     parser.add_argument(
-        "--param", action="append", default=[], metavar="NAME=VALUE",
-        help="a law parameter for every row, SI units (repeat --param for each)",
+        "--param", action="extend", nargs="+", default=[], metavar="NAME=VALUE",
+        help="a law parameter for every row, SI units (--param c=2e6 b1=800, or repeated)",
     )  # fmt: skip
     parser.add_argument("--mass", type=float, metavar="KG", help="m for every row, kg")
     parser.add_argument("--v0", type=float, metavar="M/S", help="impact speed for every row")
-    parser.add_argument("--g", type=float, default=0.0, metavar="M/S^2", help="gravity")
     parser.add_argument(
-        "--separation", choices=("force", "penetration"), default="force", help="end of contact"
+        "--g", type=float, metavar="M/S^2", help="gravity for every row (default 0)"
     )
+    parser.add_argument(
+        "--separation", choices=("force", "penetration"),
+        help="end of contact for every row (default force)",
+    )  # fmt: skip
     parser.add_argument("--out", required=True, type=Path, metavar="OUT", help="file to write")
     parser.add_argument(
         "--chunk-rows", type=int, default=100_000, metavar="N",

@@ -8,6 +8,7 @@ on; `--json` for the numbers, `--plot` for a bar chart of the ratios against the
 
 import math
 import sys
+import textwrap
 
 from .._bench import LAWS, TARGETS, require_scipy, run_bench, steps
 from .._format import format_number
@@ -19,6 +20,8 @@ from .common import (
     check_plot_path,
     command_parser,
     emit,
+    format_table,
+    terminal_width,
 )
 
 
@@ -99,21 +102,20 @@ def _ratio(row, kind) -> str:
     return f"{ratio:.0f}x {verdict}" if ratio >= 100 else f"{ratio:.3g}x {verdict}"
 
 
-def _table(header, rows) -> list[str]:
-    widths = [max(len(str(r[i])) for r in [header, *rows]) for i in range(len(header))]
-
-    def line(cells):
-        return "  ".join(str(c).ljust(w) for c, w in zip(cells, widths, strict=True)).rstrip()
-
-    return [line(header), "  ".join("-" * w for w in widths), *map(line, rows)]
-
-
-def _text(data) -> str:
+def _text(data, width=None) -> str:
+    """The report, fitted to `width` columns (default: the terminal's, 88 when stdout is
+    not one): prose wrapped, the table's headers wrapped and, where it is still too wide,
+    its columns in two tables that each repeat the law."""
+    width = terminal_width() if width is None else width
     machine, cond = data["machine"], data["conditions"]
     batch = data["rows"][0]["batch_size"] if data["rows"] else 0
     rounds = data["rows"][0]["rounds"] if data["rows"] else 0
     cache = machine["compilation_cache"]
-    out = [
+
+    def prose(*paragraphs) -> list[str]:  # each wrapped to the width
+        return [line for p in paragraphs for line in (_wrap(p, width) if p else [""])]
+
+    out = prose(
         f"jaximpact bench{' --quick' if cond['quick'] else ''}: default impact() against scipy "
         f"solve_ivp DOP853 with an event; m = {format_number(cond['m'])} kg, "
         f"v0 = {format_number(cond['v0'])} m/s, separation at zero force, float64",
@@ -123,7 +125,7 @@ def _text(data) -> str:
         f"{machine['load_average_end']} at end",
         f"compilation cache: {cache if cache else 'off'}",
         "",
-    ]
+    )
     header = [
         "law",
         "path",
@@ -157,16 +159,16 @@ def _text(data) -> str:
         ]
         for r in data["rows"]
     ]
-    out += _table(header, rows)
+    out += format_table(header, rows, width=width)
     limit = data["targets"]["error_e"]
     loose = [r for r in data["rows"] if not (r["err_e"] is not None and r["err_e"] <= limit)]
     if loose:
-        out.append(
+        out += prose(
             f"note: the default impact's error in e is above the {limit:.0e} that scipy is "
             "held to for: " + ", ".join(f"{r['case']} ({_error(r['err_e'])})" for r in loose)
         )
     eu = data["euler"]
-    out += [
+    out += prose(
         "",
         f"seed paper's explicit Euler (scheme as printed), dt = {format_number(eu['dt'])} s, "
         f"{eu['law']}: e = {eu['e']:.6f} against {eu['e_ref']:.6f} (contact until x = 0, "
@@ -178,9 +180,9 @@ def _text(data) -> str:
         f"member of a jax.vmap over {batch} impact speeds in v0 x [0.8, 1.25]); compile s: "
         "first call (tracing, compilation or the cache's load); ratios: scipy time / "
         f"jaximpact time, median over {rounds} alternated rounds.",
-    ]
+    )
     if "plot" in data:
-        out.append(f"plot written to {data['plot']}")
+        out += prose(f"plot written to {data['plot']}")
     return "\n".join(out)
 
 
@@ -218,3 +220,11 @@ def _plot(data, path):
     )
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     save_figure(fig, path)
+
+
+def _wrap(text: str, width: int) -> list[str]:
+    """`text` in lines of at most `width` characters (a word longer than that, such as a
+    path, on a line of its own), continuations indented by two."""
+    return textwrap.wrap(
+        text, width, subsequent_indent="  ", break_long_words=False, break_on_hyphens=False
+    )

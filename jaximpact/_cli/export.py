@@ -2,6 +2,7 @@
 engine realises) and `jaximpact engine-e` (engine parameters -> e(v), T(v))."""
 
 import json
+import sys
 
 from .._format import format_number
 from .common import (
@@ -20,77 +21,142 @@ def add_export(subparsers):
         subparsers,
         "export",
         help="an engine's contact parameters (MuJoCo, Drake, LAMMPS, LIGGGHTS, Chrono, Yade) "
-        "for a law or target e, T",
-        description="Turn a law (--law, --param) or target --e and --T into the contact "
+        "for a law, a fit or target e, T",
+        description="Turn a law (--law, --param), a fit (--from FILE, the JSON of "
+        "'jaximpact calibrate --json') or target --e and --T into the contact "
         "parameters of MuJoCo, Drake, LAMMPS, LIGGGHTS, Chrono or Yade, in the engine's own "
         "names and units, with a "
         "snippet to paste, a recommended time step, and the e and T the engine realises "
         "(its time stepping included). Scenes: MuJoCo and Drake, a body of --mass on a "
         "plane; the others, two spheres each of --mass and --radius colliding head-on at "
-        "relative speed --v0. docs/engines.md has the formulas and measured tables.",
-        example="jaximpact export --engine mujoco --e 0.75 --T 0.01 --mass 0.05 --v0 1\n"
-        "jaximpact export --engine lammps --law hertz_rate --param c=2e6 b1=800 "
-        "--mass 1 --v0 2.5 --radius 0.02 --json",
+        "relative speed --v0. docs/engines.md has the formulas and measured tables.\n\n"
+        "--mass has no default: every engine's parameters depend on it (MuJoCo from --e and "
+        "--T alone excepted: solref is per unit mass), and so do a law's e and T. An export "
+        "the engine cannot realise at --timestep (a parameter not finite, e outside [0, 1], "
+        "fewer than 5 steps per contact, or e or T more than 5 % off the target) is refused "
+        "with the step that would work; --no-strict exports it anyway, with a warning.",
+        example="jaximpact export mujoco --e 0.75 --T 0.01 --v0 1\n"
+        "jaximpact export lammps --law hertz_rate --param c=2e6 b1=800 "
+        "--mass 1 --v0 2.5 --radius 0.02 --json\n"
+        "jaximpact calibrate --law hertz_rate --mass 0.05 --v0 2.5 --e 0.85 --T 7.8e-3 "
+        "--json > fit.json\n"
+        "jaximpact export mujoco --from fit.json",
     )
     parser.add_argument(
-        "--engine",
-        required=True,
-        metavar="NAME",
-        help="mujoco, lammps, drake, liggghts, chrono or yade",
-    )
+        "engine_name", nargs="?", metavar="ENGINE",
+        help="mujoco, lammps, drake, liggghts, chrono or yade (or --engine NAME)",
+    )  # fmt: skip
+    parser.add_argument("--engine", metavar="NAME", help="the engine, as ENGINE")
+    parser.add_argument(
+        "--from", dest="source", metavar="FILE",
+        help="a fit to export: the JSON that 'jaximpact calibrate --json' (or 'simulate "
+        "--json') writes, '-' for stdin; its law, parameters, mass and speed are used",
+    )  # fmt: skip
     parser.add_argument("--law", metavar="NAME", help="a law of 'jaximpact laws'")
     parser.add_argument("--param", action="extend", nargs="+", default=[], metavar="NAME=VALUE")
     parser.add_argument("--e", type=float, help="target restitution in (0, 1] (without --law)")
     parser.add_argument("--T", type=float, metavar="S", help="target contact duration, s")
-    parser.add_argument("--mass", type=float, default=1.0, metavar="KG", help="mass, kg")
-    parser.add_argument("--v0", type=float, required=True, metavar="M/S", help="impact speed")
+    parser.add_argument(
+        "--mass", type=float, metavar="KG",
+        help="mass, kg (two-sphere engines: of each sphere); required, except for MuJoCo "
+        "from --e/--T, and with --from (the fit's)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--v0", type=float, metavar="M/S",
+        help="impact speed, m/s (with --from: the fit's, if it has one speed)",
+    )  # fmt: skip
     parser.add_argument("--timestep", type=float, metavar="S", help="the engine's step, s")
     parser.add_argument("--radius", type=float, metavar="M", help="sphere radius, m (LAMMPS)")
     parser.add_argument("--poisson", type=float, help="Poisson's ratio (LAMMPS; default 0.3)")
     parser.add_argument(
         "--limit-damping", action="store_true", help="LAMMPS: keep the force non-attractive"
     )
+    parser.add_argument(
+        "--no-strict", dest="strict", action="store_false",
+        help="export what the engine cannot realise at --timestep anyway, with a warning",
+    )  # fmt: skip
     add_output_arguments(parser, plot=False)
     parser.set_defaults(handler=_run_export)
 
 
+def _engine_name(args) -> str:
+    """ENGINE or --engine (one of them, the same if both), checked."""
+    names = {n for n in (args.engine_name, args.engine) if n is not None}
+    if not names:
+        raise CLIError(f"name the engine: jaximpact export ENGINE, one of {', '.join(_ENGINES)}")
+    if len(names) > 1:
+        raise CLIError(f"ENGINE {args.engine_name!r} and --engine {args.engine!r} disagree")
+    (name,) = names
+    if name not in _ENGINES:
+        raise CLIError(f"unknown engine {name!r}; choose one of: {', '.join(_ENGINES)}")
+    return name
+
+
 def _run_export(args):
     from .._engines import export
+    from .._engines.export import ENGINES, UnrealisedExport, missing_mass
 
-    if args.engine not in _ENGINES:
-        raise CLIError(f"unknown engine {args.engine!r}; choose one of: {', '.join(_ENGINES)}")
-    if args.law is None and args.e is None:
-        raise CLIError("give --law (with --param) or the target --e (and --T)")
-    if args.law is not None and (args.e is not None or args.T is not None):
-        raise CLIError("give either --law or --e/--T, not both")
-    if args.law is None and args.param:
-        raise CLIError("--param needs --law")
-    from .._engines.export import ENGINES
-
-    if args.radius is None and ENGINES[args.engine].TWO_SPHERES:
-        raise CLIError(f"{args.engine} needs --radius (m) of the two spheres")
+    engine = _engine_name(args)
+    notes = []
+    if args.source is not None:
+        if args.e is not None or args.T is not None:
+            raise CLIError("give either --from or --e/--T, not both")
+        if args.param:
+            raise CLIError("--param conflicts with --from: the fit gives the parameters")
+        name, params, args.mass, args.v0, notes = read_fit(args.source, args)
+    else:
+        if args.law is None and args.e is None:
+            raise CLIError("give --law (with --param), --from FILE or the target --e (and --T)")
+        if args.law is not None and (args.e is not None or args.T is not None):
+            raise CLIError("give either --law or --e/--T, not both")
+        if args.law is None and args.param:
+            raise CLIError("--param needs --law")
+        if args.v0 is None:
+            raise CLIError("--v0 is required: the impact speed, m/s")
+        name, params = args.law, parse_params(args.param)
+    module = ENGINES[engine]
+    missing = []
+    if args.mass is None and (name is not None or module.MASS_DEPENDS is not None):
+        missing.append("--mass (kg)")
+    if args.radius is None and module.TWO_SPHERES:
+        missing.append("--radius (m)")
+    if missing:
+        what = " and ".join(missing)
+        if "--mass (kg)" in missing:
+            raise CLIError(missing_mass(engine, name is not None, f"give {what}"))
+        raise CLIError(f"{engine} needs {what} of the two spheres")
     source = None
-    if args.law is not None:
+    if name is not None:
         from .._laws import law
 
-        source = law(args.law, **parse_params(args.param))
-    x = export(
-        source,
-        args.engine,
-        m=args.mass,
-        v0=args.v0,
-        timestep=args.timestep,
-        radius=args.radius,
-        poisson=args.poisson,
-        e=args.e,
-        T=args.T,
-        limit_damping=args.limit_damping,
-    )
+        source = law(name, **params)
+    try:  # with --no-strict, the refusal comes as a warning (one line on stderr)
+        x = export(
+            source,
+            engine,
+            m=args.mass,
+            v0=args.v0,
+            timestep=args.timestep,
+            radius=args.radius,
+            poisson=args.poisson,
+            e=args.e,
+            T=args.T,
+            limit_damping=args.limit_damping,
+            strict=args.strict,
+        )
+    except UnrealisedExport as refusal:
+        raise CLIError(refusal.message("--no-strict to export it anyway")) from None
+    data = x.to_dict()
+    data["warnings"] = [*notes, *data["warnings"]]
+    if args.source is not None:
+        data["from"] = str(args.source)
 
     def text():
+        mass = "per unit mass" if x.m is None else f"m = {format_number(x.m)} kg"
         lines = [
             f"{x.engine}: {x.scene}",
-            f"asked    e = {x.target_e:.6g}, T = {x.target_T:.6g} s at v0 = {x.v0:g} m/s",
+            *([f"from     {args.source}: law {name}"] if args.source is not None else []),
+            f"asked    e = {x.target_e:.6g}, T = {x.target_T:.6g} s at v0 = {x.v0:g} m/s, {mass}",
             f"realised e = {x.e:.6g}, T = {x.T:.6g} s with time step {x.timestep:.6g} s"
             + (
                 f" (e {x.e_range[0]:.5g} to {x.e_range[1]:.5g} over where contact starts)"
@@ -108,10 +174,133 @@ def _run_export(args):
             for i, v in enumerate(x.speeds):
                 law_e = f"   {x.e_target[i]:.5g}" if with_law else ""
                 lines.append(f"  {format_number(v):>9}   {x.e_engine[i]:.5g}{law_e}")
-        lines += [f"warning: {w}" for w in x.warnings]
+        lines += [f"warning: {w}" for w in data["warnings"]]
         return "\n".join(lines)
 
-    emit(args, x.to_dict(), text)
+    emit(args, data, text)
+
+
+def read_fit(path: str, args):
+    """`(law name, parameters, m, v0, notes)` of the fit in the JSON file `path` ('-': stdin)
+    that `jaximpact calibrate --json` writes (one law, or `--law all`'s ranking: its best,
+    or the one `--law` names), or `simulate --json`: its `law`, `params`, `m` (kg) and
+    speed (`rows[].v0`, or `v0`), m/s. `--mass` and `--law`, where given, must agree with
+    the file; `--v0` picks the speed (required where the fit has several). Each missing or
+    mismatched field is a one-line `CLIError`; `notes` are warnings for the output."""
+    import math
+
+    from .._laws import LAWS
+
+    where = f"--from {path}"
+    try:
+        if path == "-":
+            text = sys.stdin.read()
+        else:
+            with open(path) as handle:
+                text = handle.read()
+    except OSError as error:
+        raise CLIError(f"{where}: cannot read it ({error.strerror or error})") from None
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as error:
+        raise CLIError(
+            f"{where}: not JSON ({error.msg}, line {error.lineno}); write it with "
+            "'jaximpact calibrate ... --json > FILE'"
+        ) from None
+    if not isinstance(data, dict):
+        raise CLIError(f"{where}: expected the JSON object of 'jaximpact calibrate --json'")
+    record = data
+    if isinstance(data.get("ranking"), list):  # calibrate --law all
+        ranked = [r for r in data["ranking"] if isinstance(r, dict)]
+        names = [r.get("law") for r in ranked]
+        wanted = args.law if args.law is not None else data.get("best", names[0] if names else None)
+        if wanted not in names:
+            raise CLIError(
+                f"{where}: its ranking has no law {wanted!r}; it has {', '.join(map(str, names))}"
+            )
+        record = ranked[names.index(wanted)]
+    name = record.get("law")
+    if not isinstance(name, str):
+        raise CLIError(f"{where}: no law name ('law'); is it the output of calibrate --json?")
+    if name not in LAWS:
+        raise CLIError(f"{where}: law {name!r} is not one of 'jaximpact laws'")
+    if args.law is not None and args.law != name:
+        raise CLIError(f"--law {args.law} but {path} holds a fit of {name}")
+    params = record.get("params")
+    if not isinstance(params, dict) or not params:
+        raise CLIError(f"{where}: no parameters ('params': an object NAME -> number)")
+    for key, value in params.items():
+        if not _number(value) or not math.isfinite(value):
+            raise CLIError(f"{where}: parameter {key} = {value!r} is not a finite number")
+    unknown = sorted(set(params) - set(LAWS[name].parameters))
+    if unknown:
+        raise CLIError(f"{where}: law {name} has no parameter {', '.join(unknown)}")
+    m = data.get("m", record.get("m"))
+    if m is None:
+        if args.mass is None:
+            raise CLIError(f"{where}: no mass ('m'); give --mass (kg), the one it was fitted for")
+        m = args.mass
+    elif not _number(m) or not (math.isfinite(m) and m > 0):
+        raise CLIError(f"{where}: mass m = {m!r} is not a number > 0 (kg)")
+    elif args.mass is not None and not math.isclose(args.mass, m, rel_tol=1e-12):
+        raise CLIError(
+            f"--mass {args.mass:g} but {path} was fitted for m = {m:g} kg: the law's e and T "
+            "depend on the mass; leave --mass out"
+        )
+    speeds = _speeds(record)
+    if speeds is None:
+        raise CLIError(f"{where}: a speed ('rows'[].v0 or 'v0') is not a number > 0 (m/s)")
+    notes = []
+    if args.v0 is not None:
+        v0 = args.v0
+        if speeds and not (min(speeds) <= v0 <= max(speeds)):
+            notes.append(
+                f"v0 = {v0:g} m/s is outside the speeds of the fit ({_span(speeds)} m/s): the "
+                "law is extrapolated"
+            )
+    elif len(set(speeds)) == 1:
+        v0 = speeds[0]
+    elif not speeds:
+        raise CLIError(f"{where}: no impact speed ('rows'[].v0 or 'v0'); give --v0 (m/s)")
+    else:
+        raise CLIError(
+            f"{where}: the fit has {len(set(speeds))} speeds ({_span(speeds)} m/s); give --v0, "
+            "the speed the export is to be exact at"
+        )
+    separation = data.get("separation", record.get("separation", "force"))
+    if separation != "force":
+        raise CLIError(
+            f"{where}: fitted with separation {separation!r}; the engines' contacts end when "
+            "the force does (separation 'force'): refit with --separation force, or export "
+            "the measured --e and --T"
+        )
+    g = data.get("g", record.get("g", 0.0))
+    if _number(g) and g != 0:
+        notes.append(
+            f"the fit had gravity g = {g:g} m/s^2 during contact; the export's targets are the "
+            "law's e and T without it"
+        )
+    if record.get("converged") is False:
+        notes.append(f"the fit in {path} did not converge")
+    return name, {k: float(v) for k, v in params.items()}, float(m), float(v0), notes
+
+
+def _speeds(record) -> list[float] | None:
+    """The impact speeds (m/s) of a fit record (`rows`[].v0 or `v0`), None if one is bad."""
+    import math
+
+    rows = record.get("rows")
+    values = [r.get("v0") for r in rows if isinstance(r, dict)] if isinstance(rows, list) else []
+    if not values and "v0" in record:
+        v0 = record["v0"]
+        values = v0 if isinstance(v0, list) else [v0]
+    if not all(_number(v) and math.isfinite(v) and v > 0 for v in values):
+        return None
+    return [float(v) for v in values]
+
+
+def _span(speeds) -> str:
+    return f"{min(speeds):g} to {max(speeds):g}"
 
 
 def add_engine_e(subparsers):
@@ -143,7 +332,11 @@ def add_engine_e(subparsers):
         help="mujoco, lammps, drake, liggghts, chrono or yade",
     )
     parser.add_argument("--params", required=True, metavar="JSON", help="engine parameters")
-    parser.add_argument("--mass", type=float, default=1.0, metavar="KG", help="mass, kg")
+    parser.add_argument(
+        "--mass", type=float, metavar="KG",
+        help="mass, kg (two-sphere engines: of each sphere); required except for MuJoCo, "
+        "whose solref is per unit mass",
+    )  # fmt: skip
     parser.add_argument("--speed", type=float, nargs="+", required=True, metavar="M/S")
     parser.add_argument("--radius", type=float, metavar="M", help="sphere radius, m (LAMMPS)")
     add_output_arguments(parser, plot=False)
@@ -193,6 +386,17 @@ def _run_engine_e(args):
     if not isinstance(params, dict):
         raise CLIError("--params must be a JSON object, e.g. '{\"solref\": [0.02, 1]}'")
     _check_engine_params(args.engine, params)
+    from .._engines.export import ENGINES
+
+    module = ENGINES[args.engine]
+    if args.mass is None:
+        if module.MASS_DEPENDS is not None:
+            each = ", of each sphere" if module.TWO_SPHERES else ""
+            raise CLIError(
+                f"{args.engine} needs --mass (kg{each}): the e and T its parameters give "
+                "depend on it"
+            )
+        args.mass = 1.0  # MuJoCo: per unit mass, e and T do not depend on it
     law, separation, e, T = engine_response(
         args.engine, params, m=args.mass, speeds=args.speed, radius=args.radius
     )

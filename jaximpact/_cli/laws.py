@@ -1,7 +1,14 @@
 """`jaximpact laws`: the force laws, their equations, parameters and units."""
 
 from .._format import concrete_units as concrete_units, format_number
-from .common import add_output_arguments, command_parser, emit
+from .common import (
+    KEEP_TOGETHER,
+    add_output_arguments,
+    command_parser,
+    emit,
+    format_table,
+    terminal_width,
+)
 
 # --------------------------------------------------------------------------------------
 # jaximpact laws
@@ -44,37 +51,50 @@ def _law_rows():
     return rows
 
 
-def _laws_text(rows) -> str:
-    def params(row):
+def _laws_text(rows, width=None) -> str:
+    """The table of laws, fitted to `width` columns (default: the terminal's, 88 when
+    stdout is not one): formulas and parameters wrap at spaces, the reference under each."""
+    import textwrap
+
+    width = terminal_width() if width is None else width
+
+    def params(row):  # each parameter with its unit on one line
         return ", ".join(
-            f"{p['name']} [{p['unit']}]"
-            + ("" if p["default"] is None else f" = {format_number(p['default'])}")
+            (
+                f"{p['name']} [{p['unit']}]"
+                + ("" if p["default"] is None else f" = {format_number(p['default'])}")
+            ).replace(" ", KEEP_TOGETHER)
             for p in row["parameters"]
         )
 
     header = ("name", "eq.", "F(x, v) [N]", "parameters")
-    table = [header] + [(r["name"], r["equation"], r["formula"], params(r)) for r in rows]
-    widths = [max(len(line[i]) for line in table) for i in range(4)]
-    indent = " " * (widths[0] + widths[1] + 4)
-
-    def line(cells):
-        return (
-            "  ".join(c.ljust(w) for c, w in zip(cells[:3], widths, strict=False)) + "  " + cells[3]
-        )
-
-    out = [
+    table = [(r["name"], r["equation"], r["formula"], params(r)) for r in rows]
+    lines = format_table(
+        header,
+        table,
+        width=width,
+        wrap=(2, 3),
+        notes=[f"ref.: {r['reference']}" for r in rows],
+        note_column=2,
+    )
+    if max(map(len, lines)) > width:  # too narrow for a table: a block per law
+        lines = []
+        for (name, equation, formula, parameters), row in zip(table, rows, strict=True):
+            lines.append(name + ("" if equation == "-" else f" (eq. {equation})"))
+            for text in (f"F = {formula}", parameters, f"ref.: {row['reference']}"):
+                lines += [
+                    line.replace(KEEP_TOGETHER, " ")
+                    for line in textwrap.wrap(
+                        text, width, initial_indent="    ", subsequent_indent="      ",
+                        break_long_words=False, break_on_hyphens=False,
+                    )
+                ]  # fmt: skip
+    intro = (
         "Force laws: F(x, v) in N, positive pushing the body out; x = penetration (m), "
-        "v = dx/dt (m/s).",
-        "Equation numbers: Polukoshko, Viba, Kononova & Sokolova, Proc. Estonian Acad. Sci. "
-        "Eng. 13 (2007).",
-        "",
-        line(header).rstrip(),
-        "  ".join("-" * w for w in widths),
-    ]
-    for cells, row in zip(table[1:], rows, strict=True):
-        out.append(line(cells).rstrip())
-        out.append(f"{indent}ref.: {row['reference']}")
-    return "\n".join(out)
+        "v = dx/dt (m/s). Equation numbers: Polukoshko, Viba, Kononova & Sokolova, Proc. "
+        "Estonian Acad. Sci. Eng. 13 (2007)."
+    )
+    return "\n".join([*textwrap.wrap(intro, width), "", *lines])
 
 
 def _run_laws(args):

@@ -1,8 +1,12 @@
 """`jaximpact simulate`: one impact, its e, T, x_max, F_max, ... and a figure."""
 
+import math
+import textwrap
+
 from .._format import format_number, format_quantity
 from .._plotting import new_figure, save_figure
 from .common import (
+    CLIError,
     add_impact_arguments,
     add_law_arguments,
     add_output_arguments,
@@ -10,8 +14,10 @@ from .common import (
     check_plot_path,
     command_parser,
     emit,
+    format_table,
     law_from_args,
     parse_params,
+    terminal_width,
 )
 from .laws import concrete_units
 
@@ -41,19 +47,26 @@ def add_simulate(subparsers):
     parser = command_parser(
         subparsers,
         "simulate",
-        help="integrate one impact and print e, T, x_max, F_max, ...",
+        help="integrate one impact (or a sweep of speeds) and print e, T, x_max, F_max, ...",
         description="Integrate one impact of a body of mass --mass (kg) hitting the surface "
         "at --v0 (m/s) under the force law --law with parameters --param (SI units, see "
         "'jaximpact laws'), and print the coefficient of restitution e, the contact "
         "duration T, the maximum penetration x_max and when it is reached (t_max), the "
-        "largest force F_max, the energy dissipated and how the contact ended.",
+        "largest force F_max, the energy dissipated and how the contact ended. Several "
+        "speeds (--v0 0.5 1 2 4) give a sweep: one row per speed with units in the header "
+        "(--json: a list of the one-speed objects; --plot: e and T against v0).",
         example="jaximpact simulate --law hertz_rate --param c=2e6 --param b1=800 --v0 2.5\n"
         "jaximpact simulate --law kelvin_voigt --param c=2e6 b=400 --mass 1 --v0 2.5 "
         "--separation penetration --json\n"
-        "jaximpact simulate --law bingham --param c=2e6 b=200 P=400 --v0 2.5 --plot bingham.png",
+        "jaximpact simulate --law bingham --param c=2e6 b=200 P=400 --v0 2.5 --plot bingham.png\n"
+        "jaximpact simulate --law hertz_rate --param c=2e6 b1=800 --v0 0.5 1 2 4",
     )
     add_law_arguments(parser)
     add_impact_arguments(parser)
+    for action in parser._actions:  # --v0: one speed, or several for a sweep
+        if action.dest == "v0":
+            action.nargs = "+"
+            action.help = "impact speed, m/s (> 0); several for a sweep of e(v0), T(v0)"
     add_output_arguments(parser)
     parser.set_defaults(handler=_run_simulate)
 
@@ -65,25 +78,40 @@ def _run_simulate(args):
     from .._solve.impact import impact
 
     law = law_from_args(args)
-    check_contact_scales(args.law, parse_params(args.param), args.mass, args.v0)
-    conditions = dict(m=args.mass, v0=args.v0, separation=args.separation, g=args.gravity)
-    result = impact(law, **conditions)
-    status = result.status_name
-    data = {
-        "law": law.name,
-        "params": {k: float(v) for k, v in law.parameters.items()},
-        "m": args.mass,
-        "v0": args.v0,
-        "separation": args.separation,
-        "g": args.gravity,
-    }
-    data.update({k: getattr(result, k) for k in _RESULT_UNITS})
-    data.update(status=status, path=result.path, num_steps=result.num_steps)
-    data["units"] = {k: u or "-" for k, u in _RESULT_UNITS.items()}
+    speeds = list(args.v0)
+    for v0 in speeds:  # every speed checked before any work
+        if not (math.isfinite(v0) and v0 > 0):
+            raise CLIError(f"--v0 {v0:g}: the impact speed v0 must be a finite number > 0 (m/s)")
+        check_contact_scales(args.law, parse_params(args.param), args.mass, v0)
+    runs = []
+    for v0 in speeds:
+        conditions = dict(m=args.mass, v0=v0, separation=args.separation, g=args.gravity)
+        result = impact(law, **conditions)
+        data = {
+            "law": law.name,
+            "params": {k: float(v) for k, v in law.parameters.items()},
+            "m": args.mass,
+            "v0": v0,
+            "separation": args.separation,
+            "g": args.gravity,
+        }
+        data.update({k: getattr(result, k) for k in _RESULT_UNITS})
+        data.update(status=result.status_name, path=result.path, num_steps=result.num_steps)
+        data["units"] = {k: u or "-" for k, u in _RESULT_UNITS.items()}
+        runs.append(data)
+    if len(runs) > 1:
+        if args.plot is not None:
+            _plot_sweep(law, runs, args.plot)
+            for data in runs:
+                data["plot"] = str(args.plot)
+        emit(args, runs, lambda: _sweep_text(law, runs))
+        return 0
+    (data,) = runs
     if args.plot is not None:
         from .._plotting import plot_impact
 
-        ts = np.linspace(0.0, 1.05 * float(result.T), 600)
+        conditions = dict(m=args.mass, v0=data["v0"], separation=args.separation, g=args.gravity)
+        ts = np.linspace(0.0, 1.05 * float(data["T"]), 600)
         history = impact(law, **conditions, ts=ts)
         fig = new_figure(figsize=(13.5, 4.2), layout="constrained")
         plot_impact(history, law, fig=fig)
@@ -93,7 +121,8 @@ def _run_simulate(args):
     return 0
 
 
-def _simulate_text(law, data) -> str:
+def _head(law, data) -> list[str]:
+    """The law, its parameters with units and the impact's conditions (`data`: one run)."""
     from .._laws import LAWS
 
     spec = LAWS.get(law.name)
@@ -104,9 +133,60 @@ def _simulate_text(law, data) -> str:
     )
     eq = f"eq. {spec.equation}: " if spec is not None and spec.equation != "-" else ""
     formula = f" ({eq}F = {spec.formula})" if spec is not None else ""
+    return [f"law        {law.name}{formula}", f"params     {params}"]
+
+
+def _sweep_text(law, runs, width=None) -> str:
+    """A sweep: the law and conditions, then one row per speed (SI units in the header),
+    fitted to the terminal (`common.format_table`)."""
+    first = runs[0]
     lines = [
-        f"law        {law.name}{formula}",
-        f"params     {params}",
+        *_head(law, first),
+        f"impact     m = {format_number(first['m'])} kg, g = {format_number(first['g'])} "
+        f"m/s^2, separation by {first['separation']}",
+        "",
+    ]
+    keys = [k for k in _RESULT_UNITS if first[k] is not None and k != "v_out"]  # v_out = -e v0
+    header = ["v0 (m/s)", *(f"{k} ({_RESULT_UNITS[k]})" if _RESULT_UNITS[k] else k for k in keys)]
+    # status and path as columns where they change with the speed, else said once
+    varying = [k for k in ("status", "path") if len({r[k] for r in runs}) > 1]
+    header += varying
+    rows = [
+        [format_number(r["v0"]), *(f"{float(r[k]):.5g}" for k in keys), *(r[k] for k in varying)]
+        for r in runs
+    ]
+    lines += format_table(header, rows, width=width)
+    same = [f"{k} {first[k]}" for k in ("status", "path") if k not in varying]
+    if same:
+        lines.append(f"at every speed: {', '.join(same)}")
+    notes = {r["status"] for r in runs} & set(_STATUS_NOTES)
+    for status in sorted(notes):
+        lines += textwrap.wrap(
+            f"{status}: {_STATUS_NOTES[status]}", width or terminal_width(), subsequent_indent="  "
+        )
+    if "plot" in first:
+        lines.append(f"plot written to {first['plot']}")
+    return "\n".join(lines)
+
+
+def _plot_sweep(law, runs, path):
+    """e and T (ms) against the impact speed v0 (m/s), one point per run."""
+    fig = new_figure(figsize=(9.0, 3.6), layout="constrained")
+    v = [r["v0"] for r in runs]
+    ax_e, ax_T = fig.subplots(1, 2)
+    ax_e.plot(v, [float(r["e"]) for r in runs], "o-")
+    ax_e.set_xlabel("impact speed v0 (m/s)")
+    ax_e.set_ylabel("restitution e")
+    ax_T.plot(v, [1e3 * float(r["T"]) for r in runs], "o-")
+    ax_T.set_xlabel("impact speed v0 (m/s)")
+    ax_T.set_ylabel("contact duration T (ms)")
+    fig.suptitle(f"{law.name}, m = {format_number(runs[0]['m'])} kg")
+    save_figure(fig, path)
+
+
+def _simulate_text(law, data) -> str:
+    lines = [
+        *_head(law, data),
         f"impact     m = {format_number(data['m'])} kg, v0 = {format_number(data['v0'])} m/s, "
         f"g = {format_number(data['g'])} m/s^2, separation by {data['separation']}",
         "",

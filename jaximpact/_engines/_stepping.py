@@ -16,6 +16,10 @@ E_RANGE_TOL = 0.002  # half-spread of e over start phases (relative) a recommend
 _BIAS_TOL = 0.001  # relative error of the phase-mean e and T a recommended step allows
 _WARN_TOL = 0.005  # spread or bias (relative) above which an export warns about its step
 _MIN_STEPS, _MAX_STEPS = 400, 51200  # steps per contact a recommended step searches
+# What an export refuses (`unrealised`): a contact resolved by fewer steps than this, or a
+# realised (phase-mean) e or T further than this (relative) from the target
+RESOLVED_STEPS = 5
+REFUSE_TOL = 0.05
 
 
 def step_until_separated(step, h, v0, phases=PHASES, max_steps=2_000_000):
@@ -119,3 +123,39 @@ def realised(es, Ts, h: float) -> dict:
         steps_per_contact=float(Ts.mean() / h),
         timestep=h,
     )
+
+
+def unrealised(e, T, *, target_e: float, target_T, steps_per_contact, parameters: dict):
+    """Why an engine cannot realise the target `target_e`, `target_T` (s) with its exported
+    `parameters`, or None where it can. It cannot when (in this order):
+
+    - a parameter is not a finite number (NaN or an overflow in the design);
+    - what it realises is not an impact: e or T (s) not finite, e outside [0, 1] (0.5 % of
+      slack for round-off at e = 1), T <= 0;
+    - its step does not resolve the contact: fewer than `RESOLVED_STEPS` (5) steps per
+      contact (`steps_per_contact`: target T over the step; None where no step applies);
+    - what it realises (the mean over where first touch falls inside a step) misses the
+      target e or T by more than `REFUSE_TOL` (5 %, ten times the 0.5 % that warns).
+
+    The reason is one line naming what the engine would realise."""
+    for key, value in parameters.items():
+        values = value if isinstance(value, (list, tuple)) else [value]
+        for v in values:
+            if isinstance(v, float) and not math.isfinite(v):
+                return f"its {key} is not a finite number ({v})"
+    with np.errstate(all="ignore"):
+        e, T = float(e), float(T)
+    asked = f"e = {target_e:.4g}" + ("" if target_T is None else f", T = {target_T:.4g} s")
+    got = f"it would realise e = {e:.4g}, T = {T:.4g} s instead of {asked}"
+    if not (math.isfinite(e) and math.isfinite(T)) or e < 0 or e > 1 + _WARN_TOL or T <= 0:
+        return f"{got}, not an impact"
+    if steps_per_contact is not None and steps_per_contact < RESOLVED_STEPS:
+        return (
+            f"its step resolves the contact by {steps_per_contact:.2g} steps (fewer than "
+            f"{RESOLVED_STEPS})"
+        )
+    miss_e = abs(e / target_e - 1) if target_e > 0 else abs(e)
+    miss_T = 0.0 if target_T is None else abs(T / target_T - 1)
+    if max(miss_e, miss_T) > REFUSE_TOL:
+        return f"{got} (more than {REFUSE_TOL:.0%} off)"
+    return None

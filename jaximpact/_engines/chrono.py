@@ -30,6 +30,7 @@ SCENE = lammps.SCENE
 law = lammps.law
 KEYS = (lammps.KEYS[0], ("poisson", "limit_damping"))
 TWO_SPHERES = True
+MASS_DEPENDS = "its Young's modulus scales with the mass"  # what m changes (export)
 
 
 def response(parameters, *, m: float, radius=None):

@@ -30,6 +30,7 @@ NAME = "drake"
 # the keys `engine-e` takes: (needed, optional)
 KEYS = (("point_contact_stiffness", "hunt_crossley_dissipation"), ("time_step",))
 TWO_SPHERES = False  # the scene: a body of mass m on a half space
+MASS_DEPENDS = "its point_contact_stiffness scales with the mass"  # what m changes
 SCENE = (
     "a body of mass m on a fixed half space (both geometries with the exported properties), "
     "no gravity, approaching along the normal at v0; continuous plant (time_step = 0), or "

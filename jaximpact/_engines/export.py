@@ -2,10 +2,11 @@
 the e and T that the engine will realise."""
 
 import dataclasses
+import warnings as _warnings
 
 import numpy as np
 
-from . import chrono, drake, lammps, liggghts, mujoco, yade
+from . import _stepping, chrono, drake, lammps, liggghts, mujoco, yade
 from .materials import check_positive, check_restitution
 
 ENGINES = {
@@ -21,6 +22,48 @@ ENGINES = {
 # plane), design (targets -> parameters and what the engine realises), law and response
 # (parameters -> its continuous law), stepper (its time stepping, replicated), snippet.
 _SPEED_FACTORS = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0)
+
+
+class UnrealisedExport(ValueError):
+    """An export its engine cannot realise at the given step (`_stepping.unrealised`): the
+    `engine`, its time `step` (s), the `reason`, and `working` (s), a step that realises the
+    target (0.0: Drake's continuous plant; None where none was found)."""
+
+    def __init__(self, engine: str, step, reason: str, working):
+        self.engine, self.step, self.reason, self.working = engine, step, reason, working
+        super().__init__(self.message("pass strict=False to export it anyway"))
+
+    def message(self, anyway: str) -> str:
+        """The one-line refusal, ending with how to `anyway` export it."""
+        if self.working is None:
+            fix = "no time step down to T/51200 realises it"
+        elif self.working == 0.0:
+            fix = "use time_step = 0 (its continuous plant)"
+        else:
+            fix = f"use a time step of {self.working:.3g} s or less"
+            if self.engine == "drake":
+                fix += " (or time_step = 0, its continuous plant)"
+        return (
+            f"{self.engine} cannot realise the target at time step {self.step:.3g} s: "
+            f"{self.reason}; {fix}, or {anyway}"
+        )
+
+
+class UnrealisedWarning(UserWarning):
+    """`export(..., strict=False)` of an export its engine cannot realise."""
+
+
+def missing_mass(engine: str, from_law: bool, how: str) -> str:
+    """The one-line reason an export to `engine` needs the mass (`how`: how to give it)."""
+    module = _engine(engine)
+    each = " of each sphere" if module.TWO_SPHERES else ""
+    why = [module.MASS_DEPENDS] if module.MASS_DEPENDS else []
+    if from_law:
+        why.append("the law's e and T at v0 depend on it")
+    return (
+        f"{engine} needs the mass{each}: {how}; {' and '.join(why)} (MuJoCo from target e "
+        "and T alone needs none)"
+    )
 
 
 @dataclasses.dataclass(frozen=True)
@@ -110,7 +153,7 @@ def export(
     law_or_fit,
     engine: str,
     *,
-    m,
+    m=None,
     v0,
     timestep=None,
     radius=None,
@@ -119,6 +162,7 @@ def export(
     T=None,
     limit_damping: bool = False,
     curves: bool = True,
+    strict: bool = True,
 ) -> Export:
     """Parameters for `engine` (`"mujoco"`, `"drake"`, `"lammps"`, `"liggghts"`, `"chrono"`,
     `"yade"`)
@@ -134,9 +178,27 @@ def export(
     The returned `Export` states what the engine realises, computed through a replica of its
     time stepping (MuJoCo, LAMMPS) checked against the engines in tests/test_engines.py.
 
+    `m` has no default: every engine's parameters depend on it (LAMMPS, LIGGGHTS, Chrono:
+    the Young's modulus; Yade: the density; Drake: the stiffness), and so do a law's e and T
+    at `v0`. MuJoCo from targets alone (`law_or_fit` None) needs none: solref scales the
+    contact per unit mass (the `Export`'s `m` is then None, its `law` per kg).
+
+    An export the engine cannot realise at `timestep` is refused: an `UnrealisedExport`
+    (a `ValueError`) that names the step that would work (`.step`), or with `strict=False`
+    a warning (also in `Export.warnings`) and the export anyway. It cannot realise it when a
+    parameter is not finite, when what it realises is no impact (e or T not finite, e
+    outside [0, 1], T <= 0), when fewer than 5 steps resolve the contact (T over the step),
+    or when its e or T (the mean over where first touch falls inside a step) misses the
+    target by more than 5 % (`_stepping.unrealised`).
+
     **Example**: `export(law("hertz_rate", c=2e6, b1=800.0), "mujoco", m=1.0, v0=2.5).parameters`.
     """
-    _engine(engine)
+    module = _engine(engine)
+    m_given = m is not None
+    if not m_given:
+        if law_or_fit is not None or module.MASS_DEPENDS is not None:
+            raise ValueError(missing_mass(engine, law_or_fit is not None, "pass m= (kg)"))
+        m = 1.0  # MuJoCo from targets: per unit mass (the export does not depend on it)
     m = check_positive("m", m, "kg")
     v0 = check_positive("v0", v0, "m/s")
     if timestep is not None:
@@ -164,26 +226,26 @@ def export(
     if target_T is not None:
         _check_scales(m, v0, target_T)
     warnings = []
-    module = ENGINES[engine]
     if module.TWO_SPHERES:
         if radius is None:
             raise ValueError(f"{engine} needs the spheres' radius: pass radius= (m)")
         radius = check_positive("radius", radius, "m")
         if target_T is None:
             raise ValueError(f"{engine} needs a contact duration: pass T= (s) or a law")
-    out = module.design(
-        target_e,
-        target_T,
-        m=m,
-        v0=v0,
-        radius=radius,
-        poisson=0.3 if poisson is None else poisson,
-        timestep=timestep,
-        limit_damping=limit_damping,
-    )
+    design = dict(m=m, v0=v0, radius=radius, poisson=0.3 if poisson is None else poisson,
+                  limit_damping=limit_damping)  # fmt: skip
+    out = module.design(target_e, target_T, timestep=timestep, **design)
     target_T = out.get("target_T", target_T)  # MuJoCo without T: its default timeconst's
     separation, h = out["separation"], out["timestep"]
     warnings += out["warnings"]
+    reason = _unrealised(out, target_e, target_T)
+    if reason is not None:
+        step = _working_step(module, target_e, target_T, design)
+        refusal = UnrealisedExport(engine, h, reason, step)
+        if strict:
+            raise refusal
+        warnings.insert(0, str(refusal))
+        _warnings.warn(str(refusal), UnrealisedWarning, stacklevel=2)
     # the law each side realises; LAMMPS's promise is for the pair (effective mass m/2)
     engine_law = module.law(out["parameters"], m)
     m_engine = m / 2.0 if module.TWO_SPHERES else m
@@ -217,7 +279,7 @@ def export(
         warnings=tuple(warnings),
         target_e=target_e,
         target_T=target_T,
-        m=m,
+        m=m if m_given else None,
         v0=v0,
         e_range=out["e_range"],
         T_range=out["T_range"],
@@ -230,6 +292,43 @@ def export(
         e_target=e_target,
         T_target=T_target,
     )
+
+
+def _unrealised(out: dict, target_e: float, target_T) -> str | None:
+    """Why the design `out` of an engine does not realise `target_e`, `target_T` (s)."""
+    h = out["timestep"]
+    steps = target_T / h if (h and target_T is not None) else None
+    return _stepping.unrealised(
+        out["e"], out["T"], target_e=target_e, target_T=target_T, steps_per_contact=steps,
+        parameters=out["parameters"],
+    )  # fmt: skip
+
+
+def _working_step(module, target_e: float, target_T, design: dict):
+    """A time step (s) at which `module` realises the target: its recommended step (the
+    design without a step), or where that is Drake's continuous plant (0.0), the first of
+    T/50, T/100, ... T/51200 whose discrete plant does; None where none does."""
+    try:
+        out = module.design(target_e, target_T, timestep=None, **design)
+    except ValueError:
+        return None
+    target_T = out.get("target_T", target_T)
+    if out["timestep"] and _unrealised(out, target_e, target_T) is None:
+        return float(out["timestep"])
+    if out["timestep"] == 0.0 and target_T is not None:  # a continuous plant: 0 or a step
+        steps = 50
+        while steps <= 51200:
+            h = _stepping.nice_down(target_T / steps)
+            try:
+                out = module.design(target_e, target_T, timestep=h, **design)
+            except ValueError:
+                return 0.0
+            near = abs(out["e"] / target_e - 1) <= 0.005 and abs(out["T"] / target_T - 1) <= 0.005
+            if near and _unrealised(out, target_e, target_T) is None:
+                return h
+            steps *= 2
+        return 0.0
+    return None
 
 
 def _check_scales(m: float, v0: float, T: float) -> None:

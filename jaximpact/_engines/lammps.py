@@ -27,6 +27,7 @@ NAME = "lammps"
 # the keys `engine-e` takes: (needed, optional)
 KEYS = (("E", "coeff_restitution"), ("poisson", "limit_damping", "timestep"))
 TWO_SPHERES = True  # the scene: two equal spheres head-on (effective mass m/2)
+MASS_DEPENDS = "its Young's modulus scales with the mass"  # what m changes (export)
 SCENE = (
     "two equal spheres, each of mass m and radius `radius`, colliding head-on at relative "
     "speed v0 (no gravity, no friction effect on a head-on impact)"

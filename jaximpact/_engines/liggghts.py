@@ -27,6 +27,7 @@ SCENE = lammps.SCENE
 law = lammps.law
 KEYS = lammps.KEYS
 TWO_SPHERES = True
+MASS_DEPENDS = "its youngsModulus scales with the mass"  # what m changes (export)
 stepper = lammps.stepper  # fix nve/sphere: the same velocity Verlet
 
 

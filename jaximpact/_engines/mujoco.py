@@ -31,6 +31,9 @@ NAME = "mujoco"
 # the keys `engine-e` takes: (needed, optional)
 KEYS = (("solref",), ("timestep",))
 TWO_SPHERES = False  # the scene: a body of mass m on a plane
+# solref scales the contact per unit mass: from targets e and T no mass is needed (from a
+# law, its e and T at v0 depend on the mass); `MASS_DEPENDS` None says so to `export`
+MASS_DEPENDS = None
 DEFAULT_TIMECONST = 0.02  # s, MuJoCo's solref default
 SCENE = (
     "a free body of mass m on a fixed plane (MuJoCo scales the contact per unit mass: the "

@@ -36,6 +36,7 @@ NAME = "yade"
 # the keys `engine-e` takes: (needed, optional)
 KEYS = (("tc", "en"), ("timestep", "damping"))
 TWO_SPHERES = True  # the scene: two equal spheres head-on (effective mass m/2)
+MASS_DEPENDS = "its density (and kn, cn) scale with the mass"  # what m changes (export)
 SCENE = (
     "two equal spheres of ViscElMat, each of mass m and radius `radius`, colliding head-on at "
     "relative speed v0 (no gravity, NewtonIntegrator(damping=0))"
