@@ -24,7 +24,7 @@ import jaximpact as ji  # noqa: E402
 
 
 def write_bodies(path, rows, seed=0):
-    """A synthetic table: c (N/m^1.5), b1 (N s/m^2.5), m (kg), v0 (m/s), g (m/s^2)."""
+    """A synthetic table: c (N/m^1.5), b1 (N s/m^1.5), m (kg), v0 (m/s), g (m/s^2)."""
     rng = np.random.default_rng(seed)
     columns = dict(
         c=rng.uniform(1e6, 3e6, rows),

@@ -1,5 +1,10 @@
-"""Calibrate the seed paper's law 14 (Hertz with x^0.5 damping) from a measured
-restitution and contact duration, and check the fit with an independent re-simulation.
+"""Calibrate the seed paper's law 14 (Hertz with x^0.5 damping) from a restitution and a
+contact duration, and check the fit with an independent re-simulation.
+
+The targets (e = 0.85, T = 7.8 ms at 2.5 m/s for 1 kg) are illustrative numbers, not a
+measurement. Two numbers fix law 14's two parameters exactly, so the fit reproducing them
+says nothing about whether the law suits a material: that needs more speeds (see
+examples/pick_a_law.py, which judges each law by its reduced chi-square).
 
 Run: python examples/calibrate_e_and_T.py [--plot calibration.png]
 """
@@ -24,7 +29,7 @@ def main():
     )
     args = parser.parse_args()
 
-    # A 1 kg body hits a surface at 2.5 m/s; we measured e = 0.85 and T = 7.8 ms.
+    # A 1 kg body hits a surface at 2.5 m/s with e = 0.85 and T = 7.8 ms (illustrative).
     m, v0, e, T = 1.0, 2.5, 0.85, 7.8e-3
     start = ji.law("hertz_rate", c=1e6, b1=100.0)  # a rough guess: F = c x^1.5 + b1 x^0.5 v
 
@@ -40,8 +45,17 @@ def main():
     print(f"  c  = {c:.6e} N/m^1.5")
     print(f"  b1 = {b1:.6e} N s/m^1.5")
     print(
-        f"  converged: {bool(fit.converged)} after {int(fit.iterations)} iterations, "
-        f"loss {float(fit.loss):.2e}"
+        f"  optimiser converged: {bool(fit.converged)} after {int(fit.iterations)} "
+        f"iterations, loss {float(fit.loss):.2e}"
+    )
+    print(
+        f"  reproduces the targets to 1e-6: {bool(fit.reproduces)} ({int(fit.n_data)} data, "
+        f"{len(fit.free)} parameters: {int(fit.dof)} degrees of freedom, an exact fit)"
+    )
+    print(
+        f"  implied at v0: x_max = {1e3 * float(fit.x_max[0]):.4f} mm, "
+        f"F_max = {float(fit.F_max[0]):.1f} N for m = {m:g} kg (a mass in the wrong unit "
+        "shows here)"
     )
     print(
         f"  time: {first:.1f} s for the first fit (includes compilation), "

@@ -1,7 +1,7 @@
 """Drop design: the drop height and mass of a ball that give a wanted sequence of bounce
-apexes on a floor with law 14 (c = 1e6, b1 = 1350: the seed paper's section 7), by
-Levenberg-Marquardt with forward-mode derivatives through jaximpact.bounce (closed-form
-flights, one impact solve with gravity per contact).
+apexes on a floor with law 14 (c = 1e6 N/m^1.5, b1 = 1350 N s/m^1.5: the seed paper's
+section 7), by Levenberg-Marquardt with forward-mode derivatives through jaximpact.bounce
+(closed-form flights, one impact solve with gravity per contact).
 
 Run: python examples/drop_design.py [--apexes 0.30 0.165 0.095 0.055] [--plot drop_design.png]
 """

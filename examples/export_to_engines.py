@@ -1,6 +1,7 @@
-"""From a measured e and T to the engine you run: fit law 14 (Hertz with x^1.5 damping) to
-e = 0.75, T = 2 ms at 1 m/s, then export it to MuJoCo, Drake, LAMMPS, LIGGGHTS, Yade and
-Chrono, each with the e and T it will realise and its e(v) beside the fitted law's.
+"""From a target e and T to the engine you run: fit law 14 (F = c x^1.5 + b1 x^0.5 v) to
+e = 0.75, T = 2 ms at 1 m/s (illustrative numbers, not a measurement), then export it to
+MuJoCo, Drake, LAMMPS, LIGGGHTS, Yade and Chrono, each with the e and T it will realise and
+its e(v) beside the fitted law's.
 
 Run: python examples/export_to_engines.py [--plot export_to_engines.png]
 """
@@ -29,7 +30,14 @@ def main():
     fit = ji.calibrate(start, m=M, v0=V0, e=0.75, T=2e-3)
     print(
         f"fitted law 14: c = {fit.law.parameters['c']:.5g} N/m^1.5, "
-        f"b1 = {fit.law.parameters['b1']:.5g} N s/m^2.5 (e = 0.75, T = 2 ms at 1 m/s)\n"
+        f"b1 = {fit.law.parameters['b1']:.5g} N s/m^1.5 (e = 0.75, T = 2 ms at 1 m/s)"
+    )
+    verdict = "reproduces" if bool(fit.reproduces) else "does NOT reproduce"
+    print(
+        f"  {verdict} the targets (two numbers, two parameters: an exact fit, not a test of "
+        f"the law): e = {float(fit.e[0]):.6f}, T = {float(fit.T[0]) * 1e3:.6f} ms "
+        f"(x_max = {float(fit.x_max[0]) * 1e3:.3g} mm, F_max = {float(fit.F_max[0]):.4g} N "
+        f"for m = {M} kg)\n"
     )
     exports = {}
     print(f"{'engine':<9} {'e realised':>10} {'T realised (s)':>15} {'step (s)':>10}  scene")

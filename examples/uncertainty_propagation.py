@@ -1,7 +1,7 @@
-"""Sensitivities and uncertainty of law 14 (the seed paper's Fig. 10: c = 2e6, b1 = 800,
-m = 1 kg, v0 = 2.5 m/s): maps of d e/d param and d T/d param over (b1, c), and the spread of
-e and T from scattered c, b1 and v0, to first order (J Sigma J^T) and by Monte Carlo (vmap),
-with the Monte Carlo sampling error that says whether they agree.
+"""Sensitivities and uncertainty of law 14 (the seed paper's Fig. 10: c = 2e6 N/m^1.5,
+b1 = 800 N s/m^1.5, m = 1 kg, v0 = 2.5 m/s): maps of d e/d param and d T/d param over
+(b1, c), and the spread of e and T from scattered c, b1 and v0, to first order (J Sigma J^T)
+and by Monte Carlo (vmap), with the Monte Carlo sampling error that says whether they agree.
 
 Run: python examples/uncertainty_propagation.py [--samples 20000] [--plot uncertainty.png]
 """

@@ -73,6 +73,25 @@ def test_example_runs_on_the_samples(script, tmp_path):
     out.mkdir()
     stdout = run_example(clone / "examples" / script, out)
     assert "examples/data" in stdout
+    # the output says the data are made up (and by what), and judges the fits
+    data_line = next(line for line in stdout.splitlines() if line.startswith("data: "))
+    assert data_line.startswith("data: SYNTHETIC") and "make_samples.py" in data_line
+    assert "measured" not in data_line and "verdict" in stdout
+    if script == "pick_a_law.py":  # e falling linearly with v0: no law fits within the errors
+        assert "pingpong ball (synthetic data)" in stdout
+        assert "does NOT fit these data: reduced chi-square" in stdout
+
+
+def test_examples_give_law_14_its_units():
+    """b1 of law 14 (F = c x^1.5 + b1 x^0.5 v) is in N s/m^1.5 wherever an example names
+    its unit, and no example calls its made-up targets measured."""
+    import re
+
+    for path in (ROOT / "examples").glob("*.py"):
+        text = path.read_text()
+        for exponent in re.findall(r"b1[^\n]{0,40}?N s/m\^([\d.]+)", text):
+            assert exponent == "1.5", f"{path.name}: b1 in N s/m^{exponent}"
+        assert "we measured" not in text, path.name
 
 
 def run_example(path, cwd):

@@ -330,6 +330,7 @@ def _run_one(args, data):
         optimizer=args.optimizer,
         init=init,
         start={k: float(v) for k, v in start.parameters.items()},
+        given=sorted(given),
     )
     if args.plot is not None:
         _plot(args, data, [(args.law, fit)])
@@ -341,6 +342,7 @@ def _run_one(args, data):
 def _fit_record(name, fit, data):
     import numpy as np
 
+    from .._fit.calibrate import goodness_text
     from .._laws import LAWS
 
     rows = []
@@ -363,22 +365,42 @@ def _fit_record(name, fit, data):
     order = list(fit.law.parameters)
     if name in LAWS:  # the law's own order (a compiled fit returns its dict sorted)
         order = [k for k in LAWS[name].parameters if k in fit.params]
+    for i, row in enumerate(rows):
+        row.update(x_max=float(fit.x_max[i]), F_max=float(fit.F_max[i]))
     return dict(
         law=name,
         params={k: float(fit.params[k]) for k in order},
         free=list(fit.free),
         stderr=None if fit.stderr is None else {k: float(v) for k, v in fit.stderr.items()},
         converged=bool(fit.converged),
+        reproduces=bool(fit.reproduces),
+        target_tol=float(fit.target_tol),
         undetermined=list(fit.undetermined),
         iterations=int(fit.iterations),
         loss=float(fit.loss),
         max_residual=float(np.max(np.abs(residuals))) if residuals.size else 0.0,
+        n_data=int(fit.n_data),
+        dof=int(fit.dof),
+        weighted=fit.weighted,
+        sum_sq=float(fit.chi2),
+        reduced_chi2=_number(fit.reduced_chi2),
+        p_value=_number(fit.p_value),
+        rms_e=_number(fit.rms_e),
+        rms_T=_number(fit.rms_T),
+        goodness=goodness_text(fit),
+        notes=list(fit.notes),
         rows=rows,
     )
 
 
+def _number(value):
+    """A float, or None for NaN (JSON has no NaN)."""
+    value = float(value)
+    return value if math.isfinite(value) else None
+
+
 def _run_all(args, data):
-    from .._fit.model_choice import PAPER_LAWS, compare_laws
+    from .._fit.model_choice import PAPER_LAWS, compare_laws, fits_badly
 
     laws = tuple(MODEL_CHOICE_LAWS or PAPER_LAWS)
     has_sigma = data["sigma_e"] is not None
@@ -390,8 +412,8 @@ def _run_all(args, data):
                      "printed at the end)")  # fmt: skip
             check_interrupt()  # a safe point between fits: a Ctrl-C stops here at the latest
             bar.label = name
-            try:
-                rankings += compare_laws(laws=(name,), progress=False, **kwargs)
+            try:  # one law at a time: the verdict on the best one comes at the end
+                rankings += compare_laws(laws=(name,), progress=False, warn=False, **kwargs)
             except Exception as error:  # one law's failure must not hide the others' fits
                 check_interrupt()  # unless it was an interrupt that JAX reported as an error
                 failed[name] = f"{type(error).__name__}: {str(error).splitlines()[0]}"
@@ -402,12 +424,13 @@ def _run_all(args, data):
             "no law could be fitted: "
             + ("; ".join(f"{k}: {v}" for k, v in failed.items()) or "more parameters than data")
         )
-    rankings.sort(key=(lambda r: r.aic) if has_sigma else (lambda r: r.chi2))
+    rankings.sort(key=(lambda r: r.aic) if has_sigma else (lambda r: r.sum_sq))
     ranked = []
     for rank, item in enumerate(rankings, start=1):
         record = _fit_record(item.name, item.fit, data)
-        record.update(rank=rank, k=item.k, chi2=item.chi2, aic=item.aic, bic=item.bic)
+        record.update(rank=rank, k=item.k, chi2=item.sum_sq, aic=item.aic, bic=item.bic)
         ranked.append(record)
+    bad_fit = fits_badly(rankings[0].fit)
     n_data = len(data["e"]) + (
         0 if data["T"] is None else sum(not math.isnan(t) for t in data["T"])
     )
@@ -416,7 +439,8 @@ def _run_all(args, data):
         separation=args.separation,
         g=args.gravity,
         optimizer=args.optimizer,
-        criterion="aic" if has_sigma else "chi2",
+        criterion="aic" if has_sigma else "sum_sq",
+        bad_fit=bad_fit,
         n_data=n_data,
         skipped=[
             name for name in laws if name not in {r.name for r in rankings} and name not in failed
@@ -469,7 +493,8 @@ def _params_text(name, params, stderr=None, indent=11):
 
 def _rows_text(data, rows):
     has_T = data["T"] is not None
-    header = ["v0 [m/s]", "e", "e fit"] + (["T", "T fit"] if has_T else [])
+    header = ["v0 [m/s]", "e", "e fit"] + (["T", "T fit"] if has_T else ["T fit"])
+    header += ["x_max fit", "F_max fit"]
     if data["sigma_e"] is not None:
         header.insert(2, "sigma_e")
     table = [header]
@@ -480,7 +505,8 @@ def _rows_text(data, rows):
         cells.append(f"{row['e_fit']:.4f}")
         if has_T:
             cells.append("-" if row["T"] is None else format_quantity(row["T"], "s"))
-            cells.append(format_quantity(row["T_fit"], "s"))
+        cells.append(format_quantity(row["T_fit"], "s"))
+        cells += [format_quantity(row["x_max"], "m"), format_quantity(row["F_max"], "N")]
         table.append(cells)
     widths = [max(len(line[i]) for line in table) for i in range(len(header))]
     return "\n".join(
@@ -489,17 +515,79 @@ def _rows_text(data, rows):
 
 
 def _status_text(record):
+    if record["converged"]:
+        text = f"optimiser converged after {record['iterations']} iterations"
+        if record["iterations"] == 0:
+            text += ", the start solving the equations"
+    else:
+        text = (
+            f"optimiser NOT converged after {record['iterations']} iterations (or an impact "
+            "of the fitted law does not separate): the best point reached is shown"
+        )
     if record.get("undetermined"):
-        return (
-            f"{' and '.join(record['undetermined'])} NOT determined by these data (give T, "
+        text += (
+            f"; {' and '.join(record['undetermined'])} NOT determined by these data (give T, "
             "more speeds, or hold one with --free): their values are not estimates"
         )
-    if record["converged"]:
-        return f"converged after {record['iterations']} iterations"
+    return text
+
+
+def _reproduces_text(record):
+    tol = format_number(record["target_tol"])
+    if record["weighted"]:
+        meaning = f"{tol} standard deviations"
+    else:
+        meaning = f"{tol}, the data to numerical precision (no sigmas given)"
+    if record["reproduces"]:
+        return f"reproduces the data: every residual within {meaning}"
+    largest = format_number(record["max_residual"], 3)
+    return f"does not reproduce the data within {meaning}: largest residual {largest}"
+
+
+def _wrapped(head, text, width=100):
+    """`head` then `text` wrapped to `width` columns, continued under the text."""
+    import textwrap
+
+    return textwrap.fill(
+        text, width=width, initial_indent=head, subsequent_indent=" " * len(head),
+        break_on_hyphens=False, break_long_words=False,
+    )  # fmt: skip
+
+
+def _sanity_text(record):
+    """The sizes the fitted law implies at the measured speeds, with the mass and the
+    kinetic energy: a mass typed in grams as kilograms shows as a force and an energy a
+    thousand times too large, a time in ms as s as an absurd penetration."""
+    m = record["m"]
+    rows = sorted(record["rows"], key=lambda row: row["v0"])
+    low, high = rows[0], rows[-1]
+
+    def span(key, unit):
+        values = sorted({row[key] for row in rows})
+        if len(values) == 1:
+            return format_quantity(values[0], unit)
+        return f"{format_quantity(values[0], unit)} to {format_quantity(values[-1], unit)}"
+
+    speeds = span("v0", "m/s")
+    energy = (
+        format_quantity(0.5 * m * low["v0"] ** 2, "J")
+        if len(rows) == 1 or low["v0"] == high["v0"]
+        else f"{format_quantity(0.5 * m * low['v0'] ** 2, 'J')} to "
+        f"{format_quantity(0.5 * m * high['v0'] ** 2, 'J')}"
+    )
+    peak_g = max(row["F_max"] for row in rows) / (m * 9.80665)
+    mass = f"{format_number(m * 1e3, 4)} g" if m < 1 else f"{format_number(m, 4)} kg"
     return (
-        f"NOT converged after {record['iterations']} iterations: the law does not reproduce "
-        f"the data (largest residual {format_number(record['max_residual'], 3)}); "
-        "the best fit is shown"
+        f"m = {mass}, kinetic energy "
+        f"{energy} at v0 = {speeds}: the fitted law implies a penetration x_max of "
+        f"{span('x_max', 'm')}, a peak force F_max of {span('F_max', 'N')} "
+        f"(deceleration up to {format_number(peak_g, 3)} g) and a contact time of "
+        f"{span('T_fit', 's')}: if these look wrong, check the units (--mass in kg)"
+        + (
+            " (c was not fitted: x_max, F_max and the contact time follow from its fixed value)"
+            if "c" in record["params"] and "c" not in record["free"]
+            else ""
+        )
     )
 
 
@@ -515,13 +603,34 @@ def _one_text(result, data):
         f"fitted     {_params_text(result['law'], fitted, result['stderr'])}",
     ]
     if kept:
-        lines.append(f"kept       {_params_text(result['law'], kept)}")
+        given = [k for k in kept if k in result.get("given", ())]
+        assumed = [k for k in kept if k not in given]
+        why = []
+        if given:
+            why.append(f"{', '.join(given)} as given by --param")
+        if assumed:
+            origin = "jaximpact.starting_law's start value" + (
+                ", which assumes T = 1 ms as no T was measured" if data["T"] is None else ""
+            )
+            why.append(f"{', '.join(assumed)}: {origin}")
+        lines.append(f"fixed      {_params_text(result['law'], kept)}")
+        lines.append(_wrapped("           ", f"(not fitted: {'; '.join(why)}; --param sets "
+                                             "a value, --free fits it)"))  # fmt: skip
     lines.append(
-        f"fit        {_status_text(result)} ({result['optimizer']}, start {result['init']}), "
-        f"loss {format_number(result['loss'], 3)}"
+        _wrapped(
+            "fit        ",
+            f"{_status_text(result)} ({result['optimizer']}, start {result['init']}), "
+            f"loss {format_number(result['loss'], 3)}",
+        )
     )
+    lines.append(_wrapped("goodness   ", result["goodness"]))
+    lines.append(_wrapped("           ", _reproduces_text(result)))
     if result["stderr"] is not None:
-        lines.append("           +- one standard error, from the Jacobian and the sigmas")
+        source = "the sigmas" if result["weighted"] else "the residuals' scatter (no sigmas given)"
+        lines.append(f"           +- one standard error, from the Jacobian and {source}")
+    lines.append(_wrapped("check      ", _sanity_text(result)))
+    for note in result["notes"]:
+        lines.append(_wrapped("note       ", note))
     lines += ["", _rows_text(data, result["rows"])]
     if "plot" in result:
         lines.append(f"plot written to {result['plot']}")
@@ -530,35 +639,59 @@ def _one_text(result, data):
 
 def _all_text(result, data):
     criterion = result["criterion"]
-    by = "AIC = chi2 + 2k" if criterion == "aic" else "the sum of squared residuals (no sigmas)"
+    weighted = criterion == "aic"
+    by = (
+        "AIC = chi2 + 2k (chi2: the sum of squared normalised residuals)"
+        if weighted
+        else "sum_sq, the sum of squared residuals e_fit - e and (T_fit - T)/T (no sigmas)"
+    )
     lines = [
         f"model choice: {result['n_data']} measurements at {data['rows']} speed"
         f"{'s' if data['rows'] > 1 else ''}, m = {format_number(result['m'])} kg; "
         f"ranked by {by}",
         "",
     ]
-    header = ["rank", "law", "k", "chi2", "AIC", "BIC", "converged", "parameters"]
+    has_T = data["T"] is not None
+    if weighted:
+        header = ["rank", "law", "k", "chi2", "chi2/dof", "AIC", "BIC", "converged"]
+    else:
+        header = ["rank", "law", "k", "sum_sq", "rms_e"] + (["rms_T"] if has_T else [])
+        header += ["converged"]
+    header += ["parameters"]
     table = [header]
+
+    def number(value, digits):
+        return "-" if value is None else format_number(value, digits)
+
     for r in result["ranking"]:
         params = ", ".join(f"{k} = {format_number(v, 4)}" for k, v in r["params"].items())
-        table.append(
-            [
-                str(r["rank"]),
-                r["law"],
-                str(r["k"]),
-                format_number(r["chi2"], 3),
-                "-" if r["aic"] is None else format_number(r["aic"], 4),
-                "-" if r["bic"] is None else format_number(r["bic"], 4),
-                "yes" if r["converged"] else "no",
-                params,
-            ]
-        )
+        cells = [str(r["rank"]), r["law"], str(r["k"]), format_number(r["sum_sq"], 3)]
+        if weighted:
+            cells += [number(r["reduced_chi2"], 3), number(r["aic"], 4), number(r["bic"], 4)]
+        else:
+            cells.append(number(r["rms_e"], 3))
+            if has_T:
+                cells.append("-" if r["rms_T"] is None else f"{100 * r['rms_T']:.3g}%")
+        cells += ["yes" if r["converged"] else "no", params]
+        table.append(cells)
     widths = [max(len(line[i]) for line in table) for i in range(len(header) - 1)]
     for line in table:
         cells = [c.ljust(w) for c, w in zip(line[:-1], widths, strict=True)]
         lines.append("  ".join(cells) + "  " + line[-1])
     lines.append("")
+    meaning = (
+        "chi2/dof: reduced chi-square, about 1 for a law that fits within the sigmas"
+        if weighted
+        else "rms_e: RMS of e_fit - e" + ("; rms_T: RMS of (T_fit - T)/T" if has_T else "")
+    )
+    lines.append(f"  {meaning}; converged: the optimiser reached a minimum")
+    lines.append("")
     lines.append(f"best: {result['best']}")
+    if result["bad_fit"]:
+        lines.append(
+            f"warning: the best law, {result['best']}, fits these data badly: "
+            f"{result['bad_fit']}; no law tried describes them"
+        )
     k_max = max(r["k"] for r in result["ranking"])
     if result["n_data"] <= k_max:
         lines.append(

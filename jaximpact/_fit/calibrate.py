@@ -16,7 +16,14 @@ from .._checks import check_scale
 from .._curves.shapes import curve_key
 from .._curves.similarity import beta_for_restitution, curve_values
 from .._curves.store import curves_for
-from .._format import concrete_units, format_fields, format_value, is_traced, jsonable
+from .._format import (
+    concrete_units,
+    format_fields,
+    format_number,
+    format_value,
+    is_traced,
+    jsonable,
+)
 from .._laws import AbstractLaw, damping_parameter, shape_of
 from .._solve.impact import CURVES_RTOL, ImpactOptions, similarity_reason, solve_impact
 from .._status import Status
@@ -32,17 +39,37 @@ class Fit(eqx.Module):
 
     - `law`, `params`: the fitted law and its parameters (SI units).
     - `e`, `T`: predicted restitution and contact duration (s) at every row's `v0`.
+    - `m` (kg), `x_max` (m), `F_max` (N): the mass fitted for, and the largest penetration
+      and contact force the fitted law implies at every row's `v0`: a sanity echo (grams
+      typed as kilograms give a force a thousand times too large).
     - `residuals`: weighted residuals, `(e_fit - e)/sigma_e` then `(T_fit - T)/sigma_T`
       (without sigmas: `e_fit - e` and `(T_fit - T)/T`); 0 for a row without `T`.
     - `loss`: half the sum of squared residuals; `history`: the loss at each iteration.
-    - `converged`: the optimiser stopped at a minimum and every residual is below
-      `target_tol` (a target the law cannot reach gives `False`, with the best fit).
-    - `iterations`; `stderr`: standard errors of the free parameters (from the Jacobian,
-      only when sigmas are given), `None` otherwise.
+    - `converged`: the optimiser stopped at a minimum of the loss (gradient or steps below
+      `tol`, or the loss at the noise floor of the impact solves) and every fitted impact
+      separates; at one speed with `e` and `T` (solved on the curves, no iteration) the
+      equations were solved to 1e-6. It says nothing of how well the law fits the data:
+    - `reproduces`: every residual is within `target_tol` (default 1e-6 without sigmas,
+      i.e. the data to numerical precision, as synthetic data are: real data give `False`;
+      3 with sigmas, every point within three standard deviations).
+    - Goodness of fit: `n_data` (measured values: every `e` and every `T` given), `dof`
+      (`n_data` minus the free parameters), `chi2` (sum of squared residuals: with sigmas
+      the sum of squared normalised residuals, a chi-square with `dof` degrees of freedom),
+      `reduced_chi2` (`chi2 / dof`, about 1 for a law that fits within the sigmas; NaN
+      without sigmas or without degrees of freedom) and its `p_value`, and, with or
+      without sigmas, `rms_e` (RMS of `e_fit - e`) and `rms_T` (RMS of `(T_fit - T)/T`,
+      relative).
+    - `iterations`; `stderr`: standard errors of the free parameters from the Jacobian,
+      scaled by the sigmas when given, else by the residuals' own scatter (`chi2 / dof`
+      stands for the variance of every residual, as `fit_bounces` does); without sigmas
+      and without a degree of freedom left (as many data as free parameters) `None` (NaN
+      inside `jit` or `vmap`).
     - `undetermined`: free parameters these data cannot fix (fewer data than free
       parameters, or `e` alone for a one-group law, which fixes only the group `beta`
       that stiffness and damping make together); their values are not estimates. A
-    warning says so when the fit is not traced.
+      warning says so when the fit is not traced.
+    - `notes`: what the data determined where that is not every parameter, e.g. with `e`
+      alone "e determines beta = ...; c held at its start value" (concrete fits only).
     """
 
     law: AbstractLaw
@@ -61,13 +88,74 @@ class Fit(eqx.Module):
     free: tuple[str, ...] = eqx.field(static=True)
     optimizer: str = eqx.field(static=True)
     undetermined: tuple[str, ...] = eqx.field(static=True, default=())
+    m: Array | None = None
+    x_max: Array | None = None
+    F_max: Array | None = None
+    reproduces: Array | None = None
+    target_tol: Array | None = None
+    n_data: Array | None = None
+    weighted: bool = eqx.field(static=True, default=False)
+    notes: tuple[str, ...] = eqx.field(static=True, default=())
+
+    # --------------------------------------------------------------- goodness of fit
+
+    @property
+    def dof(self) -> Array:
+        """Degrees of freedom: measured values minus free parameters."""
+        return self.n_data - len(self.free)
+
+    @property
+    def chi2(self) -> Array:
+        """Sum of squared residuals (with sigmas: of normalised residuals, a chi-square)."""
+        return jnp.sum(jnp.square(self.residuals), axis=-1)
+
+    @property
+    def reduced_chi2(self) -> Array:
+        """`chi2 / dof` with sigmas (about 1 for a law that fits within them); NaN without
+        sigmas (the residuals then have no scale) or without a degree of freedom."""
+        dof = self.dof
+        ok = self.weighted & (dof > 0)
+        return jnp.where(ok, self.chi2 / jnp.where(dof > 0, dof, 1), jnp.nan)
+
+    @property
+    def p_value(self) -> Array:
+        """Probability of a chi-square at least this large if the law were right and the
+        sigmas the data's true scatter (NaN where `reduced_chi2` is)."""
+        dof = jnp.where(self.dof > 0, self.dof, 1).astype(float)
+        p = jax.scipy.special.gammaincc(dof / 2.0, self.chi2 / 2.0)
+        return jnp.where(jnp.isnan(self.reduced_chi2), jnp.nan, p)
+
+    @property
+    def rms_e(self) -> Array:
+        """RMS of `e_fit - e` over the rows (NaN where e was not measured)."""
+        return jnp.sqrt(jnp.mean(jnp.square(self.e - self.e_target), axis=-1))
+
+    @property
+    def rms_T(self) -> Array:
+        """RMS of `(T_fit - T)/T` over the rows with a measured T (relative; NaN if none)."""
+        known = jnp.isfinite(self.T_target)
+        target = jnp.where(known, self.T_target, 1.0)
+        relative = jnp.where(known, (self.T - target) / target, 0.0)
+        count = jnp.sum(known, axis=-1)
+        mean = jnp.sum(jnp.square(relative), axis=-1) / jnp.where(count > 0, count, 1)
+        return jnp.where(count > 0, jnp.sqrt(mean), jnp.nan)
+
+    @property
+    def max_residual(self) -> Array:
+        """The largest `|residual|` (what `target_tol` bounds)."""
+        return jnp.max(jnp.abs(self.residuals), axis=-1)
 
     def summary(self) -> str:
         """The fit as text: each parameter with its unit (and standard error, or `fixed`,
-        or `undetermined`), how the optimiser ended, then e and T predicted beside their
-        targets at each speed; inside `jit` the shapes (`traced f64[]`)."""
+        or `undetermined`), whether the optimiser converged, how well the law fits
+        (reduced chi-square with sigmas, RMS residuals without) and whether it reproduces
+        the data, then e and T predicted beside their targets at each speed, with the
+        penetration and force they imply, and the notes; inside `jit` the shapes
+        (`traced f64[]`)."""
         units = law_units(self.law)
-        order = [k for k in getattr(self.law, "parameters", {}) if k in self.params]
+        spec = getattr(self.law, "spec", None)
+        order = [k for k in getattr(spec, "parameters", ()) if k in self.params]
+        order += [k for k in getattr(self.law, "parameters", {}) if k not in order]
         order += [k for k in self.params if k not in order]  # the law's order, not jit's
         rows = []
         for name in order:
@@ -81,32 +169,125 @@ class Fit(eqx.Module):
             elif self.stderr is not None and name in self.stderr:
                 text += f" ± {format_value(self.stderr[name], unit)}"
             rows.append((name, text))
+        one = _is_one_concrete_fit(self)
         rows += [
-            ("converged", format_value(self.converged, None)),
+            ("converged", converged_text(self) if one else format_value(self.converged, None)),
             ("iterations", format_value(self.iterations, None)),
+        ]
+        if self.n_data is not None:
+            rows.append(("fit", goodness_text(self) if one else format_value(self.chi2)))
+        if self.reproduces is not None:
+            shown = reproduces_text(self) if one else format_value(self.reproduces, None)
+            rows.append(("reproduces", shown))
+        rows += [
             ("loss", format_value(self.loss)),
             ("v0", format_value(self.v0, "m/s")),
             ("e", f"{format_value(self.e)} ({_target_text(self.e_target, '')})"),
             ("T", f"{format_value(self.T, 's')} ({_target_text(self.T_target, 's')})"),
         ]
+        if self.m is not None and self.x_max is not None:
+            rows += [
+                ("m", format_value(self.m, "kg")),
+                ("x_max", format_value(self.x_max, "m") + " (implied by the fit)"),
+                ("F_max", format_value(self.F_max, "N") + " (implied by the fit)"),
+            ]
         name = getattr(self.law, "name", type(self.law).__name__)
-        return format_fields(f"Fit of {name} ({self.optimizer}; SI units)", rows)
+        text = format_fields(f"Fit of {name} ({self.optimizer}; SI units)", rows)
+        return "\n".join([text, *(f"  note: {note}" for note in self.notes)])
 
     def to_dict(self) -> dict:
         """The fit as plain numbers and lists (SI units), NaN as None: `law` (name and
-        parameters), `params`, `stderr`, `free`, `undetermined`, `converged`, `iterations`,
-        `loss`, `history`, and per speed `v0`, `e`, `T`, `e_target`, `T_target`,
-        `residuals`. Concrete fits only (not inside `jit`)."""
-        names = ("params", "stderr", "converged", "iterations", "loss", "history", "v0", "e",
-                 "T", "e_target", "T_target", "residuals")  # fmt: skip
+        parameters), `params`, `stderr`, `free`, `undetermined`, `converged` (the
+        optimiser), `reproduces`, `target_tol`, the goodness of fit (`n_data`, `dof`,
+        `chi2`, `reduced_chi2`, `p_value`, `rms_e`, `rms_T`, `weighted`), `iterations`,
+        `loss`, `history`, per speed `v0`, `e`, `T`, `e_target`, `T_target`, `x_max`,
+        `F_max`, `residuals`, the mass `m`, and the `notes`. Concrete fits only (not
+        inside `jit`)."""
+        names = ("params", "stderr", "converged", "reproduces", "target_tol", "iterations",
+                 "loss", "history", "m", "v0", "e", "T", "e_target", "T_target", "x_max",
+                 "F_max", "residuals")  # fmt: skip
         out = {k: jsonable(getattr(self, k)) for k in names}
+        if self.n_data is not None:
+            out.update({k: jsonable(getattr(self, k)) for k in ("n_data", "dof", "chi2",
+                        "reduced_chi2", "p_value", "rms_e", "rms_T")})  # fmt: skip
         law = {"name": getattr(self.law, "name", type(self.law).__name__)}
         law["parameters"] = out["params"]
         return {"law": law, **out, "free": list(self.free), "optimizer": self.optimizer,
-                "undetermined": list(self.undetermined)}  # fmt: skip
+                "undetermined": list(self.undetermined), "weighted": self.weighted,
+                "notes": list(self.notes)}  # fmt: skip
 
     def __repr__(self) -> str:
         return self.summary()
+
+
+def _is_one_concrete_fit(fit) -> bool:
+    """A fit with numbers (not traced) for one body (not a batch from `jax.vmap`)."""
+    return not is_traced(fit.loss) and np.ndim(fit.loss) == 0 and fit.n_data is not None
+
+
+def converged_text(fit) -> str:
+    """Whether the optimiser converged, in words (one concrete fit)."""
+    if bool(fit.converged):
+        if int(fit.iterations) == 0:
+            return "True (solved at the start: no iteration needed)"
+        return "True (the optimiser stopped at a minimum of the loss)"
+    return (
+        f"False (no minimum reached in {int(fit.iterations)} iterations, or an impact "
+        "of the fitted law does not separate)"
+    )
+
+
+def goodness_text(fit) -> str:
+    """How well the law fits, with what each number means (one concrete fit): reduced
+    chi-square with its degrees of freedom when sigmas were given, RMS residuals in e
+    and (relative) in T otherwise."""
+    dof = int(fit.dof)
+    parts = []
+    if fit.weighted:
+        chi2 = float(fit.chi2)
+        if dof > 0:
+            parts.append(
+                f"reduced chi-square {format_number(float(fit.reduced_chi2), 3)} with {dof} "
+                f"degrees of freedom (p = {format_number(float(fit.p_value), 2)}; "
+                f"chi2 = {format_number(chi2, 3)}, the sum of squared normalised residuals)"
+            )
+        else:
+            parts.append(
+                f"chi2 = {format_number(chi2, 3)} (sum of squared normalised residuals) with "
+                "no degree of freedom left: as many data as free parameters, the fit cannot "
+                "be judged"
+            )
+    rms = []
+    if np.any(np.isfinite(np.asarray(fit.e_target))):
+        rms.append(f"RMS of e_fit - e = {format_number(float(fit.rms_e), 3)}")
+    if np.isfinite(float(fit.rms_T)):
+        rms.append(f"RMS of (T_fit - T)/T = {format_number(100 * float(fit.rms_T), 3)} %")
+    if rms:
+        text = ", ".join(rms)
+        if not fit.weighted:
+            text += (
+                f" ({dof} degrees of freedom; no sigmas given, so no chi-square: compare "
+                "with the scatter of the measurements)"
+                if dof > 0
+                else " (as many data as free parameters: an exact fit is expected)"
+                if dof == 0
+                else " (fewer data than free parameters)"
+            )
+        parts.append(text)
+    return "; ".join(parts)
+
+
+def reproduces_text(fit) -> str:
+    """Whether every residual is within `target_tol`, and what that tolerance means."""
+    tol = format_number(float(fit.target_tol))
+    meaning = (
+        f"{tol} standard deviations (the sigmas given)" if fit.weighted
+        else f"{tol} (no sigmas: the data to numerical precision, as synthetic data are)"
+    )  # fmt: skip
+    if bool(fit.reproduces):
+        return f"True: every residual within target_tol = {meaning}"
+    largest = format_number(float(fit.max_residual), 3)
+    return f"False: largest residual {largest}, target_tol = {meaning}"
 
 
 def _target_text(target, unit: str) -> str:
@@ -270,10 +451,13 @@ def _start_on_curves(law, free, *, m, v0, e, T, has_T, key):
 # ------------------------------------------------------------------------------ the fit
 
 
-def _residual_function(law, free, *, m, separation, g, rtol, has_e, has_T, curves=None):
-    """Weighted residuals and predictions; differentiated in forward mode only (through
-    `with_forward_jacobian`), hence the explicit `ForwardMode` adjoint. With `curves` (a
-    `CurveKey`) every impact is read off the universal curves: no ODE solve."""
+def _residual_function(
+    law, free, *, m, separation, g, rtol, has_e, has_T, curves=None, peaks=False
+):
+    """Weighted residuals and predictions `(e, T, status)` (with `peaks`, also `x_max`
+    and `F_max`); differentiated in forward mode only (through `with_forward_jacobian`),
+    hence the explicit `ForwardMode` adjoint. With `curves` (a `CurveKey`) every impact
+    is read off the universal curves: no ODE solve."""
     options = ImpactOptions(
         separation=separation,
         closed_form=False,
@@ -284,7 +468,7 @@ def _residual_function(law, free, *, m, separation, g, rtol, has_e, has_T, curve
         tau_max=1e4,
         rest_tol=1e-9,
         adjoint=dfx.ForwardMode(),
-        peaks=False,
+        peaks=peaks,
         similarity=curves,
     )
 
@@ -294,6 +478,8 @@ def _residual_function(law, free, *, m, separation, g, rtol, has_e, has_T, curve
         result = jax.vmap(lambda v: solve_impact(fitted, m, v, g, None, options))(v0)
         parts = []
         predictions = (result.e, result.T, result.status)
+        if peaks:
+            predictions += (result.x_max, result.F_max)
         if has_e:
             parts.append((result.e - e) / s_e)
         if has_T:
@@ -390,8 +576,12 @@ def calibrate(
     - `init`: `"auto"` starts from the law's nondimensional restitution table (one damping
       group sets `e`, then `T` sets the stiffness) so most fits need a few iterations;
       `"given"` starts from the values in `law`.
-    - `target_tol`: the largest residual a converged fit may leave (default 1e-6 without
-      sigmas, 3 with them, i.e. three standard deviations).
+    - `target_tol`: the largest residual a fit that `reproduces` the data may leave
+      (default 1e-6 without sigmas, the data to numerical precision; 3 with them, i.e.
+      three standard deviations). `converged` is the optimiser's own verdict, whatever
+      the residuals; the goodness of fit is in `reduced_chi2` (with sigmas), `rms_e` and
+      `rms_T`, and standard errors come from the sigmas or, without them, from the
+      residuals' scatter (`Fit`).
     - `rtol`: tolerance of each impact solve.
     - `method`: `"auto"` reads every impact off the universal curves where they serve (a
       one-group law, `g = 0`; see `impact`), with the start read off them too (at one
@@ -478,15 +668,22 @@ def calibrate(
     )
     fit = _fit(law, data, m, np.float64(g) if g_is_zero else jnp.asarray(g, dtype=float),
                np.float64(target_tol), options)  # fmt: skip
-    return _reported(fit, undetermined, undetermined_why)
+    e_only = T is None and g_is_zero and shape_of(law) is not None
+    return _reported(fit, undetermined, undetermined_why, e_only)
 
 
-def _reported(fit, undetermined, why):
-    """`fit` with what the data leave undetermined (a warning too), after refusing one that
-    left float64's range; under a transformation only the record."""
+def _reported(fit, undetermined, why, e_only=False):
+    """`fit` with what the data leave undetermined (a warning too) and, where `e` alone
+    was measured for a one-group law (`e_only`), the group it determined (`notes`), after
+    refusing one that left float64's range; under a transformation only the record."""
     concrete = not isinstance(fit.loss, jax.core.Tracer)
     if concrete:
         _check_finite(fit)
+        if fit.stderr is not None and not fit.weighted:
+            if all(np.all(np.isnan(np.asarray(v))) for v in fit.stderr.values()):
+                fit = dataclasses.replace(fit, stderr=None)  # no degree of freedom left
+        if e_only and np.ndim(fit.loss) == 0:
+            fit = dataclasses.replace(fit, notes=(*fit.notes, *_group_notes(fit, undetermined)))
     if not undetermined:
         return fit
     if concrete:
@@ -497,6 +694,47 @@ def _reported(fit, undetermined, why):
             stacklevel=3,
         )
     return dataclasses.replace(fit, undetermined=undetermined)
+
+
+def _group_notes(fit, undetermined) -> tuple[str, ...]:
+    """What `e` alone determined for a one-group law (no `T`, no gravity): `e` depends on
+    the damping group `beta` alone, so the fit fixes `beta` at each speed; the stiffness
+    held fixed (or left undetermined) sets how that group splits into parameters."""
+    law = fit.law
+    damping = damping_parameter(law)
+    shape = shape_of(law)
+    if shape is None or damping not in fit.free:
+        return ()
+    n, p = shape
+    v0 = np.asarray(fit.v0, dtype=float)
+    m = float(fit.m)
+
+    def betas(item):
+        return np.asarray([float(item.dynamics(m=m, v0=float(v), g=0.0).beta) for v in v0])
+
+    beta = betas(law)
+    c = float(law.parameters["c"])
+    with_c = betas(law.replace(c=2.0 * c))
+    c_enters = not np.allclose(with_c, beta, rtol=1e-9, atol=0.0)
+    units = law_units(law)
+    group = (
+        f"e depends on the damping group beta alone (beta = b x*^{p + 1:g}/(m v0), "
+        f"x* = (m v0^2/c)^(1/{n + 1:g}), b the coefficient of x^{p:g} v): e determines "
+        f"beta = {format_value(beta)} at v0 = {format_value(v0, 'm/s')}"
+    )
+    if "c" in undetermined:
+        return (f"{group}; c and {damping} separately are not determined: give T",)
+    value = format_value(law.parameters[damping], units.get(damping, ""))
+    held = f"c held at its start value {format_value(c, units.get('c', ''))}"
+    if c_enters:
+        return (
+            f"{group}; {held}: {damping} = {value} is the value that gives this beta with "
+            f"that c (another c gives another {damping} and the same e; give T to fit c)",
+        )
+    return (
+        f"{group}, which does not involve c: {damping} = {value} is determined; {held} "
+        "(c sets T and x_max, not e: give T to fit it)",
+    )
 
 
 def _check_finite(fit):
@@ -601,10 +839,13 @@ def _fit(law, data, m, g, target_tol, options):
             options.max_iter,
             gtol=options.tol,
         )
-    if options.has_sigma:
-        (r, (e_fit, T_fit, status)), jacobian = jacobian_fn(theta, data)
-    else:
-        r, (e_fit, T_fit, status) = raw(theta, data)
+    # the final point once more, with the peaks (x_max, F_max: the sanity echo); on the
+    # curves they cost nothing, an integrated law adds their events to this one solve
+    final = _residual_function(law, free, m=m, separation=options.separation, g=g,
+                               rtol=options.rtol, has_e=options.has_e, has_T=options.has_T,
+                               curves=options.curves, peaks=True)  # fmt: skip
+    r, (e_fit, T_fit, status, x_max, F_max) = final(theta, data)
+    (_, _), jacobian = jacobian_fn(theta, data)
     final_loss = 0.5 * jnp.sum(r**2)
     if history is None:
         history = jnp.stack([loss(theta0, data), final_loss])[-1 if exact else 0 :]
@@ -612,16 +853,24 @@ def _fit(law, data, m, g, target_tol, options):
         filled = jnp.arange(history.shape[0]) < iterations
         history = jnp.where(filled, history, final_loss)
     fitted = law_with(law, free, theta)
-    converged = jnp.all(jnp.abs(r) <= target_tol) & jnp.all(status == Status.separated)
-    stderr = None
-    if options.has_sigma:
-        covariance = jnp.linalg.pinv(jacobian.T @ jacobian)
-        params = jnp.stack([fitted.parameters[k] for k in free])
-        scale = jnp.where(
-            jnp.asarray([k == "e_nominal" for k in free]), params * (1 - params), params
-        )
-        se = scale * jnp.sqrt(jnp.abs(jnp.diag(covariance)))
-        stderr = {k: se[i] for i, k in enumerate(free)}
+    separated = jnp.all(status == Status.separated)
+    reproduces = jnp.all(jnp.abs(r) <= target_tol) & separated
+    if exact:  # no optimiser ran: converged where the curves' solution meets the targets
+        known = jnp.isfinite(T)
+        T_known = jnp.where(known, T, 1.0)
+        T_off = jnp.where(known, jnp.abs(T_fit - T_known) / T_known, 0.0)
+        stopped = jnp.all(jnp.abs(e_fit - e) <= 1e-6) & jnp.all(T_off <= 1e-6)
+    n_data = (rows if options.has_e else 0) + (jnp.sum(jnp.isfinite(T)) if options.has_T else 0)
+    dof = n_data - len(free)
+    # without sigmas the residuals' own scatter stands for every residual's variance
+    variance = 1.0 if options.has_sigma else jnp.sum(r**2) / jnp.where(dof > 0, dof, 1)
+    covariance = variance * jnp.linalg.pinv(jacobian.T @ jacobian)
+    params = jnp.stack([fitted.parameters[k] for k in free])
+    scale = jnp.where(jnp.asarray([k == "e_nominal" for k in free]), params * (1 - params), params)
+    se = scale * jnp.sqrt(jnp.abs(jnp.diag(covariance)))
+    if not options.has_sigma:
+        se = jnp.where(dof > 0, se, jnp.nan)
+    stderr = {k: se[i] for i, k in enumerate(free)}
     return Fit(
         law=fitted,
         params=fitted.parameters,
@@ -632,10 +881,17 @@ def _fit(law, data, m, g, target_tol, options):
         T_target=T if options.has_T else jnp.full(rows, jnp.nan),
         residuals=r,
         loss=final_loss,
-        converged=(converged & stopped) | (final_loss <= 1e-30),
+        converged=(stopped & separated) | (final_loss <= 1e-30),
         iterations=jnp.asarray(iterations),
         history=history,
         stderr=stderr,
         free=free,
+        m=jnp.asarray(m, dtype=float),
+        x_max=x_max,
+        F_max=F_max,
+        reproduces=reproduces,
+        target_tol=jnp.asarray(target_tol, dtype=float),
+        n_data=jnp.asarray(n_data),
+        weighted=options.has_sigma,
         optimizer=optimizer if isinstance(optimizer, str) else type(optimizer).__name__,
     )

@@ -2,6 +2,7 @@
 
 import dataclasses
 import math
+import warnings
 
 import jax.numpy as jnp
 import numpy as np
@@ -79,31 +80,114 @@ def _dry_both_ways(spec, v0) -> bool:
 
 @dataclasses.dataclass
 class Ranking:
-    """One law's fit in a comparison: the `Fit`, its weighted sum of squares `chi2`, the
-    number of free parameters `k`, and AIC/BIC (with sigmas only, else `None`)."""
+    """One law's fit in a comparison: the `Fit`; `sum_sq`, the sum of its squared residuals
+    (with sigmas the sum of squared normalised residuals, a chi-square; without them
+    `e_fit - e` and `(T_fit - T)/T`, unweighted); the number of free parameters `k`; and
+    AIC/BIC (with sigmas only, else `None`). `chi2` is the old name of `sum_sq`;
+    `reduced_chi2`, `dof`, `p_value`, `rms_e` and `rms_T` are the fit's (`Fit`)."""
 
     name: str
     fit: Fit
-    chi2: float
+    sum_sq: float
     k: int
     aic: float | None
     bic: float | None
 
+    @property
+    def chi2(self) -> float:
+        """The old name of `sum_sq` (a chi-square only when sigmas were given)."""
+        return self.sum_sq
+
+    @property
+    def dof(self) -> int:
+        return int(self.fit.dof)
+
+    @property
+    def reduced_chi2(self) -> float:
+        return float(self.fit.reduced_chi2)
+
+    @property
+    def p_value(self) -> float:
+        return float(self.fit.p_value)
+
+    @property
+    def rms_e(self) -> float:
+        return float(self.fit.rms_e)
+
+    @property
+    def rms_T(self) -> float:
+        return float(self.fit.rms_T)
+
     def summary(self) -> str:
-        """The law's place in the comparison (chi2, k, AIC, BIC), then its fit
+        """The law's place in the comparison (sum of squares, k, AIC, BIC), then its fit
         (`Fit.summary()`), every number with its unit."""
-        rows = [(k, format_value(getattr(self, k), None if k == "k" else ""))
-                for k in ("chi2", "k", "aic", "bic")]  # fmt: skip
+        if self.fit.weighted:
+            what = "chi2: the sum of squared normalised residuals"
+        else:
+            what = ("sum of squared residuals e_fit - e and (T_fit - T)/T, unweighted (no "
+                    "sigmas: not a chi-square; .chi2 is the same number)")  # fmt: skip
+        rows = [("sum_sq", f"{format_value(self.sum_sq, '')} ({what})")]
+        rows += [(k, format_value(getattr(self, k), None if k == "k" else ""))
+                 for k in ("k", "aic", "bic")]  # fmt: skip
         return format_fields(f"Ranking of {self.name}", rows) + "\n" + self.fit.summary()
 
     def to_dict(self) -> dict:
-        """`name`, `chi2`, `k`, `aic`, `bic` and the `fit` (`Fit.to_dict()`), as plain
-        numbers (NaN and missing as None)."""
-        head = {k: jsonable(getattr(self, k)) for k in ("name", "chi2", "k", "aic", "bic")}
+        """`name`, `sum_sq` (also as `chi2`, its old name), `k`, `dof`, `reduced_chi2`,
+        `p_value`, `rms_e`, `rms_T`, `aic`, `bic` and the `fit` (`Fit.to_dict()`), as
+        plain numbers (NaN and missing as None)."""
+        names = ("name", "sum_sq", "chi2", "k", "dof", "reduced_chi2", "p_value", "rms_e",
+                 "rms_T", "aic", "bic")  # fmt: skip
+        head = {k: jsonable(getattr(self, k)) for k in names}
         return {**head, "fit": self.fit.to_dict()}
 
     def __repr__(self) -> str:
         return self.summary()
+
+
+class BadFitWarning(UserWarning):
+    """The best law of `compare_laws` does not fit the data (see `fits_badly`)."""
+
+
+# without sigmas, what "fits badly" means: RMS residuals above these (e: absolute, a
+# restitution measured to +-0.01 is a good repeatability; T: relative, 5 %)
+MAX_RMS_E = 0.01
+MAX_RMS_T = 0.05
+# with sigmas: a chi-square this improbable if the law were right
+MIN_P_VALUE = 1e-3
+
+
+def fits_badly(fit: Fit, *, max_rms_e=MAX_RMS_E, max_rms_T=MAX_RMS_T) -> str | None:
+    """Why `fit` (one concrete `Fit`) fits its data badly, or `None`. With sigmas: a
+    reduced chi-square well above 1, i.e. `p_value < 1e-3` (a chi-square that large has
+    less than 0.1 % chance if the law were right and the sigmas the data's scatter).
+    Without sigmas: the RMS of `e_fit - e` above `max_rms_e` (0.01) or that of
+    `(T_fit - T)/T` above `max_rms_T` (5 %). A fit with no degree of freedom (as many
+    data as free parameters) is never judged badly: it cannot be judged."""
+    dof = int(fit.dof)
+    if dof <= 0:
+        return None
+    if fit.weighted:
+        p = float(fit.p_value)
+        if p < MIN_P_VALUE:
+            return (
+                f"reduced chi-square {float(fit.reduced_chi2):.3g} with {dof} degrees of "
+                f"freedom (p = {p:.2g} < {MIN_P_VALUE:g}: its residuals are far larger than "
+                "the sigmas)"
+            )
+        return None
+    reasons = []
+    rms_e, rms_T = float(fit.rms_e), float(fit.rms_T)
+    if np.isfinite(rms_e) and rms_e > max_rms_e:
+        reasons.append(f"RMS of e_fit - e = {rms_e:.3g}")
+    if np.isfinite(rms_T) and rms_T > max_rms_T:
+        reasons.append(f"RMS of (T_fit - T)/T = {100 * rms_T:.3g} %")
+    if not reasons:
+        return None
+    return (
+        " and ".join(reasons) + f" (without sigmas, badly means an RMS residual above "
+        f"{max_rms_e:g} in e or {100 * max_rms_T:g} % in T; give sigmas to judge against "
+        "the data's own scatter)"
+    )
 
 
 def compare_laws(
@@ -117,12 +201,22 @@ def compare_laws(
     laws=PAPER_LAWS,
     separation="force",
     progress=True,
+    warn: bool = True,
+    max_rms_e=MAX_RMS_E,
+    max_rms_T=MAX_RMS_T,
     **calibrate_options,
 ) -> list[Ranking]:
     """Fit every law of `laws` to the same measurements and rank them, best first.
 
     Ranked by AIC (`chi2 + 2k`, Gaussian errors) when sigmas are given, else by the sum of
-    squared residuals. Laws with more free parameters than data are skipped.
+    squared residuals (`e_fit - e` and `(T_fit - T)/T`). Laws with more free parameters
+    than data are skipped.
+
+    The best law is not thereby a good one: with `warn`, a `BadFitWarning` says when it
+    fits badly, which means (`fits_badly`): with sigmas, a reduced chi-square well above
+    1 (`p_value < 1e-3`); without sigmas, an RMS of `e_fit - e` above `max_rms_e` (0.01)
+    or of `(T_fit - T)/T` above `max_rms_T` (0.05, i.e. 5 %). Each `Ranking` carries the
+    numbers (`reduced_chi2`, `dof`, `rms_e`, `rms_T`).
 
     **Example**: `compare_laws(m=0.0027, v0=[1, 2, 3], e=[0.9, 0.87, 0.85])[0].name`.
     """
@@ -165,14 +259,25 @@ def compare_laws(
                 separation=separation,
                 **calibrate_options,
             )
-            chi2 = float(jnp.sum(fit.residuals**2))
+            sum_sq = float(jnp.sum(fit.residuals**2))
             k = len(free)
-            aic = chi2 + 2 * k if has_sigma else None
-            bic = chi2 + k * math.log(n_data) if has_sigma else None
-            rankings.append(Ranking(name, fit, chi2, k, aic, bic))
+            aic = sum_sq + 2 * k if has_sigma else None
+            bic = sum_sq + k * math.log(n_data) if has_sigma else None
+            rankings.append(Ranking(name, fit, sum_sq, k, aic, bic))
             bar.update(name)
-    key = (lambda r: r.aic) if has_sigma else (lambda r: r.chi2)
-    return sorted(rankings, key=key)
+    key = (lambda r: r.aic) if has_sigma else (lambda r: r.sum_sq)
+    rankings = sorted(rankings, key=key)
+    if warn and rankings:
+        why = fits_badly(rankings[0].fit, max_rms_e=max_rms_e, max_rms_T=max_rms_T)
+        if why is not None:
+            warnings.warn(
+                f"the best law, {rankings[0].name}, fits these data badly: {why}; no law of "
+                f"{', '.join(r.name for r in rankings)} describes them; check the data and "
+                "their sigmas, or try other laws",
+                BadFitWarning,
+                stacklevel=2,
+            )
+    return rankings
 
 
 def _free_for(name, *, has_T, n_data):

@@ -11,6 +11,7 @@ program, differentiable in both modes (shared/notes/diffrax-impact-notes.md, sec
 
 import dataclasses
 import enum
+import warnings
 import math
 
 import diffrax as dfx
@@ -528,7 +529,9 @@ def bounce(
       (`ForwardMode` under `jax.jacfwd`). Tolerances must lie in (0, 1), `tau_max` be > 0,
       `max_steps` and `max_impacts` integers >= 1 (a ValueError otherwise).
     - `h0 = 0` needs a downward (or upward) `v_drop`: a ball at rest on the floor is refused.
-    - `throw`: raise if the sequence failed or ran out of `max_impacts`.
+    - `throw`: raise if the sequence failed or ran out of `max_impacts`; by default an
+      eager call whose sequence failed (a contact's solve ran out of steps or failed) warns,
+      and keeps the contacts before the failed one (the failed one's fields are NaN).
     Differentiable (forward and reverse mode) in the law's parameters, `m`, `h0`, `v_drop`,
     `g` and `drag`; works under `jax.vmap`.
 
@@ -597,4 +600,14 @@ def bounce(
             (result.status == BounceStatus.failed) | (result.status == BounceStatus.max_impacts),
             "the bounce sequence failed (a contact ran out of steps) or used up max_impacts",
         )
+    elif not isinstance(result.status, jax.core.Tracer) and np.ndim(result.status) == 0:
+        if int(result.status) == BounceStatus.failed:
+            # the contacts before the failed one are right and worth having: a warning, the
+            # failed contact and those after it NaN (the failure rule, `Status`)
+            warnings.warn(
+                f"the bounce sequence failed at contact {int(result.num_impacts)}: its solve "
+                f"ran out of steps (max_steps={max_steps}) or failed; the contacts before it "
+                "are right, the rest NaN (raise max_steps or loosen rtol; throw=True raises)",
+                stacklevel=2,
+            )
     return result

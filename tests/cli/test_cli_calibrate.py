@@ -51,8 +51,39 @@ def test_one_impact_text(capsys):
     assert "law        hertz_rate (eq. 14: F = c x^1.5 + b1 x^0.5 v)" in out
     assert re.search(r"^fitted     c  = 2e6 N/m\^1\.5$", out, flags=re.MULTILINE), out
     assert re.search(r"^           b1 = 800 N s/m\^1\.5$", out, flags=re.MULTILINE), out
-    assert "converged after" in out and "start auto" in out
+    flat = " ".join(out.split())  # the long lines are wrapped to 100 columns
+    assert "optimiser converged after" in flat and "start auto" in flat
     assert "7.845 ms" in out  # the T column: measured and fitted
+    # one speed, e and T, two parameters: no degree of freedom, an exact fit expected
+    assert "goodness   RMS of e_fit - e = " in out and "an exact fit is expected" in flat
+    assert "reproduces the data: every residual within 1e-6" in flat
+    assert max(len(line) for line in out.splitlines()) <= 100
+
+
+def test_sanity_echo_shows_grams_typed_as_kilograms(capsys):
+    """The fitted law's x_max, F_max and contact time at the measured speed, with the mass
+    and the kinetic energy: the same e and T with the mass typed 1000 times too large give
+    the same x_max and a force and energy 1000 times larger, in plain sight."""
+    status, out, _ = run_cli(capsys, ONE)
+    assert status == 0
+    check = " ".join(out[out.index("check      ") :].split("\n\n")[0].split())
+    assert check.startswith("check m = 1 kg, kinetic energy 3.125 J at v0 = 2.5 m/s")
+    reference = reference_impact("hertz_rate", LAW14, m=1.0, v0=2.5)
+    x_mm, force = reference["x_max"] * 1e3, reference["F_max"] / 1e3
+    assert f"penetration x_max of {x_mm:.4g} mm" in check, check
+    assert f"peak force F_max of {force:.4g} kN" in check, check
+    assert "contact time of 7.845 ms" in check and "check the units (--mass in kg)" in check
+    records = []
+    for mass in ("1", "1000"):
+        argv = [*ONE, "--json"]
+        argv[argv.index("--mass") + 1] = mass
+        status, out, _ = run_cli(capsys, argv)
+        assert status == 0
+        records.append(json.loads(out)["rows"][0])
+    assert_rel(records[0]["x_max"], reference["x_max"], 1e-8, "x_max of the fitted law")
+    assert_rel(records[0]["F_max"], reference["F_max"], 1e-8, "F_max of the fitted law")
+    assert_rel(records[1]["x_max"], records[0]["x_max"], 1e-8, "x_max: set by v0 and T")
+    assert_rel(records[1]["F_max"], 1000 * records[0]["F_max"], 1e-8, "F_max scales with m")
 
 
 def test_one_impact_json_with_start_values(capsys):
@@ -111,18 +142,40 @@ def test_model_choice(capsys, monkeypatch, law14_csv):
     monkeypatch.setattr(_model_choice, "compare_laws", failing_maxwell)
     status, out, err = run_cli(capsys, ["calibrate", "--law", "all", "--data", str(law14_csv)])
     assert status == 0 and err == ""
-    table = [line.split() for line in out.splitlines() if re.match(r"^\d+\s+\w+", line)]
+    lines = out.splitlines()
+    header = next(line.split() for line in lines if line.startswith("rank"))
+    assert header == ["rank", "law", "k", "sum_sq", "rms_e", "rms_T", "converged", "parameters"]
+    table = [line.split() for line in lines if re.match(r"^\d+\s+\w+", line)]
     assert [row[:2] for row in table] == [["1", "hertz_rate"], ["2", "kelvin_voigt"]]
-    assert table[0][6] == "yes" and table[1][6] == "no"  # converged
-    assert "ranked by the sum of squared residuals" in out and "best: hertz_rate" in out
+    # both optimisers converged; only law 14 reproduces the data (RMS of e_fit - e ~ 0)
+    assert table[0][6] == "yes" and table[1][6] == "yes"
+    assert float(table[0][4]) < 1e-12 < 1e-3 < float(table[1][4])
+    assert "ranked by sum_sq, the sum of squared residuals e_fit - e and (T_fit - T)/T" in out
+    assert "best: hertz_rate" in out and "fits these data badly" not in out
     assert "failed: maxwell (RuntimeError: boom)" in out
     monkeypatch.setattr(_cli_calibrate, "MODEL_CHOICE_LAWS", ("kelvin_voigt", "hertz_rate"))
     status, out, _ = run_cli(
         capsys, ["calibrate", "--law", "all", "--data", str(law14_csv), "--json"]
     )
     data = json.loads(out)
-    assert data["best"] == "hertz_rate" and data["criterion"] == "chi2"
-    assert data["ranking"][0]["chi2"] < 1e-12 < data["ranking"][1]["chi2"]
+    assert data["best"] == "hertz_rate" and data["criterion"] == "sum_sq"
+    assert data["bad_fit"] is None
+    best, other = data["ranking"]
+    assert best["sum_sq"] < 1e-12 < other["sum_sq"] and other["chi2"] == other["sum_sq"]
+    assert best["reproduces"] and best["converged"]
+    assert other["converged"] and not other["reproduces"] and other["rms_e"] > 0.01
+
+
+def test_model_choice_warns_when_the_best_law_fits_badly(capsys, monkeypatch, law14_csv):
+    """Kelvin-Voigt alone on law 14's falling e: its optimiser converges, it is the best
+    of one, and it fits badly (RMS of e_fit - e above 0.01, no sigmas): a warning line."""
+    monkeypatch.setattr(_cli_calibrate, "MODEL_CHOICE_LAWS", ("kelvin_voigt",))
+    status, out, err = run_cli(capsys, ["calibrate", "--law", "all", "--data", str(law14_csv)])
+    assert status == 0 and err == ""
+    assert "best: kelvin_voigt" in out
+    (line,) = [line for line in out.splitlines() if line.startswith("warning:")]
+    assert line.startswith("warning: the best law, kelvin_voigt, fits these data badly: RMS")
+    assert "badly means an RMS residual above 0.01 in e or 5 % in T" in line
 
 
 # -------------------------------------------------------------------- bad input

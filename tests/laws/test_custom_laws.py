@@ -295,3 +295,17 @@ def test_every_entry_point_takes_a_plainly_written_law():
     # an export of the plain law promises its e at v0
     export = ji.export(plain, "mujoco", m=1.0, v0=2.5)
     assert math.isfinite(export.e) and abs(export.e - float(r.e)) < 0.05
+
+
+@pytest.mark.slow
+def test_a_failed_drop_warns_and_keeps_no_number():
+    """A drop whose contact solve runs out of steps: an eager bounce warns (the contacts
+    before the failed one are worth having), its status is `failed`, the failed contact's
+    fields are NaN; throw=True raises."""
+    law = ji.custom_law(_hunt_crossley_pow, c=2e6, n=1.5, a=0.3)
+    with pytest.warns(UserWarning, match=r"failed at contact 1: .*max_steps=20"):
+        b = ji.bounce(law, m=1.0, h0=0.6, t_end=2.0, max_steps=20)
+    assert b.status_name == "failed"
+    assert math.isnan(float(b.e[0])) and math.isnan(float(b.T[0]))
+    with pytest.raises(Exception, match="failed"):
+        ji.bounce(law, m=1.0, h0=0.6, t_end=2.0, max_steps=20, throw=True)
