@@ -13,10 +13,10 @@ def elastic_part(law, x):
     """The elastic part `c x^n` (N) of a law of the power family over the penetrations
     `x` (m) reached, as `(x grid, force, legend label)`; `None` for laws without one
     (Maxwell, a user's own law)."""
-    spec = getattr(law, "spec", None)
-    if spec is None or spec.coefficients is None:
+    family = None if law is None else law.coefficients(1.0)  # c and n never depend on v0
+    if family is None:
         return None
-    c, n, *_ = spec.coefficients(law.parameters, 1.0)  # c and n never depend on v0
+    c, n, *_ = family
     c, n = float(c), float(n)
     x = np.linspace(0.0, max(float(np.max(x, initial=0.0)), 0.0), 200)
     power = "" if n == 1 else f"^{{{n:g}}}"
@@ -122,7 +122,7 @@ def plot_impact(result, law=None, *, fig=None, axes=None, title: str | None = No
     ax_speed.legend(loc="best", fontsize="small")
 
     if title is None:
-        name = getattr(law, "name", None)
+        name = None if law is None else law.name
         title = (f"{name}: " if name else "") + f"e = {e:.4g}, T = {T * _MS:.4g} ms"
         if status != "separated":
             title += f" ({status})"

@@ -13,9 +13,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._checks import check_nonnegative, check_positive, invalid_entries
-from .._laws import LAW_NAMES, LAWS, CustomLaw, Law, custom_law, law as make_law
-from .._laws.closed_forms import closed_form_for
-from .._laws.named_law import invalid_parameter_rows
+from .._laws import LAW_NAMES, LAWS, AbstractLaw, CustomLaw, custom_law, law as make_law
+from .._laws.named_law import invalid_parameter_rows, table_law
 from .._solve.impact import CURVES_RTOL, impact, similarity_reason
 from .._status import Status
 from .runner import run_batch
@@ -43,10 +42,10 @@ def _law_skeleton(law):
     """A hashable description of a law's structure (everything but its parameter values)."""
     if isinstance(law, str):
         return ("law", law)
-    if isinstance(law, Law):
-        return ("law", law.name)
     if isinstance(law, CustomLaw):
         return ("custom", law.fn, law.name)
+    if isinstance(law, AbstractLaw) and law.spec is not None:
+        return ("law", law.name)
     raise TypeError(
         f"impact_batch takes a law name or a law from jaximpact.law / custom_law, "
         f"got {type(law).__name__}"
@@ -60,7 +59,7 @@ def build_law(skeleton, params):
     if skeleton[0] == "law":
         fixed = dict(skeleton[2]) if len(skeleton) > 2 else {}
         params = {**{k: jnp.asarray(v, dtype=float) for k, v in fixed.items()}, **params}
-        return Law(skeleton[1], {k: params[k] for k in LAWS[skeleton[1]].parameters})
+        return table_law(skeleton[1], {k: params[k] for k in LAWS[skeleton[1]].parameters})
     return CustomLaw(skeleton[1], params, skeleton[2])
 
 
@@ -126,7 +125,7 @@ def batch_path(
     """The path every row of a batch of `law`'s impacts takes: `"closed_form"`,
     `"similarity"` (the universal curves) or `"integrated"` (the same choice as `impact`'s
     `method="auto"`, made once for the batch)."""
-    closed = closed_form_for(law, separation, g_is_zero=g_is_zero)
+    closed = law.closed_form(separation, g_is_zero=g_is_zero)
     if method != "integrate" and closed is not None:
         return "closed_form"
     if (

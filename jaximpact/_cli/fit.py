@@ -187,7 +187,7 @@ def _summary(fit) -> dict:
 
     data = dict(
         kind=fit.kind,
-        law=getattr(fit.law, "name", "custom"),
+        law=fit.law.name,
         params=fit.params,
         stderr=fit.stderr,
         free=list(fit.free),

@@ -1,6 +1,6 @@
 """Where curves live: the file shipped with the package, and a cache for other shapes.
 
-The shipped file holds the shapes of the law table (`SHIPPED`); a shape that is not
+The shipped file holds the shapes of the law table's rows (`SHIPPED`); a shape that is not
 there (Hunt-Crossley with another `n`, a power law with the user's own `n` and `p`) is
 built on first use and kept in `$JAXIMPACT_CURVES_DIR` (default
 `$XDG_CACHE_HOME/jaximpact/curves`, else `~/.cache/jaximpact/curves`). Every file carries
@@ -18,23 +18,15 @@ from pathlib import Path
 
 import numpy as np
 
+from .._laws import SHIPPED_SHAPES
 from .curve import DEGREE, OUTPUTS, Curves
 from .shapes import CurveKey, curve_key
 
 FORMAT = 1
 SHIPPED_FILE = Path(__file__).with_name("curves.npz")
-SHIPPED = (
-    curve_key(1.0, 0.0, "force"),  # Kelvin-Voigt (its closed form serves `impact`)
-    curve_key(1.0, 1.0, "force"),  # Kelvin-Voigt modified, either criterion
-    curve_key(1.5, 0.0, "force"),  # Hertz viscous
-    curve_key(1.5, 1.0, "force"),  # Hertz modified
-    curve_key(1.5, 1.0, "penetration"),
-    curve_key(1.5, 0.5, "force"),  # the paper's law 14
-    curve_key(1.5, 0.5, "penetration"),
-    curve_key(1.5, 1.5, "force"),  # Hunt-Crossley and its variants, either criterion
-    curve_key(1.5, 0.0, "penetration"),  # Hertz viscous: captured above a threshold
-    curve_key(1.5, 0.25, "force"),  # Tsuji (LAMMPS, LIGGGHTS, Chrono)
-    curve_key(1.5, 0.25, "penetration"),
+# the shapes of the law table's one-group rows, under both criteria (`table.SHIPPED_SHAPES`)
+SHIPPED = tuple(
+    dict.fromkeys(curve_key(n, p, s) for n, p in SHIPPED_SHAPES for s in ("force", "penetration"))
 )
 _ENV = "JAXIMPACT_CURVES_DIR"
 

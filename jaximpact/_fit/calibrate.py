@@ -153,10 +153,8 @@ class Fit(eqx.Module):
         penetration and force they imply, and the notes; inside `jit` the shapes
         (`traced f64[]`)."""
         units = law_units(self.law)
-        spec = getattr(self.law, "spec", None)
-        order = [k for k in getattr(spec, "parameters", ()) if k in self.params]
-        order += [k for k in getattr(self.law, "parameters", {}) if k not in order]
-        order += [k for k in self.params if k not in order]  # the law's order, not jit's
+        order = [k for k in self.law.parameters if k in self.params]  # the row's order
+        order += [k for k in self.params if k not in order]  # not jit's
         rows = []
         for name in order:
             value = self.params[name]
@@ -191,7 +189,7 @@ class Fit(eqx.Module):
                 ("x_max", format_value(self.x_max, "m") + " (implied by the fit)"),
                 ("F_max", format_value(self.F_max, "N") + " (implied by the fit)"),
             ]
-        name = getattr(self.law, "name", type(self.law).__name__)
+        name = self.law.name
         text = format_fields(f"Fit of {name} ({self.optimizer}; SI units)", rows)
         return "\n".join([text, *(f"  note: {note}" for note in self.notes)])
 
@@ -210,7 +208,7 @@ class Fit(eqx.Module):
         if self.n_data is not None:
             out.update({k: jsonable(getattr(self, k)) for k in ("n_data", "dof", "chi2",
                         "reduced_chi2", "p_value", "rms_e", "rms_T")})  # fmt: skip
-        law = {"name": getattr(self.law, "name", type(self.law).__name__)}
+        law = {"name": self.law.name}
         law["parameters"] = out["params"]
         return {"law": law, **out, "free": list(self.free), "optimizer": self.optimizer,
                 "undetermined": list(self.undetermined), "weighted": self.weighted,
@@ -300,7 +298,7 @@ def _target_text(target, unit: str) -> str:
 def law_units(law) -> dict[str, str]:
     """The units of `law`'s parameters (`{"c": "N/m^1.5", ...}`; "" for a pure number);
     a user's own law has none to give."""
-    spec = getattr(law, "spec", None)
+    spec = law.spec
     if spec is None:
         return {}
     try:
@@ -388,7 +386,7 @@ MAX_REACH = 1.0
 def _initial_law(law, free, *, m, v0, e, T, separation):
     """Start from one dimensionless damping group: `e` sets it (through a table of the
     law's nondimensional impact), `T` then sets the time scale and so the stiffness."""
-    spec = getattr(law, "spec", None)
+    spec = law.spec
     if spec is None or not spec.restitution_table:
         return law
     damping = spec.damping
@@ -408,7 +406,7 @@ def _initial_law(law, free, *, m, v0, e, T, separation):
     log_group = jnp.interp(loss_row, loss_table, np.log(groups))
     group = jnp.exp(log_group)
     tau = jnp.interp(loss_row, loss_table, tau_table)
-    if spec.coefficients is None:  # Maxwell: group b / sqrt(m c), tau = T / sqrt(m / c)
+    if law.has_state:  # Maxwell: group b / sqrt(m c), tau = T / sqrt(m / c)
         c = law.params["c"]
         if T is not None and "c" in free:
             c = jnp.where(jnp.isfinite(T[row]), m * (tau / T[row]) ** 2, c)

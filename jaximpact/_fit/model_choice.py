@@ -9,7 +9,7 @@ import numpy as np
 from jax.scipy.special import gammaln
 
 from .._format import format_fields, format_value, jsonable
-from .._laws import LAWS, exponents, law
+from .._laws import LAWS, AbstractLaw, exponents, law
 from .._progress import Progress
 from .calibrate import Fit, calibrate
 from .parameters import default_free
@@ -33,7 +33,7 @@ def starting_law(name: str, *, m: float, v0: float, e: float, T: float | None):
     log_e = math.log(min(max(e, 1e-6), 0.999999))
     zeta = -log_e / math.sqrt(math.pi**2 + log_e**2)
     try:
-        if spec.coefficients is None:  # Maxwell: a spring of period 2 T in series with a dashpot
+        if spec.state is not None:  # Maxwell: a spring of period 2 T in series with a dashpot
             omega = math.pi / T
             return law(name, c=_in_range(m * omega**2), b=_in_range(m * omega / max(zeta, 1e-3)))
         n, p = exponents(spec)
@@ -208,6 +208,9 @@ def compare_laws(
 ) -> list[Ranking]:
     """Fit every law of `laws` to the same measurements and rank them, best first.
 
+    `laws`: names of the law table (started from `starting_law`), or law objects such as
+    a user's `custom_law(...)`, each started from its own parameters.
+
     Ranked by AIC (`chi2 + 2k`, Gaussian errors) when sigmas are given, else by the sum of
     squared residuals (`e_fit - e` and `(T_fit - T)/T`). Laws with more free parameters
     than data are skipped.
@@ -235,15 +238,20 @@ def compare_laws(
     has_sigma = sigma_e is not None or sigma_T is not None
     rankings = []
     with Progress(len(laws), "fitting laws", enabled=progress) as bar:
-        for name in laws:
-            start = starting_law(
-                name,
-                m=float(m),
-                v0=float(v0_rows[middle]),
-                e=float(e_rows[middle]),
-                T=None if T_rows is None else float(T_rows[middle]),
-            )
-            free = _free_for(name, has_T=T_rows is not None, n_data=n_data)
+        for entry in laws:
+            if isinstance(entry, AbstractLaw):  # a law object (a user's own): its own start
+                name, start = entry.name, entry
+                free = _free_for_law(entry, has_T=T_rows is not None, n_data=n_data)
+            else:
+                name = entry
+                start = starting_law(
+                    name,
+                    m=float(m),
+                    v0=float(v0_rows[middle]),
+                    e=float(e_rows[middle]),
+                    T=None if T_rows is None else float(T_rows[middle]),
+                )
+                free = _free_for(name, has_T=T_rows is not None, n_data=n_data)
             if len(free) > n_data:
                 bar.update(f"{name} (skipped)")
                 continue
@@ -278,6 +286,18 @@ def compare_laws(
                 stacklevel=2,
             )
     return rankings
+
+
+def _free_for_law(law, *, has_T, n_data):
+    """A law object's free parameters: those a table law of its name frees, else (a
+    user's law) every parameter, but the stiffness `c` when no T was measured and there
+    is one more parameter than the data can fix."""
+    if law.name in LAWS:
+        return _free_for(law.name, has_T=has_T, n_data=n_data)
+    names = tuple(law.parameters)
+    if not has_T and "c" in names and len(names) > 1:
+        names = tuple(k for k in names if k != "c")
+    return names
 
 
 def _free_for(name, *, has_T, n_data):

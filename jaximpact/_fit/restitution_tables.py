@@ -16,7 +16,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._laws import LAWS, Law
+from .._laws import LAWS, table_law
 from .._solve.impact import impact
 from .._status import Status
 
@@ -35,11 +35,11 @@ def compute_table(name: str, separation: str, n: float = 1.5):
         # the damping that makes the family's b (or Maxwell's b / sqrt(m c)) equal the group
         per_unit = (
             1.0
-            if spec.coefficients is None
+            if spec.state is not None
             else spec.coefficients({**params, spec.damping: 1.0}, 1.0)[2]
         )
         params[spec.damping] = group / per_unit
-        law = Law(name, {k: jnp.asarray(v, float) for k, v in params.items()})
+        law = table_law(name, {k: jnp.asarray(v, float) for k, v in params.items()})
         result = impact(law, m=1.0, v0=1.0, separation=separation, peaks=False, rtol=1e-10)
         return result.e, result.T, result.status
 

@@ -9,5 +9,6 @@ from .base import (
     shape_of as shape_of,
 )
 from .custom import CustomLaw as CustomLaw, custom_law as custom_law
-from .named_law import Law as Law, law as law
-from .table import LAW_NAMES as LAW_NAMES, LAWS as LAWS
+from .maxwell import MaxwellLaw as MaxwellLaw
+from .named_law import Law as Law, law as law, table_law as table_law
+from .table import LAW_NAMES as LAW_NAMES, LAWS as LAWS, SHIPPED_SHAPES as SHIPPED_SHAPES

@@ -21,19 +21,26 @@ class LawSpec:
     """One row of the law table.
 
     `coefficients(params, v0)` returns the family coefficients
-    `(c, n, b, p, P_compression, P_restitution)` in SI units; `None` for laws outside the
-    family (Maxwell). `split`: the force jumps at maximum compression (a dry force), so the
+    `(c, n, b, p, P_compression, P_restitution)` in SI units; `None` for a law outside the
+    family. `state`: a law that carries a contact state beyond `(x, v)` (Maxwell's force,
+    eqs. 10-11; later a plastic law's largest overlap, an adhesive neck) is its own final
+    class (an `AbstractLaw` with its own `dynamics`), named here; `law(name, ...)` builds
+    that class, and `None` builds the family's `Law` from `coefficients`. `split`: the force
+    jumps at maximum compression (a dry force), so the
     contact is integrated as two smooth phases; `dry`: that force can hold the body at rest.
     `gap` says where the force criterion ends contact: `"force"` (a dry force makes `F`
     itself cross zero), `"x"` (the force only vanishes at `x = 0`), or the exponent `n - p`
     of the reduced force `F / x^p` (`"power"`: computed from the law's own `n` and `p`).
     `one_group`: without gravity the impact depends on the one group `beta` alone (the
-    family without a dry force), so `impact` can read it off the universal curves;
-    `shape`: the exponents `(n, p)`, each a number or the name of the parameter that holds
-    it (`shape_parameters`: those names, which must be known numbers, not traced values,
-    for the curves to serve). `closed_form`: `impact` has an
-    exact solution for every parameter value without gravity (`closed_forms.closed_form_for`);
-    `closed_form_gravity`: that solution holds with gravity too (any `g >= 0`).
+    family without a dry force), so `impact` can read it off the universal curves, whose
+    shipped shapes are those of these rows (`table.SHIPPED_SHAPES`);
+    `shape`: the exponents `(n, p)` of a family law, each a number or the name of the
+    parameter that holds it (`shape_parameters`: those names, which must be known numbers,
+    not traced values, for the curves to serve); `()` outside the family. `closed_form`:
+    the exact impact for every parameter value without gravity, as a function
+    `closed_form(separation) -> f(law, *, m, v0, g, rest_tol) -> dict` of `ImpactResult`
+    fields (`closed_forms.py`; `None`: none), which `AbstractLaw.closed_form` hands to
+    `impact`; `closed_form_gravity`: that solution holds with gravity too (any `g >= 0`).
     `damping`: the parameter that sets the dissipation (what `restitution_map` varies and a
     fit frees first); `map_range`, `map_fixed`: the map's default range of it and the other
     parameters held (the seed paper's set m = 1 kg, v0 = 2.5 m/s, c = 2e6 lies inside, from
@@ -51,13 +58,14 @@ class LawSpec:
     parameters: tuple[str, ...]
     units: dict[str, str]
     reference: str
-    coefficients: Callable | None
+    coefficients: Callable | None = None
+    state: type | None = None
     gap: str | float = "force"
     split: bool = False
     dry: bool = False
     defaults: dict[str, float] = dataclasses.field(default_factory=dict)
     one_group: bool = False
-    closed_form: bool = False
+    closed_form: Callable | None = None
     closed_form_gravity: bool = False
     shape: tuple = ()
     damping: str | None = None
@@ -67,6 +75,10 @@ class LawSpec:
     nominal: Callable | None = None
     positive: tuple[str, ...] = ("c", "n")
 
+    def __post_init__(self):
+        if (self.coefficients is None) == (self.state is None):
+            raise ValueError(f"row {self.name!r}: give coefficients (the family) or state")
+
     @property
     def shape_parameters(self) -> tuple[str, ...]:
         """The parameters that hold the shape's exponents (no repeats)."""
@@ -74,21 +86,54 @@ class LawSpec:
 
 
 class AbstractLaw(eqx.Module):
-    """A contact force law. Its array fields are its parameters (what a fit updates)."""
+    """A contact force law. Its array fields are its parameters (what a fit updates).
+
+    What every law declares: `name`, its row `spec` of the law table (`None` for a user's
+    own law, which has no row), `params` (its parameters by name, arrays), whether its
+    force is a contact state (`has_state`: it has no `force(x, v)`; Maxwell), its
+    `dynamics` and `replace`. The rest of the library reads these, never probes for them.
+    The concrete laws are final: `Law` (the family of the table), `MaxwellLaw`, `CustomLaw`.
+    """
+
+    name: eqx.AbstractVar[str]
+    spec: eqx.AbstractVar[LawSpec | None]
+    params: eqx.AbstractVar[dict[str, Array]]
+    has_state: eqx.AbstractClassVar[bool]
 
     @abc.abstractmethod
     def dynamics(self, *, m, v0, g) -> AbstractDynamics:
         """The nondimensional equations of one contact (mass m in kg, speed v0 in m/s,
         gravity g in m/s^2 along the inward normal)."""
 
-    @property
-    @abc.abstractmethod
-    def parameters(self) -> dict[str, Array]:
-        """The law's parameters by name."""
-
     @abc.abstractmethod
     def replace(self, **params) -> "AbstractLaw":
         """The same law with some parameters changed."""
+
+    @abc.abstractmethod
+    def force(self, x, v, **kwargs):
+        """The contact force (N) at penetration `x` (m) and velocity `v` (m/s); a law whose
+        force is a state (`has_state`) raises instead."""
+
+    @property
+    def parameters(self) -> dict[str, Array]:
+        """The law's parameters by name."""
+        return dict(self.params)
+
+    def coefficients(self, v0):
+        """The family coefficients `(c, n, b, p, P_compression, P_restitution)` (SI) of a law
+        of the family `F = c x^n + b x^p v + P d(v)` at impact speed `v0`; `None` for the
+        others (a force that is a state, a user's law)."""
+        return None
+
+    def closed_form(self, separation: str, *, g_is_zero: bool = True):
+        """The exact impact `impact` may take for this law, or `None` (a static decision):
+        the row's `closed_form` built for `separation`, where it holds (every `g` where the
+        row says `closed_form_gravity`, else `g = 0` only). The function returned is
+        `f(law, *, m, v0, g, rest_tol) -> dict` of `ImpactResult` fields."""
+        spec = self.spec
+        if not (spec and spec.closed_form) or not (g_is_zero or spec.closed_form_gravity):
+            return None
+        return spec.closed_form(separation)
 
     def __getattr__(self, item):
         params = self.__dict__.get("params")
@@ -100,11 +145,12 @@ class AbstractLaw(eqx.Module):
 def shape_of(law) -> tuple[float, float] | None:
     """The exponents `(n, p)` of a one-group law as numbers, or `None` (not one-group, or
     its exponents are traced values under a transformation)."""
-    spec = getattr(law, "spec", None)
-    if spec is None or not spec.one_group:
+    if not (law.spec and law.spec.one_group):
         return None
     try:
-        return tuple(float(law.params[q]) if isinstance(q, str) else float(q) for q in spec.shape)
+        return tuple(
+            float(law.params[q]) if isinstance(q, str) else float(q) for q in law.spec.shape
+        )
     except (TypeError, jax.errors.ConcretizationTypeError, jax.errors.TracerArrayConversionError):
         return None
 
@@ -115,8 +161,8 @@ _DAMPING_NAMES = ("b", "b1", "a", "d", "e_nominal", "P")
 def damping_parameter(law) -> str | None:
     """The parameter that sets a law's (or a row's) dissipation: the row's `damping`; for a
     user's own law, the first of b, b1, a, d, e_nominal, P that it has (None: none)."""
-    spec = law if isinstance(law, LawSpec) else getattr(law, "spec", None)
-    if spec is not None and spec.damping is not None:
+    spec = law if isinstance(law, LawSpec) else law.spec
+    if spec and spec.damping is not None:
         return spec.damping
     return next((k for k in _DAMPING_NAMES if k in law.parameters), None)
 

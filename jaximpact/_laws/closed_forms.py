@@ -4,8 +4,10 @@
 - Maxwell (eqs. 10-11) under the force criterion, under-damped (`4 b^2 > m c`): the
   paper's formulas, kept as an oracle (`impact` uses `closed_forms_linear.maxwell_impact`,
   which holds for every damping and both criteria).
-- `closed_form_for`: the exact impact `impact` takes for a law of the table (Kelvin-Voigt,
-  with gravity too; Bingham, eqs. 7 and 9, and Maxwell: `closed_forms_linear`).
+- The exact impacts the law table's rows hold (`LawSpec.closed_form`, taken by `impact`
+  through `AbstractLaw.closed_form`): `kelvin_voigt_closed_form` (with gravity too),
+  `bingham_closed_form` (eq. 7), `bingham_compression_closed_form` (eq. 9) and
+  `maxwell_closed_form` (eqs. 10-11), the last three through `closed_forms_linear`.
 - The undamped power-law spring `F = c x^n`: `x_max` and `T`.
 - The restitution of the Hunt-Crossley family `F = c x^n (1 + D v)`, a function of
   `D v0` only (through the Lambert W function).
@@ -330,29 +332,6 @@ def _hunt_crossley_restitution(alpha):
     return jnp.where(valid, e, jnp.where(alpha == jnp.inf, 0.0, jnp.nan))
 
 
-def closed_form_for(law, separation, *, g_is_zero=True):
-    """The closed form `impact` may use for `law`, or `None` (a static decision).
-
-    The law table owns the facts (`LawSpec.closed_form`: exact for every parameter value
-    without gravity; `closed_form_gravity`: with it too). The function returned,
-    `f(law, *, m, v0, g, rest_tol) -> dict` of `ImpactResult` fields, holds for every `g`
-    where the row says so (then `g_is_zero` does not change it), else for `g = 0` only
-    (`None` when `g_is_zero` is False):
-
-    - Kelvin-Voigt: eq. 5's formulas (`kelvin_voigt`) at `g = 0`, the piecewise
-      oscillator (`closed_forms_linear.linear_impact`) under gravity.
-    - Bingham (eq. 7) and Bingham in compression (eq. 9): `linear_impact`, any `g`.
-    - Maxwell (eqs. 10-11): `closed_forms_linear.maxwell_impact`, every damping, `g = 0`.
-    """
-    spec = getattr(law, "spec", None)
-    if spec is None or not spec.closed_form:
-        return None
-    if not (g_is_zero or spec.closed_form_gravity):
-        return None
-    build = _CLOSED_FORMS.get(law.name)
-    return None if build is None else build(separation)
-
-
 def exact_batch(name: str, params: dict, *, m, v0, separation: str) -> dict | None:
     """`e`, `T` (s) and `status` of a batch of law `name`'s impacts from an exact solution
     that holds for every member, or `None`: Maxwell under the force criterion when every
@@ -381,7 +360,10 @@ def _finish(fields, m, v0, g=0.0):
     return fields
 
 
-def _kelvin_voigt_impact(separation):
+def kelvin_voigt_closed_form(separation):
+    """Kelvin-Voigt (eq. 1): eq. 5's formulas (`kelvin_voigt`) at `g = 0`, the piecewise
+    oscillator (`closed_forms_linear.linear_impact`) under gravity; any damping."""
+
     def impact_fields(law, *, m, v0, g=0.0, rest_tol):
         from .closed_forms_linear import linear_impact
 
@@ -431,7 +413,9 @@ def _linear_impact(p_in, p_out, damped, dry):
     return build
 
 
-def _maxwell_impact(separation):
+def maxwell_closed_form(separation):
+    """Maxwell (eqs. 10-11): `closed_forms_linear.maxwell_impact`, every damping, `g = 0`."""
+
     def impact_fields(law, *, m, v0, g=0.0, rest_tol):
         from .closed_forms_linear import maxwell_impact
 
@@ -442,9 +426,8 @@ def _maxwell_impact(separation):
     return impact_fields
 
 
-_CLOSED_FORMS = {
-    "kelvin_voigt": _kelvin_voigt_impact,
-    "bingham": _linear_impact(lambda p: p, lambda p: p, damped=True, dry=True),
-    "bingham_compression": _linear_impact(lambda p: p, jnp.zeros_like, damped=False, dry=False),
-    "maxwell": _maxwell_impact,
-}
+# Bingham (eq. 7) and Bingham in compression (eq. 9): `linear_impact`, any `g`
+bingham_closed_form = _linear_impact(lambda p: p, lambda p: p, damped=True, dry=True)
+bingham_compression_closed_form = _linear_impact(
+    lambda p: p, jnp.zeros_like, damped=False, dry=False
+)

@@ -2,6 +2,7 @@
 `fn(x, v, params) -> F`."""
 
 from collections.abc import Callable
+from typing import ClassVar
 
 import equinox as eqx
 import jax.numpy as jnp
@@ -9,9 +10,9 @@ import numpy as np
 from jaxtyping import Array
 
 from .._checks import check_values
-from .base import AbstractLaw
+from .base import AbstractLaw, LawSpec
 from .dynamics import scaled_dynamics
-from .named_law import as_arrays
+from .parameters import as_arrays
 
 
 class CustomLaw(AbstractLaw):
@@ -20,10 +21,12 @@ class CustomLaw(AbstractLaw):
     fn: Callable = eqx.field(static=True)
     params: dict[str, Array]
     name: str = eqx.field(static=True, default="custom")
+    has_state: ClassVar[bool] = False
 
     @property
-    def parameters(self):
-        return dict(self.params)
+    def spec(self) -> LawSpec | None:
+        """A user's law has no row of the law table."""
+        return None
 
     def replace(self, **params):
         unknown = sorted(set(params) - set(self.params))

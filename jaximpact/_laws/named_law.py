@@ -1,5 +1,8 @@
-"""`Law`, a law of the table with its parameters, and `law(name, **params)` that builds
-one after checking the parameters."""
+"""`Law`, a law of the table's family `F = c x^n + b x^p v + P d(v)` with its parameters,
+and `law(name, **params)` that builds any law of the table (the row's own class where its
+force is a state) after checking the parameters."""
+
+from typing import ClassVar
 
 import equinox as eqx
 import jax
@@ -7,10 +10,11 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array
 
-from .._checks import check_nonnegative, check_positive, check_values, invalid_entries
+from .._checks import invalid_entries
 from .._powers import contact_pow
 from .base import AbstractLaw, LawSpec
-from .dynamics import maxwell_dynamics, power_dynamics
+from .dynamics import power_dynamics
+from .parameters import checked_parameters, parameter_rule
 from .table import LAW_NAMES, LAWS
 
 
@@ -22,14 +26,21 @@ class Law(AbstractLaw):
 
     name: str = eqx.field(static=True)
     params: dict[str, Array]
+    has_state: ClassVar[bool] = False
+
+    def __check_init__(self):
+        if LAWS[self.name].state is not None:
+            raise TypeError(
+                f"law {self.name!r} carries a state, so it is not a `Law`: "
+                f"build it with jaximpact.law({self.name!r}, ...)"
+            )
 
     @property
     def spec(self) -> LawSpec:
         return LAWS[self.name]
 
-    @property
-    def parameters(self):
-        return dict(self.params)
+    def coefficients(self, v0):
+        return self.spec.coefficients(self.params, v0)
 
     def replace(self, **params):
         unknown = sorted(set(params) - set(self.params))
@@ -41,8 +52,6 @@ class Law(AbstractLaw):
         return law(self.name, **{**self.params, **params})
 
     def dynamics(self, *, m, v0, g):
-        if self.spec.coefficients is None:  # Maxwell: the force is a state
-            return maxwell_dynamics(self.params["c"], self.params["b"], m=m, v0=v0, g=g)
         c, n, b, p, p_in, p_out = self.spec.coefficients(self.params, v0)
         gap = self.spec.gap
         if gap == "power":
@@ -66,13 +75,8 @@ class Law(AbstractLaw):
         """Contact force (N) at penetration `x` (m) and velocity `v` (m/s).
 
         The dry force's sign follows `compressing` (default: `v > 0`); the Hunt-Crossley
-        variants need the impact speed `v0`. Not defined for Maxwell, whose force is a state.
+        variants need the impact speed `v0`.
         """
-        if self.spec.coefficients is None:
-            raise ValueError(
-                "the Maxwell force is a state, not a function of (x, v): "
-                "read it from impact(..., ts=...).F"
-            )
         if v0 is None and self.spec.nominal is not None:
             raise ValueError(f"law {self.name!r} needs the impact speed: pass v0=...")
         c, n, b, p, p_in, p_out = self.spec.coefficients(self.params, v0)
@@ -92,54 +96,6 @@ def _power_gap(n, p):
     return "x" if k == 0 else k
 
 
-def as_arrays(params, numbers=()):
-    """The parameters as JAX arrays; those named in `numbers` (a law's shape exponents)
-    stay numpy arrays when given as numbers, so that they are still known numbers when the
-    law is built inside `jax.jit` (where `jnp.asarray` of a constant is a traced value)."""
-    arrays = {}
-    for key, value in params.items():
-        if isinstance(value, (str, bytes)) or value is None:
-            raise TypeError(
-                f"parameter {key} must be a number or an array of numbers, got {value!r}"
-            )
-        if key in numbers and isinstance(value, (int, float, np.number, np.ndarray)):
-            arrays[key] = np.asarray(value, dtype=jnp.result_type(float))
-        else:
-            arrays[key] = jnp.asarray(value, dtype=float)
-    return arrays
-
-
-def _parameter_rule(key, spec):
-    """What makes a law parameter's value invalid, besides not being finite."""
-    if key in spec.positive:
-        return lambda a: a <= 0
-    if key == "e_nominal":
-        return lambda a: (a <= 0) | (a > 1)
-    return lambda a: a < 0
-
-
-def _check_law_parameters(name, params):
-    """The parameters, each passed through its value check (eager `ValueError`, or
-    `eqx.error_if` under `jit`, whose result must be used)."""
-    checked, units = {}, LAWS[name].units
-    for key, value in params.items():
-        if key == "c":
-            checked[key] = check_positive(f"{name}: stiffness c", value, units["c"])
-        elif key == "n":
-            checked[key] = check_positive(f"{name}: exponent n", value)
-        elif key in LAWS[name].positive:
-            checked[key] = check_positive(f"{name}: {key}", value, units.get(key, ""))
-        elif key == "e_nominal":
-            checked[key] = check_values(
-                value,
-                _parameter_rule(key, LAWS[name]),
-                f"{name}: e_nominal must lie in (0, 1], got {value}",
-            )
-        else:
-            checked[key] = check_nonnegative(f"{name}: {key}", value, units.get(key, ""))
-    return checked
-
-
 def invalid_parameter_rows(name: str, params: dict) -> np.ndarray:
     """Rows of 1-D parameter arrays that `law(name, ...)` would refuse: not finite, out of
     range (the law's `positive` parameters > 0; e_nominal in (0, 1]; the rest >= 0), or
@@ -147,18 +103,14 @@ def invalid_parameter_rows(name: str, params: dict) -> np.ndarray:
     spec = LAWS[name]
     rows = np.zeros(np.shape(next(iter(params.values()))), bool)
     for key, value in params.items():
-        rows |= invalid_entries(value, _parameter_rule(key, spec))
+        rows |= invalid_entries(value, parameter_rule(key, spec))
     n, p = (params[q] if isinstance(q, str) else q for q in spec.shape or (1.0, 0.0))
     with np.errstate(invalid="ignore"):
         rows |= ~(np.asarray(p, float) <= np.asarray(n, float))
     return rows
 
 
-def _concrete_numbers(*values) -> bool:
-    return all(not isinstance(v, jax.core.Tracer) and jnp.ndim(v) == 0 for v in values)
-
-
-def law(name: str, **params) -> Law:
+def law(name: str, **params) -> AbstractLaw:
     """Build the law `name` of `LAW_NAMES` with its parameters (SI units).
 
     Parameter names are the seed paper's: `c` stiffness, `b` or `b1` damping, `P` dry force,
@@ -169,22 +121,11 @@ def law(name: str, **params) -> Law:
     """
     if name not in LAWS:
         raise ValueError(f"unknown law {name!r}; choose one of: {', '.join(LAW_NAMES)}")
-    spec = LAWS[name]
-    unknown = sorted(set(params) - set(spec.parameters))
-    if unknown:
-        raise ValueError(
-            f"law {name!r} has no parameter {', '.join(unknown)}; "
-            f"it takes {', '.join(spec.parameters)}"
-        )
-    given = {**spec.defaults, **params}
-    missing = [k for k in spec.parameters if k not in given]
-    if missing:
-        raise ValueError(
-            f"law {name!r} needs {', '.join(missing)}; it takes {', '.join(spec.parameters)}"
-            + (f" (defaults: {spec.defaults})" if spec.defaults else "")
-        )
-    given = {k: given[k] for k in spec.parameters}
-    n, p = (given[q] if isinstance(q, str) else q for q in spec.shape or (1.0, 0.0))
-    if _concrete_numbers(n, p) and not 0 <= float(p) <= float(n):  # a row with free exponents
-        raise ValueError(f"law {name!r} needs exponents 0 <= p <= n, got n={n}, p={p}")
-    return Law(name, as_arrays(_check_law_parameters(name, given), spec.shape_parameters))
+    return table_law(name, checked_parameters(LAWS[name], params))
+
+
+def table_law(name: str, params: dict) -> AbstractLaw:
+    """The law of the row `name` from parameters already checked (arrays, complete): the
+    row's own class where its force is a state (`LawSpec.state`), else the family's `Law`."""
+    state = LAWS[name].state
+    return Law(name, params) if state is None else state(params)

@@ -10,6 +10,12 @@ import jax.numpy as jnp
 
 from . import hunt_crossley_variants as _hysteresis_damping
 from .base import LawSpec
+from .closed_forms import (
+    bingham_closed_form,
+    bingham_compression_closed_form,
+    kelvin_voigt_closed_form,
+)
+from .maxwell import MAXWELL
 
 _PAPER = "Polukoshko et al. 2007"
 _UNITS = {
@@ -43,7 +49,7 @@ _SPECS = [
         gap=1,
         shape=(1.0, 0.0),
         one_group=True,
-        closed_form=True,
+        closed_form=kelvin_voigt_closed_form,
         closed_form_gravity=True,
     ),
     LawSpec(
@@ -75,7 +81,7 @@ _SPECS = [
         coefficients=lambda q, v0: _family(q["c"], 1, q["b"], 0, q["P"], -q["P"]),
         split=True,
         dry=True,
-        closed_form=True,
+        closed_form=bingham_closed_form,
         closed_form_gravity=True,
     ),
     LawSpec(
@@ -106,23 +112,10 @@ _SPECS = [
         coefficients=lambda q, v0: _family(q["c"], 1, 0.0, 0, q["P"], 0.0),
         gap=1,
         split=True,
-        closed_form=True,
+        closed_form=bingham_compression_closed_form,
         closed_form_gravity=True,
     ),
-    LawSpec(
-        name="maxwell",
-        damping="b",
-        map_range=(3000.0, 20000.0),
-        restitution_table=True,  # Fig. 7: 4 b^2 > m c
-        equation="10-11",
-        formula="spring c in series with dashpot b: dF/dt = c (v - F/b)",
-        parameters=("c", "b"),
-        units={"c": "N/m", "b": "N s/m"},
-        reference=f"{_PAPER}, eqs. 10-11",
-        coefficients=None,
-        positive=("c", "b"),
-        closed_form=True,  # without gravity: eqs. 10-11 are linear, any damping
-    ),
+    MAXWELL,  # a law with a state: its own class, its row beside it (maxwell.py)
     LawSpec(
         name="hertz_viscous",
         damping="b",
@@ -315,3 +308,18 @@ _SPECS += [
 
 LAWS: dict[str, LawSpec] = {spec.name: spec for spec in _SPECS}
 LAW_NAMES: tuple[str, ...] = tuple(LAWS)
+
+
+def _shipped_shapes():
+    """The exponents `(n, p)` of every one-group row, as numbers (a shape parameter at the
+    row's default or `map_fixed` value), each once, in the table's order."""
+    shapes = {}
+    for spec in _SPECS:
+        if spec.one_group:
+            known = {**spec.defaults, **spec.map_fixed}
+            shapes[tuple(float(known.get(q, q)) for q in spec.shape)] = None
+    return tuple(shapes)
+
+
+# the shapes whose universal curves ship with the package (`_curves.store.SHIPPED`)
+SHIPPED_SHAPES: tuple[tuple[float, float], ...] = _shipped_shapes()

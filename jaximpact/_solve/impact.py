@@ -57,10 +57,8 @@ def solve_impact(law, m, v0, g, ts, options: ImpactOptions) -> ImpactResult:
         fields = similarity_fields(dynamics, options.similarity, m=m, v0=v0, peaks=options.peaks)
         return ImpactResult(**fields, path="similarity")
     if options.closed_form:
-        from .._laws.closed_forms import closed_form_for
-
         # gravity reaches here only for a law whose closed form holds for every g
-        closed = closed_form_for(law, options.separation)
+        closed = law.closed_form(options.separation)
         fields = closed(law, m=m, v0=v0, g=g, rest_tol=options.rest_tol)
         return ImpactResult(**fields, path="closed_form")
     from .phases import assemble_integrated, integrate_phases, phase_plan
@@ -135,7 +133,7 @@ def _check_custom_law(law, v0):
     one real force (a `TypeError` or `ValueError` says what it gave instead), finite; one
     that pulls the body in there (`F(0, v0) < 0`) is not a contact force law, and what
     `impact` returns for it is said to be so (a warning), not left as a plain number."""
-    if getattr(law, "spec", None) is not None:
+    if law.spec is not None:  # a law of the table: checked by its row
         return
     try:
         out = jax.eval_shape(law.force, 0.0, v0)
@@ -185,7 +183,7 @@ def _warn_if_energy_gained(law, result, m, v0):
     """A user's law that gives the body energy over the contact (`dissipated < 0`, e > 1
     without gravity: it pulls during the contact or its damping is negative) is said to be
     unphysical: a passive contact takes energy (it once returned e = 8.4 as a result)."""
-    if getattr(law, "spec", None) is not None or isinstance(result.e, jax.core.Tracer):
+    if law.spec is not None or isinstance(result.e, jax.core.Tracer):
         return
     if np.ndim(result.e) != 0 or int(result.status) != Status.separated:
         return
@@ -274,13 +272,12 @@ def similarity_reason(
     one, no time histories, exponents known as numbers, and a shape whose impacts always
     separate (Hertz viscous under `"penetration"` is captured above a threshold, near which
     the contact lasts for ever)."""
-    name = getattr(law, "name", "custom")
+    name = law.name
     if not g_is_zero and not gravity_table:
         return "gravity adds a second group m g/(c x*^n); pass g=0 (a Python 0) or integrate"
     if ts is not None:
         return "time histories (ts=...) need the integration"
-    spec = getattr(law, "spec", None)
-    if spec is None or not spec.one_group:
+    if not (law.spec and law.spec.one_group):
         return (
             f"law {name!r} is not one-group (a dry force, Maxwell's state or a custom law); "
             "use method='integrate'"
@@ -288,7 +285,7 @@ def similarity_reason(
     shape = shape_of(law)
     if shape is None:
         return (
-            f"law {name!r} has its exponents {', '.join(spec.shape_parameters)} as traced "
+            f"law {name!r} has its exponents {', '.join(law.spec.shape_parameters)} as traced "
             "values; give them as numbers"
         )
     key = curve_key(*shape, separation)
@@ -376,7 +373,7 @@ def impact(
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     if rtol is None:
-        rtol = DEFAULT_RTOL if getattr(law, "spec", None) is not None else CUSTOM_RTOL
+        rtol = DEFAULT_RTOL if law.spec is not None else CUSTOM_RTOL
     _check_options(rtol=rtol, atol=atol, rest_tol=rest_tol, max_steps=max_steps, tau_max=tau_max)
     m = jnp.asarray(check_positive("mass m", m, "kg"), dtype=float)
     v0 = jnp.asarray(check_positive("impact speed v0", v0, "m/s"), dtype=float)
@@ -385,14 +382,10 @@ def impact(
     if jnp.ndim(m) or jnp.ndim(v0) or jnp.ndim(g):
         raise ValueError("impact takes scalar m, v0 and g; use jax.vmap for a batch")
 
-    closed = None
-    if ts is None and getattr(getattr(law, "spec", None), "closed_form", False):
-        from .._laws.closed_forms import closed_form_for
-
-        closed = closed_form_for(law, separation, g_is_zero=g_is_zero)
+    closed = None if ts is not None else law.closed_form(separation, g_is_zero=g_is_zero)
     if method == "closed_form" and closed is None:
         raise ValueError(
-            f"no closed form for law {getattr(law, 'name', 'custom')!r} with "
+            f"no closed form for law {law.name!r} with "
             f"separation={separation!r}, g={float(g)} and ts={'given' if ts is not None else None}"
         )
     key, reason = None, None

@@ -22,7 +22,7 @@ from helpers import assert_finite
 from scipy.integrate import solve_ivp
 
 import jaximpact as ji
-from jaximpact._laws.closed_forms import closed_form_for, kelvin_voigt
+from jaximpact._laws.closed_forms import kelvin_voigt
 from jaximpact._laws.closed_forms_linear import linear_impact, maxwell_impact
 
 REST_TOL = 1e-7
@@ -330,13 +330,13 @@ def test_impact_takes_the_closed_form(law, params, g, separation):
             )
         )
         assert r.path == "closed_form"
-    assert closed_form_for(made, separation, g_is_zero=g == 0) is not None
+    assert made.closed_form(separation, g_is_zero=g == 0) is not None
 
 
 def test_maxwell_with_gravity_is_integrated():
     made = ji.law("maxwell", c=2e6, b=2000.0)
-    assert closed_form_for(made, "force", g_is_zero=False) is None
-    assert closed_form_for(made, "force", g_is_zero=True) is not None
+    assert made.closed_form("force", g_is_zero=False) is None
+    assert made.closed_form("force", g_is_zero=True) is not None
     with pytest.raises(ValueError, match="no closed form for law 'maxwell'"):
         ji.impact(made, m=1.0, v0=2.5, g=9.81, method="closed_form")
 

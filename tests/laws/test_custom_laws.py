@@ -292,6 +292,13 @@ def test_every_entry_point_takes_a_plainly_written_law():
     # a batch of speeds
     out = ji.impact_batch(plain, m=1.0, v0=np.array([1.0, 2.5]), progress=False)
     np.testing.assert_allclose(out["e"][1], float(r.e), rtol=1e-9)
+    # ranked beside the table's laws: the same e(v) as Hunt-Crossley with a = 1.5 a_table
+    speeds = np.array([1.0, 2.0, 3.0])
+    e_measured = [float(ji.impact(plain, m=1.0, v0=v).e) for v in speeds]
+    ranking = ji.compare_laws(m=1.0, v0=speeds, e=e_measured, laws=["hunt_crossley", plain.replace(a=0.1)], progress=False)
+    by_name = {r.name: r for r in ranking}
+    np.testing.assert_allclose(float(by_name["custom"].fit.params["a"]), 0.3, rtol=1e-6)
+    np.testing.assert_allclose(float(by_name["hunt_crossley"].fit.params["a"]), 0.2, rtol=1e-6)
     # an export of the plain law promises its e at v0
     export = ji.export(plain, "mujoco", m=1.0, v0=2.5)
     assert math.isfinite(export.e) and abs(export.e - float(r.e)) < 0.05
