@@ -59,9 +59,7 @@ def test_every_unit_has_a_rank():
 @pytest.mark.parametrize("path", MODULES, ids=lambda p: str(p.relative_to(PACKAGE)))
 def test_imports_go_down_the_layers(path):
     unit = _unit(path)
-    upward = sorted(
-        {t for t in _imports(path) if t != unit and RANK.get(t, -1) >= RANK[unit]}
-    )
+    upward = sorted({t for t in _imports(path) if t != unit and RANK.get(t, -1) >= RANK[unit]})
     assert not upward, f"{unit} imports {upward}, which are not below it"
 
 

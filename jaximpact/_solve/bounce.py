@@ -11,8 +11,8 @@ program, differentiable in both modes (shared/notes/diffrax-impact-notes.md, sec
 
 import dataclasses
 import enum
-import warnings
 import math
+import warnings
 
 import diffrax as dfx
 import equinox as eqx
@@ -29,7 +29,7 @@ from .._status import Status
 from .adjoint import auto_adjoint
 from .flight import Flight
 from .impact import CURVES_RTOL, SEPARATIONS, ImpactOptions, gravity_impact, similarity_reason
-from .phases import assemble_integrated, integrate_phases, phase_plan
+from .phases import integrated_contact
 from .precision import resolvable_tolerances
 
 
@@ -87,23 +87,7 @@ def _contact(law, m, v_in, g, ts_local, options: ImpactOptions):
     if key is not None:
         return gravity_impact(dynamics, m, v_in, g, dataclasses.replace(options, similarity=key))
     tau_grid = None if ts_local is None else ts_local / dynamics.t_star
-    plan = phase_plan(dynamics, options.peaks or tau_grid is not None)
-    phases = integrate_phases(
-        dynamics,
-        plan=plan,
-        separation=options.separation,
-        tau_grid=tau_grid,
-        solver=options.solver,
-        rtol=options.rtol,
-        atol=options.atol,
-        max_steps=options.max_steps,
-        tau_max=options.tau_max,
-        rest_tol=options.rest_tol,
-        adjoint=options.adjoint,
-    )
-    result = assemble_integrated(dynamics, phases, plan, m=m, v0=v_in, g=g, tau_grid=tau_grid)
-    x_end = dynamics.position(phases["y"][-1]) * dynamics.x_star
-    return result, x_end
+    return integrated_contact(dynamics, options, m=m, v0=v_in, g=g, tau_grid=tau_grid)
 
 
 class ChainState(eqx.Module):

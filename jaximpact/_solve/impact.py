@@ -61,29 +61,21 @@ def solve_impact(law, m, v0, g, ts, options: ImpactOptions) -> ImpactResult:
         closed = law.closed_form(options.separation)
         fields = closed(law, m=m, v0=v0, g=g, rest_tol=options.rest_tol)
         return ImpactResult(**fields, path="closed_form")
-    from .phases import assemble_integrated, integrate_phases, phase_plan
+    from .phases import integrated_contact
 
     tau_grid = None if ts is None else ts / dynamics.t_star
-    plan = phase_plan(dynamics, options.peaks or tau_grid is not None)
     # with a time grid the histories need the integration itself
     creep = dynamics.creeping(options.rest_tol) if tau_grid is None else None
-    phases = integrate_phases(
+    return integrated_contact(
         dynamics,
-        plan=plan,
-        separation=options.separation,
+        options,
+        m=m,
+        v0=v0,
+        g=g,
         tau_grid=tau_grid,
-        solver=options.solver,
-        rtol=options.rtol,
-        atol=options.atol,
-        max_steps=options.max_steps,
-        tau_max=options.tau_max,
-        rest_tol=options.rest_tol,
-        adjoint=options.adjoint,
         hold=None if creep is None else creep["captured"],
-    )
-    return assemble_integrated(
-        dynamics, phases, plan, m=m, v0=v0, g=g, tau_grid=tau_grid, creep=creep
-    )
+        creep=creep,
+    )[0]
 
 
 def raise_if_failed(result, *, max_steps, rtol, what="the impact's solve"):
@@ -221,7 +213,7 @@ def gravity_impact(dynamics, m, v0, g, options: ImpactOptions):
     both run, and the integration skips the members the table serves, so a batch pays for
     the solver only where some member is outside). Returns the `ImpactResult` (path
     `"similarity"`) and the penetration at separation (m)."""
-    from .phases import assemble_integrated, integrate_phases, phase_plan
+    from .phases import integrated_contact
 
     fields, x_end, in_range = gravity_fields(
         dynamics, options.similarity.key, m=m, v0=v0, g=g, peaks=options.peaks
@@ -237,23 +229,7 @@ def gravity_impact(dynamics, m, v0, g, options: ImpactOptions):
         return same_types(fields), jnp.asarray(x_end, float)
 
     def integrated(_):
-        plan = phase_plan(dynamics, options.peaks)
-        phases = integrate_phases(
-            dynamics,
-            plan=plan,
-            separation=options.separation,
-            tau_grid=None,
-            solver=options.solver,
-            rtol=options.rtol,
-            atol=options.atol,
-            max_steps=options.max_steps,
-            tau_max=options.tau_max,
-            rest_tol=options.rest_tol,
-            adjoint=options.adjoint,
-            hold=in_range,
-        )
-        result = assemble_integrated(dynamics, phases, plan, m=m, v0=v0, g=g, tau_grid=None)
-        x = dynamics.position(phases["y"][-1]) * dynamics.x_star
+        result, x = integrated_contact(dynamics, options, m=m, v0=v0, g=g, hold=in_range)
         return same_types({k: getattr(result, k) for k in fields}), jnp.asarray(x, float)
 
     values, x = jax.lax.cond(in_range, table, integrated, None)

@@ -174,6 +174,32 @@ def integrate_phases(
     return phases
 
 
+def integrated_contact(dynamics, options, *, m, v0, g, tau_grid=None, hold=None, creep=None):
+    """One contact integrated as `options` (an `ImpactOptions`) say: its `ImpactResult`
+    (path `"integrated"`) and the penetration where it ended (m). `hold` skips every phase
+    (see `integrate_phases`); `creep`: a contact known in closed form never to return
+    (`AbstractDynamics.creeping`), held and assembled from that form."""
+    plan = phase_plan(dynamics, options.peaks or tau_grid is not None)
+    phases = integrate_phases(
+        dynamics,
+        plan=plan,
+        separation=options.separation,
+        tau_grid=tau_grid,
+        solver=options.solver,
+        rtol=options.rtol,
+        atol=options.atol,
+        max_steps=options.max_steps,
+        tau_max=options.tau_max,
+        rest_tol=options.rest_tol,
+        adjoint=options.adjoint,
+        hold=hold,
+    )
+    result = assemble_integrated(
+        dynamics, phases, plan, m=m, v0=v0, g=g, tau_grid=tau_grid, creep=creep
+    )
+    return result, dynamics.position(phases["y"][-1]) * dynamics.x_star
+
+
 def assemble_integrated(dynamics, phases, plan, *, m, v0, g, tau_grid, creep=None):
     x_star, t_star, scale = dynamics.x_star, dynamics.t_star, dynamics.force_scale
     last = len(plan) - 1

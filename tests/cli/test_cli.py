@@ -21,8 +21,7 @@ from helpers import assert_one_line_error, run_cli  # noqa: E402
 
 import jaximpact as ji  # noqa: E402
 from jaximpact import _cli, _format  # noqa: E402
-from jaximpact._cli import common  # noqa: E402
-from jaximpact._cli import laws as cli_laws  # noqa: E402
+from jaximpact._cli import common, laws as cli_laws  # noqa: E402
 from jaximpact._plotting import plot_impact  # noqa: E402
 
 LAW = dict(c=2e6, b1=800.0)
@@ -173,7 +172,10 @@ def test_parse_params_and_formatting():
     assert _format.format_quantity(0.9999999, "m") == "1 m"
     assert _format.format_quantity(0.0, "J") == "0 J"
     assert _format.format_number(2e6) == "2e6" and _format.format_number(800.0) == "800"
-    assert _format.jsonable({"a": np.float64(np.nan), "b": np.arange(2)}) == {"a": None, "b": [0, 1]}
+    assert _format.jsonable({"a": np.float64(np.nan), "b": np.arange(2)}) == {
+        "a": None,
+        "b": [0, 1],
+    }
 
 
 def _synthetic_result(with_histories=True):

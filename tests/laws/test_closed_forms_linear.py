@@ -225,9 +225,7 @@ def grid(law, full):
     else:
         cs, ms, v0s = (1e3, 1e7), (1.0,), (0.1, 5.0)
     zetas = ZETAS if law != "bingham_compression" else (0.0,)
-    dries = {"bingham": (0.05, 0.5, 2.0), "bingham_compression": (0.05, 0.5, 2.0)}.get(
-        law, (0.0,)
-    )
+    dries = {"bingham": (0.05, 0.5, 2.0), "bingham_compression": (0.05, 0.5, 2.0)}.get(law, (0.0,))
     gs = (0.0,) if law == "maxwell" else (0.0, 9.81)
     if law == "kelvin_voigt":
         gs = (9.81,)

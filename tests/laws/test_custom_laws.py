@@ -131,7 +131,9 @@ def _reference(np_law, params, *, m, v0, separation):
     grid = np.linspace(0, T, 2001)
     k = int(np.argmin([minus_force(t) for t in grid]))
     lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
-    peak = minimize_scalar(minus_force, bounds=(lo, hi), method="bounded", options=dict(xatol=1e-15 * T))
+    peak = minimize_scalar(
+        minus_force, bounds=(lo, hi), method="bounded", options=dict(xatol=1e-15 * T)
+    )
     F_max = max(-peak.fun, -minus_force(grid[k]))
     return dict(e=-v_out / v0, T=T, x_max=x_max, F_max=F_max)
 
@@ -274,8 +276,9 @@ def test_every_entry_point_takes_a_plainly_written_law():
     table = ji.law("hunt_crossley", c=2e6, a=0.2, n=1.5)
     # calibrate: the plain law's own e and T at v0 = 2.5 m/s, from another start
     r = ji.impact(plain, m=1.0, v0=2.5)
-    fit = ji.calibrate(plain.replace(c=1e6, a=0.1), m=1.0, v0=2.5, e=float(r.e), T=float(r.T),
-                       free=("c", "a"))
+    fit = ji.calibrate(
+        plain.replace(c=1e6, a=0.1), m=1.0, v0=2.5, e=float(r.e), T=float(r.T), free=("c", "a")
+    )
     assert bool(fit.converged)
     np.testing.assert_allclose([fit.params["c"], fit.params["a"]], [2e6, 0.3], rtol=1e-6)
     # a drop: each contact as the table law's (integrated with gravity as well)
@@ -283,11 +286,13 @@ def test_every_entry_point_takes_a_plainly_written_law():
     drop_table = ji.bounce(table, m=1.0, h0=0.6, t_end=2.0)
     count = int(np.sum(np.isfinite(np.asarray(drop_table.e))))
     assert count >= 3
-    np.testing.assert_allclose(np.asarray(drop_plain.e)[:count], np.asarray(drop_table.e)[:count],
-                               rtol=1e-7)
+    np.testing.assert_allclose(
+        np.asarray(drop_plain.e)[:count], np.asarray(drop_table.e)[:count], rtol=1e-7
+    )
     # timed impacts (audio) of that drop give back a
-    fitted = ji.fit_bounces(plain.replace(a=0.2), m=1.0, impact_times=drop_plain.impact_times[:6],
-                            free=("a",))
+    fitted = ji.fit_bounces(
+        plain.replace(a=0.2), m=1.0, impact_times=drop_plain.impact_times[:6], free=("a",)
+    )
     np.testing.assert_allclose(float(fitted.law.parameters["a"]), 0.3, rtol=1e-5)
     # a batch of speeds
     out = ji.impact_batch(plain, m=1.0, v0=np.array([1.0, 2.5]), progress=False)
@@ -295,7 +300,9 @@ def test_every_entry_point_takes_a_plainly_written_law():
     # ranked beside the table's laws: the same e(v) as Hunt-Crossley with a = 1.5 a_table
     speeds = np.array([1.0, 2.0, 3.0])
     e_measured = [float(ji.impact(plain, m=1.0, v0=v).e) for v in speeds]
-    ranking = ji.compare_laws(m=1.0, v0=speeds, e=e_measured, laws=["hunt_crossley", plain.replace(a=0.1)], progress=False)
+    ranking = ji.compare_laws(
+        m=1.0, v0=speeds, e=e_measured, laws=["hunt_crossley", plain.replace(a=0.1)], progress=False
+    )
     by_name = {r.name: r for r in ranking}
     np.testing.assert_allclose(float(by_name["custom"].fit.params["a"]), 0.3, rtol=1e-6)
     np.testing.assert_allclose(float(by_name["hunt_crossley"].fit.params["a"]), 0.2, rtol=1e-6)
