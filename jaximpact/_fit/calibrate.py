@@ -450,15 +450,17 @@ def _start_on_curves(law, free, *, m, v0, e, T, has_T, key):
 
 
 def _residual_function(
-    law, free, *, m, separation, g, rtol, has_e, has_T, curves=None, peaks=False
-):
+    law, free, *, m, separation, g, rtol, has_e, has_T, curves=None, closed_form=False,
+    peaks=False,
+):  # fmt: skip
     """Weighted residuals and predictions `(e, T, status)` (with `peaks`, also `x_max`
     and `F_max`); differentiated in forward mode only (through `with_forward_jacobian`),
     hence the explicit `ForwardMode` adjoint. With `curves` (a `CurveKey`) every impact
-    is read off the universal curves: no ODE solve."""
+    is read off the universal curves, with `closed_form` taken from the law's exact
+    solution (Kelvin-Voigt, Bingham, Maxwell): no ODE solve."""
     options = ImpactOptions(
         separation=separation,
-        closed_form=False,
+        closed_form=closed_form,
         solver=dfx.Tsit5(),
         rtol=rtol,
         atol=rtol,
@@ -583,8 +585,9 @@ def calibrate(
     - `rtol`: tolerance of each impact solve.
     - `method`: `"auto"` reads every impact off the universal curves where they serve (a
       one-group law, `g = 0`; see `impact`), with the start read off them too (at one
-      speed with `e` and `T`, that start is the answer); `"similarity"` insists,
-      `"integrate"` solves the ODE for every impact.
+      speed with `e` and `T`, that start is the answer), else takes the law's exact
+      solution where it has one (Kelvin-Voigt, Bingham 7 and 9 with any `g`, Maxwell at
+      `g = 0`); `"similarity"` insists, `"integrate"` solves the ODE for every impact.
     A batch of fits (one body per element: its own mass, speeds and targets) is `jax.vmap`
     over a lambda, `jax.jit(jax.vmap(lambda m, e, T: calibrate(start, m=m, v0=v0, e=e, T=T)))`,
     which returns one `Fit` whose fields carry a leading batch axis; a batch runs until its
@@ -663,6 +666,11 @@ def calibrate(
         has_sigma=has_sigma,
         curves=curves,
         start_on_curves=init == "auto" and curves is not None,
+        # an exact solution where the law has one (Kelvin-Voigt, Bingham 7 and 9 with any
+        # g, Maxwell without gravity), unless the caller asked for the integration
+        closed_form=curves is None
+        and method == "auto"
+        and law.closed_form(separation, g_is_zero=g_is_zero) is not None,
     )
     fit = _fit(law, data, m, np.float64(g) if g_is_zero else jnp.asarray(g, dtype=float),
                np.float64(target_tol), options)  # fmt: skip
@@ -780,6 +788,7 @@ class _Options(eqx.Module):
     has_sigma: bool = eqx.field(static=True)
     curves: object = eqx.field(static=True, default=None)
     start_on_curves: bool = eqx.field(static=True, default=False)
+    closed_form: bool = eqx.field(static=True, default=False)
 
 
 @eqx.filter_jit
@@ -802,6 +811,7 @@ def _fit(law, data, m, g, target_tol, options):
         has_e=options.has_e,
         has_T=options.has_T,
         curves=options.curves,
+        closed_form=options.closed_form,
     )
     # one traced copy of the residuals and of their Jacobian, shared by every call site
     raw = jax.jit(raw)
@@ -841,7 +851,8 @@ def _fit(law, data, m, g, target_tol, options):
     # curves they cost nothing, an integrated law adds their events to this one solve
     final = _residual_function(law, free, m=m, separation=options.separation, g=g,
                                rtol=options.rtol, has_e=options.has_e, has_T=options.has_T,
-                               curves=options.curves, peaks=True)  # fmt: skip
+                               curves=options.curves, closed_form=options.closed_form,
+                               peaks=True)  # fmt: skip
     r, (e_fit, T_fit, status, x_max, F_max) = final(theta, data)
     (_, _), jacobian = jacobian_fn(theta, data)
     final_loss = 0.5 * jnp.sum(r**2)

@@ -630,3 +630,24 @@ def test_sanity_echo_of_the_fitted_law():
     text = fits[1].summary()
     assert "m          = 1000 kg" in text and "F_max      = [1.033 MN] (implied by the fit)" in text
     assert fits[1].to_dict()["m"] == 1000.0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "name, truth, start",
+    [
+        ("bingham", dict(c=2e6, b=400.0, P=100.0), dict(c=1e6, b=200.0, P=100.0)),
+        ("maxwell", dict(c=2e6, b=2000.0), dict(c=1e6, b=1000.0)),
+    ],
+)
+def test_calibrate_takes_the_closed_form(name, truth, start):
+    """Bingham and Maxwell fits read each impact off their exact solution (no ODE solve):
+    their own e and T give the parameters back to 1e-10 (the integrated fit: ~1e-8)."""
+    r = ji.impact(ji.law(name, **truth), m=1.0, v0=2.5)
+    assert r.path == "closed_form"
+    fit = ji.calibrate(
+        ji.law(name, **start), m=1.0, v0=2.5, e=float(r.e), T=float(r.T), free=("c", "b")
+    )
+    assert bool(fit.converged)
+    for key in ("c", "b"):
+        assert float(fit.params[key]) == pytest.approx(truth[key], rel=1e-10)
