@@ -3,31 +3,12 @@
 The public names below load their module on first use (PEP 562), so that `import jaximpact`
 costs little and a call pays only for what it needs: an impact read off the universal
 curves never imports diffrax or optimistix, and nothing imports matplotlib before a plot.
-The first use also turns on JAX's persistent compilation cache (`_cache`; opt out with
-`JAXIMPACT_CACHE_DIR=`), so a second process reuses the compiled programs.
+Neither importing the package nor reading a name changes JAX's configuration or the
+environment: float64 and the persistent compilation cache are the command line's settings
+(`_cli.main`) and a Python user's choice (`jax.config`, `enable_cache()`).
 """
 
 import importlib as _importlib
-import os as _os
-import sys as _sys
-
-if _os.path.basename(_sys.argv[0]) == "jaximpact":
-    # the command line: XLA's CPU compiler logs harmless "algebraic simplifier ... circular"
-    # notes at error level for diffrax's loops; the level is read when jax loads, so it is
-    # set here, before anything imports jax, and only for the `jaximpact` console script
-    _os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "3")
-    # equinox's run-time checks inside the compiled fits (lineax's, in the implicit
-    # derivative of diffrax's event times) are host callbacks, and JAX does not store a
-    # program with host callbacks in its persistent cache; as NaN instead (which the fits
-    # already report as a failed solve) the second `jaximpact calibrate` skips XLA's
-    # compilation: 14 s -> 8 s (benchmarks/first_calls.md). Inputs are checked before.
-    _os.environ.setdefault("EQX_ON_ERROR", "nan")
-    # Ctrl-C or SIGTERM while the command line starts (importing JAX takes a second):
-    # nothing is written yet, so stop at once with one line; `main` installs the handlers
-    # that stop a running command cleanly (`_interrupt`)
-    from ._interrupt import stop_at_once as _stop_at_once
-
-    _stop_at_once()
 
 # public name -> the private module that defines it, grouped as the package is layered:
 # force laws, one impact, one drop, fitting, many impacts, studies, figures, the paper
@@ -41,6 +22,12 @@ _PUBLIC = {
     "custom_law": "_laws",
     "law": "_laws",
     "safe_pow": "_powers",
+    # the process: JAX's compilation cache, progress meters
+    "enable_cache": "_cache",
+    "AbstractMeter": "_progress",
+    "NoMeter": "_progress",
+    "TextMeter": "_progress",
+    "TqdmMeter": "_progress",
     # one impact
     "ImpactResult": "_solve.results",
     "impact": "_solve.impact",
@@ -93,10 +80,6 @@ __all__ = sorted([*_PUBLIC, *_SUBMODULES])
 
 
 def __getattr__(name):
-    if name in _PUBLIC or name in _SUBMODULES:
-        from ._cache import enable_persistent_cache
-
-        enable_persistent_cache()  # compiled programs kept between processes (_cache)
     if name in _PUBLIC:
         value = getattr(_importlib.import_module(f".{_PUBLIC[name]}", __name__), name)
     elif name in _SUBMODULES:

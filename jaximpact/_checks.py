@@ -6,8 +6,10 @@ import jax.numpy as jnp
 import numpy as np
 
 
-def _is_concrete(value) -> bool:
-    return not isinstance(value, jax.core.Tracer)
+def is_traced(value) -> bool:
+    """Whether `value` is a JAX tracer (inside `jit`, `vmap`, `grad`): it has no numbers, so
+    a check must wait for run time and a report shows its shape. The one place that asks."""
+    return isinstance(value, jax.core.Tracer)
 
 
 def check_values(value, bad, message: str):
@@ -16,7 +18,7 @@ def check_values(value, bad, message: str):
     Concrete inputs are checked at once (a one-line `ValueError`); traced inputs through
     `eqx.error_if`, so the check survives `jit` (and raises at run time).
     """
-    if _is_concrete(value):
+    if not is_traced(value):
         array = np.asarray(value, dtype=float)
         if array.size == 0 or np.any(~np.isfinite(array)) or np.any(bad(array)):
             raise ValueError(message)
@@ -56,7 +58,7 @@ def _negative(a):
 
 def _show(value, bad) -> str:
     """The value, or for an array its first bad entry and where it is."""
-    if not _is_concrete(value):
+    if is_traced(value):
         return "a traced value"
     array = np.asarray(value)
     if array.size == 0:
@@ -90,7 +92,7 @@ def check_scale(name: str, value, unit: str = ""):
     outside [1e-150, 1e150] (0, NaN, inf and traced values are left to the other checks):
     such an input puts an impact's scales (energy, penetration, duration, force) where
     float64 underflows or overflows, 1e-300 kg as 1e300 kg."""
-    if not _is_concrete(value):
+    if is_traced(value):
         return value
     array = np.asarray(value, dtype=float)
     bad = [x for x in array.ravel().tolist() if out_of_scale(x)]

@@ -9,9 +9,13 @@ otherwise), or a directory that holds an input and that the run writes into or r
 another name). `atomic_output` gives a temporary name beside the final one and renames it
 into place only when the writing finished: a run stopped at any instant (an error,
 Ctrl-C, SIGTERM) leaves the final name as it was, the old file or none.
+
+`read_csv` reads a small CSV file whole (`calibrate --data`, recordings); the tables of
+`batch` stream in chunks through `_batch.readers` instead.
 """
 
 import contextlib
+import csv
 import os
 from collections.abc import Iterable
 from pathlib import Path
@@ -106,3 +110,23 @@ def write_text(path, text: str):
     """`Path(path).write_text(text)`, renamed into place whole (`atomic_output`)."""
     with atomic_output(path) as temporary:
         temporary.write_text(text)
+
+
+def read_csv(text: str, *, comments: bool = False):
+    """The header and rows of a small CSV file read whole: `(header, [(line, cells), ...])`,
+    each cell a string as written (the csv module's quoting: a quoted cell may hold commas
+    and line breaks), `line` the number in the file (from 1) of the line the row starts on.
+    Blank lines are skipped (and with `comments`, lines whose first character other than a
+    space is `#`); the header is the first row kept (`[]` and no rows if none is)."""
+    kept = [
+        (number, line)
+        for number, line in enumerate(text.splitlines(keepends=True), start=1)
+        if not (comments and line.lstrip().startswith("#"))
+    ]
+    reader = csv.reader(line for _, line in kept)
+    rows, start = [], 0
+    for cells in reader:
+        if cells and not (len(cells) == 1 and not cells[0].strip()):  # not a blank line
+            rows.append((kept[start][0], cells))
+        start = reader.line_num
+    return (rows[0][1], rows[1:]) if rows else ([], [])

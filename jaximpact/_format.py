@@ -44,11 +44,6 @@ def jsonable(value):
     return str(value)
 
 
-def is_traced(value) -> bool:
-    """Whether `value` is a JAX tracer (inside `jit`, `vmap`, `grad`): it has no numbers."""
-    return any(c.__name__ == "Tracer" for c in type(value).__mro__)
-
-
 def _shape_text(value) -> str:
     dtype = str(getattr(value, "dtype", "float"))
     short = {"float64": "f64", "float32": "f32", "int32": "i32", "int64": "i64", "bool": "bool"}
@@ -67,6 +62,8 @@ def format_value(value, unit: str | None = "", digits: int = 4) -> str:
     """
     if value is None:
         return "-"
+    from ._checks import is_traced  # here: the command line imports this module without JAX
+
     if is_traced(value):
         return f"traced {_shape_text(value)}"
     if isinstance(value, str):

@@ -12,6 +12,8 @@
   `.ci/run` sets `HYPOTHESIS_PROFILE=ci` (`derandomize`: the same examples on every run),
   so that a landing does not depend on the draw. A failure found by chance locally becomes
   an `@example` of its test.
+- JAX's persistent compilation cache on, as a user turns it on (`jaximpact.enable_cache()`;
+  the library itself changes no JAX setting): compiled programs are reused between runs.
 - The command line's progress reports (on stderr, also when it is not a terminal) are turned
   off for the tests, which check stderr line by line; tests of the progress turn it on.
 """
@@ -25,11 +27,14 @@ os.environ.setdefault("JAXIMPACT_PROGRESS", "off")
 import jax  # noqa: E402
 from hypothesis import settings  # noqa: E402
 
+import jaximpact  # noqa: E402
+
 settings.register_profile("ci", derandomize=True, database=None)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
 
 jax.config.update("jax_enable_x64", True)
 jax.config.update("jax_numpy_rank_promotion", "raise")
+jaximpact.enable_cache()
 
 _TESTS = os.path.dirname(os.path.abspath(__file__))
 if _TESTS not in sys.path:

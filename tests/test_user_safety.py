@@ -390,3 +390,26 @@ def test_dir_of_the_package_lists_its_public_names_only():
     for name in ("impact", "law", "calibrate", "export", "batch_file", "ImpactResult", "Fit"):
         assert name in public and getattr(ji, name) is not None
     assert "__version__" in names
+
+
+def test_importing_and_reading_every_name_leaves_jax_and_the_environment_alone():
+    """JAX's configuration is the user's: only the command line (and `enable_cache()`, when
+    called) changes it; a fresh process, since this one's conftest turned the cache on."""
+    child = _python(
+        """
+        import json, os
+        import jax
+        flags = ("jax_enable_x64", "jax_compilation_cache_dir",
+                 "jax_persistent_cache_min_compile_time_secs",
+                 "jax_persistent_cache_min_entry_size_bytes")
+        before = [getattr(jax.config, f) for f in flags], dict(os.environ)
+        import jaximpact
+        for name in jaximpact.__all__:
+            getattr(jaximpact, name)
+        after = [getattr(jax.config, f) for f in flags], dict(os.environ)
+        print(json.dumps(before == after))
+        """
+    )
+    out, err = child.communicate(timeout=120)
+    assert child.returncode == 0, err
+    assert out.strip() == "true"

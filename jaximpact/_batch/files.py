@@ -27,7 +27,7 @@ import numpy as np
 from .._files import check_outputs, check_suffix, temporary_name
 from .._interrupt import check_interrupt, set_note
 from .._laws import LAWS, law as make_law
-from .._progress import Progress
+from .._progress import AbstractMeter, metered
 from .._status import Status
 from .impacts import batch_path, impact_batch
 from .parts import FLOAT_OUTPUTS, OUTPUTS, Parts
@@ -79,7 +79,7 @@ def batch_file(
     separation: str | None = None,
     chunk_rows: int = 100_000,
     resume: bool = False,
-    progress: bool = True,
+    progress: bool | AbstractMeter = True,
     mesh: str = "local",
     **impact_options,
 ) -> BatchFile:
@@ -102,6 +102,8 @@ def batch_file(
       resumption).
     - `resume`: reuse the chunks an interrupted run left in `OUT.parts/` whose inputs and
       settings have not changed; recompute the others.
+    - `progress`: a meter of the checking pass and of the chunks: `True` the default one (on
+      stderr), `False` none, or an `AbstractMeter`.
 
     A `ValueError` names the first bad column or row (CSV line numbers count the header as
     1) before anything is computed or written. Rows that fail (stuck, captured, out of steps,
@@ -179,7 +181,7 @@ def batch_file(
     set_note(f"nothing computed yet, {out} not written")
     digests, rows, chunks, problem = {}, 0, 0, None
     estimate = max(1, -(-table.estimated_rows() // chunk_rows))
-    with Progress(estimate, f"checking {label}{tag}", enabled=progress and not one_pass) as bar:
+    with metered(False if one_pass else progress, estimate, f"checking {label}{tag}") as bar:
         for index, chunk in enumerate(() if one_pass else table.chunks(chunk_rows)):
             if group.owns(index) and problem is None:
                 try:
@@ -192,7 +194,7 @@ def batch_file(
             rows += table.size(chunk)
             chunks += 1
             bar.total = max(bar.total, chunks)
-            bar.update(f"{rows:,} rows")
+            bar.update(1, f"{rows:,} rows")
         bar.total = chunks
     problems = sorted(tuple(p) for p in group.gather(problem) if p is not None)
     if problems:
@@ -217,7 +219,7 @@ def batch_file(
     failed = True
     _note_kept(parts, out, 0, len(own))
     try:
-        with Progress(max(len(own), 1), f"batch {law}{tag}", enabled=progress) as bar:
+        with metered(progress, max(len(own), 1), f"batch {law}{tag}") as bar:
             for round_ in _rounds(enumerate(table.chunks(chunk_rows)), group.count):
                 check_interrupt()  # a safe point: Ctrl-C or SIGTERM stops here at the latest
                 if one_pass:
@@ -248,7 +250,7 @@ def batch_file(
                 _note_kept(parts, out, computed + reused, len(own))
                 if mine is not None:
                     done_rows += table.size(mine[1])
-                    bar.update(_rate(done_rows, own_rows, time.perf_counter() - start))
+                    bar.update(1, _rate(done_rows, own_rows, time.perf_counter() - start))
         if one_pass and rows == 0:
             raise ValueError("chunks: no rows in any chunk")
         failed = False

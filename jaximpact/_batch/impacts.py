@@ -15,6 +15,7 @@ import numpy as np
 from .._checks import check_nonnegative, check_positive, invalid_entries
 from .._laws import LAW_NAMES, LAWS, AbstractLaw, CustomLaw, custom_law, law as make_law
 from .._laws.named_law import invalid_parameter_rows, table_law
+from .._progress import AbstractMeter
 from .._solve.impact import CURVES_RTOL, impact, similarity_reason
 from .._status import Status
 from .runner import run_batch
@@ -234,7 +235,7 @@ def impact_batch(
     fields: tuple = IMPACT_FIELDS,
     order: str = "cost",
     chunk_size: int | None = None,
-    progress: bool = True,
+    progress: bool | AbstractMeter = True,
     devices=None,
     exact: bool = True,
     invalid: str = "mark",

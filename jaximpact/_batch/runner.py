@@ -40,7 +40,7 @@ import jax
 import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec, SingleDeviceSharding
 
-from .._progress import Progress
+from .._progress import AbstractMeter, metered
 
 _AXIS = "batch"
 
@@ -156,7 +156,7 @@ def run_batch(
     inputs,
     *,
     chunk_size: int = 1024,
-    progress: bool = True,
+    progress: bool | AbstractMeter = True,
     devices=None,
     cost=None,
     exact: bool = True,
@@ -195,7 +195,8 @@ def run_batch(
       first key primary). Rows run in that order, so that each block holds rows of similar
       cost (a vmapped event-terminated solve runs until its slowest member is done), and the
       outputs come back in the order of `inputs`. `None`: run in the given order.
-    - `progress`: draw a progress bar over the chunks (on stderr).
+    - `progress`: a meter of the chunks: `True` the default one (on stderr), `False` none,
+      or an `AbstractMeter`.
 
     Returns the pytree of outputs as numpy arrays with leading axis `n`.
     Several hosts: see the module docstring (`jax.distributed.initialize`, one share of the
@@ -286,16 +287,16 @@ def run_batch(
             for target, values in zip(outputs[1:], host, strict=True):
                 target[start:stop] = values[: stop - start]
 
-    with Progress(rounds, description, enabled=progress) as bar:
+    with metered(progress, rounds, description) as bar:
         pending = None
         for r in range(rounds):
             results = launch(r)  # dispatched asynchronously
             if pending is not None:  # copy the previous round back while this one runs
                 collect(*pending)
-                bar.update(f"{min(r * len(devices) * block, n):,}/{n:,} rows")
+                bar.update(1, f"{min(r * len(devices) * block, n):,}/{n:,} rows")
             pending = (r, results)
         collect(*pending)
-        bar.update(f"{n:,}/{n:,} rows")
+        bar.update(1, f"{n:,}/{n:,} rows")
 
     out_def, out_leaves = outputs[0], outputs[1:]
     if order is not None:

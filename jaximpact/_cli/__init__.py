@@ -30,6 +30,7 @@ from .common import (
     Parser,
     check_argument_scales,
     configure_jax,
+    console_environment,
     fail,
     wrap_paragraphs,
 )
@@ -86,6 +87,8 @@ def main(argv: list[str] | None = None) -> int:
     status 1 and one line (set `JAXIMPACT_DEBUG=1` for the traceback); Ctrl-C (SIGINT) or
     SIGTERM with status 130 or 143 and one line saying what was kept (`_interrupt`).
     """
+    if os.path.basename(sys.argv[0]) == PROG:  # the console script: before JAX loads
+        console_environment()
     parser = build_parser()
     args = parser.parse_args(argv)
     configure_jax()

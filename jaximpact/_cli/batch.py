@@ -115,7 +115,6 @@ def _start_processes(args):
 
 def run_batch_command(args):
     from .._batch.files import batch_file, check_output_file
-    from .._progress import progress_enabled
 
     if args.chunk_rows < 1:
         raise CLIError("--chunk-rows must be at least 1")
@@ -134,7 +133,7 @@ def run_batch_command(args):
         separation=args.separation,
         chunk_rows=args.chunk_rows,
         resume=args.resume,
-        progress=progress_enabled(),
+        progress=True,  # the default meter: none when JAXIMPACT_PROGRESS is off
         mesh=args.mesh,
     )
     counts = ", ".join(f"{n} {k}" for k, n in result.statuses.items() if n)

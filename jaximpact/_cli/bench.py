@@ -13,7 +13,7 @@ import textwrap
 from .._bench import LAWS, TARGETS, require_scipy, run_bench, steps
 from .._format import format_number
 from .._plotting import new_figure, save_figure
-from .._progress import Progress
+from .._progress import is_terminal, metered
 from .common import (
     CLIError,
     add_output_arguments,
@@ -72,8 +72,8 @@ def _run_bench(args):
     except ImportError:
         raise CLIError("jaximpact bench compares against scipy: pip install scipy") from None
     check_plot_path(args.plot)
-    with Progress(steps(laws), "bench", enabled=sys.stderr.isatty()) as bar:
-        data = run_bench(laws, quick=args.quick, on_step=bar.update)
+    with metered(is_terminal(sys.stderr), steps(laws), "bench") as bar:
+        data = run_bench(laws, quick=args.quick, on_step=lambda note: bar.update(1, note))
     if args.plot is not None:
         _plot(data, args.plot)
         data["plot"] = str(args.plot)

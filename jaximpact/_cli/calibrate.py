@@ -7,15 +7,15 @@ Without start values (`--param`), each law starts from `jaximpact.starting_law` 
 its nondimensional restitution table (`calibrate(..., init="auto")`).
 """
 
-import csv
 import math
 import sys
 from pathlib import Path
 
+from .._files import read_csv
 from .._format import format_number, format_quantity
 from .._interrupt import check_interrupt, set_note
 from .._plotting import new_figure, save_figure
-from .._progress import Progress, is_terminal, progress_enabled
+from .._progress import NoMeter, TextMeter, is_terminal, metered, progress_enabled
 from .common import (
     CLIError,
     add_law_arguments,
@@ -144,14 +144,10 @@ def read_data(path: Path) -> dict:
         raise CLIError(f"cannot read --data {path}: {error.strerror or error}") from None
     except UnicodeDecodeError:
         raise CLIError(f"--data {path} is not a text file (a CSV with columns v0,e)") from None
-    lines = [
-        (number, line)
-        for number, line in enumerate(text.splitlines(), start=1)
-        if line.strip() and not line.lstrip().startswith("#")
-    ]
-    if not lines:
+    header, rows = read_csv(text, comments=True)
+    if not header:
         raise CLIError(f"--data {path} is empty")
-    header = [name.strip() for name in next(csv.reader([lines[0][1]]))]
+    header = [name.strip() for name in header]
     unknown = [name for name in header if name not in COLUMNS]
     if unknown:
         raise CLIError(
@@ -164,8 +160,7 @@ def read_data(path: Path) -> dict:
         if needed not in header:
             raise CLIError(f"--data {path}: no column {needed!r} (need v0,e[,T,sigma_e,sigma_T])")
     columns = {name: [] for name in header}
-    for number, line in lines[1:]:
-        cells = next(csv.reader([line]))
+    for number, cells in rows:
         if len(cells) != len(header):
             raise CLIError(
                 f"--data {path}, line {number}: {len(cells)} cells for {len(header)} columns"
@@ -242,20 +237,15 @@ def _middle(data):
 # --------------------------------------------------------------------- progress bar
 
 
-def _progress(total, what, delay=None):
+def _meter(delay=None):
     """A bar redrawn every 0.2 s while the fits run (a first fit compiles for tens of seconds
     without other sign of life): after 0.5 s on a terminal; elsewhere a line every 10 s,
-    none for work under 3 s."""
+    none for work under 3 s; none at all when `JAXIMPACT_PROGRESS` is off."""
+    if not progress_enabled():
+        return NoMeter()
     if delay is None:
         delay = 0.5 if is_terminal(sys.stderr) else 3.0
-    return Progress(
-        total,
-        what,
-        enabled=progress_enabled(),
-        interval=10.0,
-        delay=delay,
-        heartbeat=0.2,
-    )
+    return TextMeter(interval=10.0, delay=delay, heartbeat=0.2)
 
 
 # ------------------------------------------------------------------------- running
@@ -318,10 +308,10 @@ def _run_one(args, data):
     free = free_names(args.free)
     fitted_names = free or default_free(start, stiffness=data["T"] is not None)
     init = args.init or ("given" if set(given) & set(fitted_names) else "auto")
-    with _progress(1, f"calibrating {args.law}") as bar:
+    with metered(_meter(), 1, f"calibrating {args.law}") as bar:
         fit = calibrate(start, free=free, init=init, **_fit_kwargs(args, data))
         jax.block_until_ready(fit)
-        bar.update("done")
+        bar.update(1, "done")
     result = _fit_record(args.law, fit, data)
     result.update(
         m=args.mass,
@@ -406,18 +396,17 @@ def _run_all(args, data):
     has_sigma = data["sigma_e"] is not None
     kwargs = _fit_kwargs(args, data)
     rankings, failed = [], {}
-    with _progress(len(laws), "fitting laws") as bar:
+    with metered(_meter(), len(laws), "fitting laws") as bar:
         for done, name in enumerate(laws):
             set_note(f"{done} of {len(laws)} laws fitted, nothing written (the ranking is "
                      "printed at the end)")  # fmt: skip
             check_interrupt()  # a safe point between fits: a Ctrl-C stops here at the latest
-            bar.label = name
             try:  # one law at a time: the verdict on the best one comes at the end
                 rankings += compare_laws(laws=(name,), progress=False, warn=False, **kwargs)
             except Exception as error:  # one law's failure must not hide the others' fits
                 check_interrupt()  # unless it was an interrupt that JAX reported as an error
                 failed[name] = f"{type(error).__name__}: {str(error).splitlines()[0]}"
-            bar.update(name)
+            bar.update(1, name)
     set_note(None)
     if not rankings:
         raise CLIError(

@@ -1,7 +1,7 @@
 """What the subcommands share: the one-line error (`CLIError`, `fail`), the parser factory
 and argument groups, reading `--param NAME=VALUE`, `--json` output (`emit`) and JAX's set-up
 (`configure_jax`). `--plot FILE` goes through `jaximpact._plotting` (matplotlib's Agg backend,
-imported only then); anything long draws a `jaximpact._progress.Progress` on stderr."""
+imported only then); anything long reports through a meter of `jaximpact._progress` on stderr."""
 
 import argparse
 import json
@@ -11,8 +11,9 @@ import textwrap
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
-from .._cache import enable_persistent_cache
+from .._cache import enable_cache
 from .._format import jsonable
+from .._interrupt import stop_at_once
 
 PROG = "jaximpact"
 DEBUG_ENV = "JAXIMPACT_DEBUG"
@@ -239,16 +240,35 @@ def emit(args, data: dict, text: str | Callable[[], str]):
         print(text() if callable(text) else text)
 
 
-def configure_jax():
-    """float64, and the persistent compilation cache (`_cache`) for every program, however
-    small."""
+def console_environment():
+    """The `jaximpact` console script's process, set before anything imports JAX (its
+    modules read these variables when they load); not for `main` called from Python."""
     # XLA's CPU compiler logs harmless "algebraic simplifier ... circular" notes at error
-    # level for diffrax's loops; keep them off the user's terminal unless asked for
+    # level for diffrax's loops; the level is read when jax loads
+    os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "3")
+    # equinox's run-time checks inside the compiled fits (lineax's, in the implicit
+    # derivative of diffrax's event times) are host callbacks, and JAX does not store a
+    # program with host callbacks in its persistent cache; as NaN instead (which the fits
+    # already report as a failed solve) the second `jaximpact calibrate` skips XLA's
+    # compilation: 14 s -> 8 s (benchmarks/first_calls.md). Inputs are checked before.
+    os.environ.setdefault("EQX_ON_ERROR", "nan")
+    # Ctrl-C or SIGTERM while the command line starts (importing JAX takes a second):
+    # nothing is written yet, so stop at once with one line; `main` installs the handlers
+    # that stop a running command cleanly (`_interrupt`)
+    stop_at_once()
+
+
+def configure_jax():
+    """The command line's JAX (the library itself changes none of it): float64, and the
+    persistent compilation cache (`_cache`) for every program, however small."""
+    # XLA's CPU compiler logs harmless "algebraic simplifier ... circular" notes at error
+    # level for diffrax's loops; keep them off the user's terminal unless asked for (read
+    # when jax loads)
     os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "3")
     import jax
 
     jax.config.update("jax_enable_x64", True)
-    enable_persistent_cache(min_compile_time_secs=0.0)
+    enable_cache(min_compile_time_secs=0.0)
 
 
 # --------------------------------------------------------------------------------------

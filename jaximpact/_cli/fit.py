@@ -309,13 +309,13 @@ def run_fit(args):
     recording = read_recording(args.file, args.format, args.where)
     law = law_from_args(args)
     length_scale, y_axis = _options(args, recording)
-    from .._progress import Progress, progress_enabled
+    from .._progress import metered
 
     fits = {}
-    with Progress(len(recording.groups), "fitting", enabled=progress_enabled()) as bar:
+    with metered(True, len(recording.groups), "fitting") as bar:
         for name, data in recording.groups.items():
             fits[name] = _fit_one(law, args, recording, name, data, length_scale, y_axis)
-            bar.update(name[:24])
+            bar.update(1, name[:24])
     units = "s" if recording.kind == "impacts" else ("px" if recording.video else "m")
     if args.plot is not None:
         _plot(fits, recording, args.plot)

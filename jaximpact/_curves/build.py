@@ -15,7 +15,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._progress import Progress
+from .._progress import metered
 from . import chebyshev
 from .curve import BETA_MAX, BETA_MIN, DEGREE, OUTPUTS, Curves
 from .reference import reference_impact
@@ -119,8 +119,7 @@ def build_curves(key: CurveKey, *, progress: bool = True, max_steps: int = 40_00
     keeps its tail as its error estimate. `max_steps` bounds each reference impact: the
     table ends where heavy damping under the penetration criterion needs more (the shipped
     shapes are built with 400 000, a shape built on first use with 40 000)."""
-    bar = Progress(1, f"building curves {key.name}", enabled=progress)
-    with bar:
+    with metered(progress, 1, f"building curves {key.name}") as bar:
         beta_max, capture = _table_end(key, max_steps)
         s_lo, s_hi = math.log(BETA_MIN), math.log(beta_max)
         edges = np.linspace(s_lo, s_hi, 13)
@@ -156,7 +155,7 @@ def build_curves(key: CurveKey, *, progress: bool = True, max_steps: int = 40_00
                     middle = 0.5 * (a + b)
                     split += [(a, middle, tail.max()), (middle, b, tail.max())]
             pending = split
-            bar.update(f"{len(accepted)} pieces")
+            bar.update(1, f"{len(accepted)} pieces")
     order = sorted(piece for piece in accepted if piece[1] <= end)
     breaks = np.array([a for a, _ in order] + [order[-1][1]])
     beta_max = math.exp(breaks[-1])

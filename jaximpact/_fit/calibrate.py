@@ -12,7 +12,7 @@ import optax
 import optimistix as optx
 from jaxtyping import Array
 
-from .._checks import check_scale
+from .._checks import check_scale, is_traced
 from .._curves.shapes import curve_key
 from .._curves.similarity import beta_for_restitution, curve_values
 from .._curves.store import curves_for
@@ -21,7 +21,6 @@ from .._format import (
     format_fields,
     format_number,
     format_value,
-    is_traced,
     jsonable,
 )
 from .._laws import AbstractLaw, damping_parameter, shape_of
@@ -317,7 +316,7 @@ def _as_rows(name, value, rows, allow_missing=False):
         if allow_missing:
             value = [np.nan if item is None else item for item in value]
         value = np.asarray(value, dtype=float)
-    xp = jnp if isinstance(value, jax.core.Tracer) else np
+    xp = jnp if is_traced(value) else np
     value = xp.atleast_1d(xp.asarray(value, dtype=float))
     if value.ndim != 1:
         raise ValueError(f"{name} must be a number or a 1-D array, got shape {value.shape}")
@@ -330,7 +329,7 @@ def _as_rows(name, value, rows, allow_missing=False):
 
 def check_targets(m, v0, e, T, sigma_e, sigma_T):
     """One-line ValueErrors for impossible targets (only for concrete inputs)."""
-    concrete = not any(isinstance(a, jax.core.Tracer) for a in (m, v0, e, T, sigma_e, sigma_T))
+    concrete = not any(is_traced(a) for a in (m, v0, e, T, sigma_e, sigma_T))
     if not concrete:
         return
     if not np.all(np.asarray(m) > 0) or not np.all(np.isfinite(np.asarray(m))):
@@ -392,7 +391,7 @@ def _initial_law(law, free, *, m, v0, e, T, separation):
     damping = spec.damping
     if damping not in free or e is None:
         return law
-    if isinstance(law.params.get("n", 0.0), jax.core.Tracer):
+    if is_traced(law.params.get("n", 0.0)):
         return law
     n = float(law.params.get("n", 1.5))  # a law with an exponent parameter: one table per n
     groups, e_table, tau_table = restitution_table(spec.name, separation, n)
@@ -621,7 +620,7 @@ def calibrate(
     sigma_e = _as_rows("sigma_e", sigma_e, rows)
     sigma_T = _as_rows("sigma_T", sigma_T, rows)
     check_targets(m, v0, e, T, sigma_e, sigma_T)
-    m = jnp.asarray(m, dtype=float) if isinstance(m, jax.core.Tracer) else np.float64(m)
+    m = jnp.asarray(m, dtype=float) if is_traced(m) else np.float64(m)
     has_sigma = sigma_e is not None or sigma_T is not None
     free = default_free(law, stiffness=T is not None) if free is None else tuple(free)
     unknown = [k for k in free if k not in law.parameters]
@@ -650,7 +649,7 @@ def calibrate(
     if sigma_T is not None:
         s_T = sigma_T
     else:
-        xp = jnp if isinstance(T, jax.core.Tracer) else np
+        xp = jnp if is_traced(T) else np
         s_T = ones if T is None else xp.where(xp.isfinite(T), T, 1.0)
     data = (v0, ones if e is None else e, ones if T is None else T, s_e, s_T)
     target_tol = (3.0 if has_sigma else 1e-6) if target_tol is None else target_tol
@@ -682,7 +681,7 @@ def _reported(fit, undetermined, why, e_only=False):
     """`fit` with what the data leave undetermined (a warning too) and, where `e` alone
     was measured for a one-group law (`e_only`), the group it determined (`notes`), after
     refusing one that left float64's range; under a transformation only the record."""
-    concrete = not isinstance(fit.loss, jax.core.Tracer)
+    concrete = not is_traced(fit.loss)
     if concrete:
         _check_finite(fit)
         if fit.stderr is not None and not fit.weighted:
@@ -763,7 +762,7 @@ def _undetermined(law, free, *, e, T, g_is_zero) -> tuple[tuple[str, ...], str]:
     def count(values):
         if values is None:
             return 0
-        if isinstance(values, jax.core.Tracer):
+        if is_traced(values):
             return values.shape[0]
         return int(np.sum(np.isfinite(np.asarray(values))))
 

@@ -10,7 +10,7 @@ from jax.scipy.special import gammaln
 
 from .._format import format_fields, format_value, jsonable
 from .._laws import LAWS, AbstractLaw, exponents, law
-from .._progress import Progress
+from .._progress import AbstractMeter, metered
 from .calibrate import Fit, calibrate
 from .parameters import default_free
 
@@ -200,7 +200,7 @@ def compare_laws(
     sigma_T=None,
     laws=PAPER_LAWS,
     separation="force",
-    progress=True,
+    progress: bool | AbstractMeter = True,
     warn: bool = True,
     max_rms_e=MAX_RMS_E,
     max_rms_T=MAX_RMS_T,
@@ -221,6 +221,9 @@ def compare_laws(
     or of `(T_fit - T)/T` above `max_rms_T` (0.05, i.e. 5 %). Each `Ranking` carries the
     numbers (`reduced_chi2`, `dof`, `rms_e`, `rms_T`).
 
+    `progress`: a meter of the fits: `True` the default one (on stderr), `False` none, or
+    an `AbstractMeter`.
+
     **Example**: `compare_laws(m=0.0027, v0=[1, 2, 3], e=[0.9, 0.87, 0.85])[0].name`.
     """
     v0_rows = np.atleast_1d(np.asarray(v0, dtype=float))
@@ -237,7 +240,7 @@ def compare_laws(
     n_data = len(e_rows) + (0 if T_rows is None else int(np.sum(np.isfinite(T_rows))))
     has_sigma = sigma_e is not None or sigma_T is not None
     rankings = []
-    with Progress(len(laws), "fitting laws", enabled=progress) as bar:
+    with metered(progress, len(laws), "fitting laws") as bar:
         for entry in laws:
             if isinstance(entry, AbstractLaw):  # a law object (a user's own): its own start
                 name, start = entry.name, entry
@@ -253,7 +256,7 @@ def compare_laws(
                 )
                 free = _free_for(name, has_T=T_rows is not None, n_data=n_data)
             if len(free) > n_data:
-                bar.update(f"{name} (skipped)")
+                bar.update(1, f"{name} (skipped)")
                 continue
             fit = calibrate(
                 start,
@@ -272,7 +275,7 @@ def compare_laws(
             aic = sum_sq + 2 * k if has_sigma else None
             bic = sum_sq + k * math.log(n_data) if has_sigma else None
             rankings.append(Ranking(name, fit, sum_sq, k, aic, bic))
-            bar.update(name)
+            bar.update(1, name)
     key = (lambda r: r.aic) if has_sigma else (lambda r: r.sum_sq)
     rankings = sorted(rankings, key=key)
     if warn and rankings:

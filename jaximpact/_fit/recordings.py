@@ -11,10 +11,10 @@ Formats (detected from the file unless `fmt` says):
 - plain numbers: two columns are `t y`, one column is impact times.
 """
 
-import csv
-import io
 import math
 from pathlib import Path
+
+from .._files import read_csv
 
 _TIME_NAMES = ("t", "time", "time_s", "t_s", "times", "seconds", "frame")
 _IMPACT_NAMES = ("event_time_s", "impact_time", "impact_times", "impact_time_s", "event_time")
@@ -85,9 +85,13 @@ def _pick(columns, names):
 
 
 def _read_csv(text, where, fmt):
-    reader = csv.DictReader(io.StringIO(text))
-    columns = reader.fieldnames or []
-    rows = list(reader)
+    columns, cells = read_csv(text)
+    # as `csv.DictReader` reads them: a short row's missing cells None, a long row's extra
+    # cells dropped
+    rows = [
+        dict(zip(columns, row + [None] * (len(columns) - len(row)), strict=False))
+        for _, row in cells
+    ]
     for condition in where:
         column, sep, value = condition.partition("=")
         if not sep or column not in columns:

@@ -23,6 +23,7 @@ import numpy as np
 import optimistix as optx
 from jax.scipy.special import gammaln
 
+from .._checks import is_traced
 from .._status import Status
 
 
@@ -260,7 +261,7 @@ def _restitution_ratio(t, alpha):
 
 
 def _check_alpha(alpha):
-    if isinstance(alpha, jax.core.Tracer):
+    if is_traced(alpha):
         return
     values = np.asarray(alpha)
     if values.dtype.kind not in "biuf":

@@ -1,11 +1,10 @@
 """A law's parameters checked against its row of the table (`checked_parameters`) and held
 as arrays (`as_arrays`): what `law(name, ...)` and every table law's `replace` build from."""
 
-import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._checks import check_nonnegative, check_positive, check_values
+from .._checks import check_nonnegative, check_positive, check_values, is_traced
 from .base import LawSpec
 
 
@@ -58,7 +57,7 @@ def _check_values(spec: LawSpec, params):
 
 
 def _concrete_numbers(*values) -> bool:
-    return all(not isinstance(v, jax.core.Tracer) and jnp.ndim(v) == 0 for v in values)
+    return all(not is_traced(v) and jnp.ndim(v) == 0 for v in values)
 
 
 def checked_parameters(spec: LawSpec, params: dict) -> dict:

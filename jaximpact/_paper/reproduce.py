@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from .._files import write_text
+from .._progress import AbstractMeter, metered
 from .cases import (
     CRITERIA,
     DROP_DURATION,
@@ -107,25 +108,26 @@ def _bounce_row(case: PaperCase) -> tuple[dict, dict]:
     return row, drops
 
 
-def reproduce_paper(out_dir, *, only=None, figures: bool = True, progress: bool = False) -> dict:
+def reproduce_paper(
+    out_dir, *, only=None, figures: bool = True, progress: bool | AbstractMeter = False
+) -> dict:
     """Recompute the seed paper's figures and tables into the directory `out_dir`.
 
     Writes `fig<N>.png` for each figure (`fig1_force.png`, `fig1_penetration.png`,
     `fig3_caption.png`, `fig3_text.png`, ...; none if `figures=False`), `table.md` (printed,
     Euler and converged `e` and `T`) and `hunt_crossley_variants.md`. `only`: figure numbers
     to restrict to (e.g. `["2", "13-15"]`; the variants table is written only without it).
-    Returns `{"rows": [...], "files": [...]}` (SI units).
+    Returns `{"rows": [...], "files": [...]}` (SI units). `progress`: a meter of the cases,
+    as in `run_batch`.
 
     **Example**: `jaximpact.reproduce_paper("paper", only=["10"])["rows"][0]["e_force"]`.
     """
-    from .._progress import Progress
-
     cases = select_cases(only)
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     rows, files = [], []
     tasks = len(cases) + (only is None)
-    with Progress(tasks, "paper", enabled=progress) as bar:
+    with metered(progress, tasks, "paper") as bar:
         for case in cases:
             if case in MAPS:
                 if figures:
@@ -143,7 +145,7 @@ def reproduce_paper(out_dir, *, only=None, figures: bool = True, progress: bool 
                 rows.append(row)
                 if figures:
                     files += plot_bounce(row, drops, out_dir)
-            bar.update(f"fig. {case.figure}")
+            bar.update(1, f"fig. {case.figure}")
         if rows:
             path = out_dir / "table.md"
             write_text(path, table_markdown(rows))
@@ -152,5 +154,5 @@ def reproduce_paper(out_dir, *, only=None, figures: bool = True, progress: bool 
             path = out_dir / "hunt_crossley_variants.md"
             write_text(path, hunt_crossley_variants_markdown())
             files.append(path)
-            bar.update("Hunt-Crossley variants")
+            bar.update(1, "Hunt-Crossley variants")
     return dict(rows=rows, files=[str(f) for f in files])

@@ -11,9 +11,11 @@ import diffrax as dfx
 import jax
 from jax._src.interpreters import ad as _ad, batching as _batching
 
+from .._checks import is_traced
+
 
 def _tracer_kinds(leaf, kinds: set):
-    while isinstance(leaf, jax.core.Tracer):
+    while is_traced(leaf):
         if isinstance(leaf, _ad.JVPTracer):
             kinds.add("forward")
         elif type(leaf).__name__ == "LinearizeTracer":

@@ -21,7 +21,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array
 
-from .._checks import check_nonnegative, check_positive, check_values
+from .._checks import check_nonnegative, check_positive, check_values, is_traced
 from .._curves.gravity import WithGravity
 from .._curves.shapes import curve_key
 from .._laws import AbstractLaw, shape_of
@@ -260,7 +260,7 @@ class BounceResult(eqx.Module):
         ts = jnp.asarray(ts, dtype=float)
         if ts.ndim != 1:
             raise ValueError("ts must be a 1-D array of times in seconds")
-        if not isinstance(ts, jax.core.Tracer) and not bool(jnp.all(ts >= 0)):  # NaN too
+        if not is_traced(ts) and not bool(jnp.all(ts >= 0)):  # NaN too
             raise ValueError("ts must be times >= 0 s from the release (no NaN)")
         # any order: the solver's save times must increase, the caller's need not
         order = jnp.argsort(ts)
@@ -389,7 +389,7 @@ def solve_bounce(law, m, g, drag, start, t_end, min_flight, options: BounceOptio
 
 def _check_real(name, value):
     """A number or array of real numbers (a traced one passes)."""
-    if value is None and name == "drag" or isinstance(value, jax.core.Tracer):
+    if value is None and name == "drag" or is_traced(value):
         return
     try:
         kind = np.asarray(value).dtype.kind
@@ -543,7 +543,7 @@ def bounce(
     min_flight = jnp.asarray(check_nonnegative("min_flight", min_flight, "s"), dtype=float)
     if drag is not None:
         drag = jnp.asarray(check_positive("air drag coefficient drag", drag, "1/m"), dtype=float)
-        concrete = not any(isinstance(a, jax.core.Tracer) for a in (drag, v_drop, g))
+        concrete = not any(is_traced(a) for a in (drag, v_drop, g))
         if concrete and float(v_drop) > 0 and float(v_drop) ** 2 * float(drag) >= float(g):
             raise ValueError(
                 f"v_drop = {float(v_drop)} m/s is not below the terminal speed "
@@ -557,7 +557,7 @@ def bounce(
         "h0 = 0 with v_drop = 0: the ball starts at rest on the floor and never bounces "
         "(give a drop height h0 > 0 m or a downward speed v_drop > 0 m/s)"
     )
-    if not any(isinstance(a, jax.core.Tracer) for a in (h0, v_drop)):
+    if not any(is_traced(a) for a in (h0, v_drop)):
         if bool(resting):
             raise ValueError(message)
     else:
@@ -584,7 +584,7 @@ def bounce(
             (result.status == BounceStatus.failed) | (result.status == BounceStatus.max_impacts),
             "the bounce sequence failed (a contact ran out of steps) or used up max_impacts",
         )
-    elif not isinstance(result.status, jax.core.Tracer) and np.ndim(result.status) == 0:
+    elif not is_traced(result.status) and np.ndim(result.status) == 0:
         if int(result.status) == BounceStatus.failed:
             # the contacts before the failed one are right and worth having: a warning, the
             # failed contact and those after it NaN (the failure rule, `Status`)

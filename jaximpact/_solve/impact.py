@@ -10,7 +10,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._checks import check_nonnegative, check_positive
+from .._checks import check_nonnegative, check_positive, is_traced
 from .._curves.gravity import WithGravity, gravity_fields, table_for
 from .._curves.shapes import CurveKey, curve_key
 from .._curves.similarity import serves, similarity_fields
@@ -83,7 +83,7 @@ def raise_if_failed(result, *, max_steps, rtol, what="the impact's solve"):
     `RuntimeError` that says what to change; traced or batched results pass (their failed
     members are NaN with their status)."""
     status = result.status
-    if isinstance(status, jax.core.Tracer) or np.ndim(status) != 0:
+    if is_traced(status) or np.ndim(status) != 0:
         return
     status = Status(int(status))
     if status == Status.out_of_steps:
@@ -104,7 +104,7 @@ def _check_representable(result, m, v0, g):
     """A concrete impact with a result that float64 cannot hold (its scales under- or
     overflow, e.g. v0 = 1e-300 m/s or g = 1e300 m/s^2) is refused, not returned as T = 0
     or NaN."""
-    if isinstance(result.T, jax.core.Tracer) or np.ndim(result.T) != 0:
+    if is_traced(result.T) or np.ndim(result.T) != 0:
         return
     if Status(int(result.status)).is_failure:
         return  # NaN by the failure rule, its status says why
@@ -150,7 +150,7 @@ def _check_custom_law(law, v0):
             f"the custom law's function must return one force for one (x, v), got shape "
             f"{out.shape} at x = 0 (parameters of shape {batch})"
         )
-    if isinstance(v0, jax.core.Tracer) or out.shape != ():
+    if is_traced(v0) or out.shape != ():
         return
     try:
         force = float(law.force(0.0, v0))
@@ -175,7 +175,7 @@ def _warn_if_energy_gained(law, result, m, v0):
     """A user's law that gives the body energy over the contact (`dissipated < 0`, e > 1
     without gravity: it pulls during the contact or its damping is negative) is said to be
     unphysical: a passive contact takes energy (it once returned e = 8.4 as a result)."""
-    if law.spec is not None or isinstance(result.e, jax.core.Tracer):
+    if law.spec is not None or is_traced(result.e):
         return
     if np.ndim(result.e) != 0 or int(result.status) != Status.separated:
         return
@@ -403,7 +403,7 @@ def impact(
         similarity=key,
     )
     result = solve_impact(law, m, v0, g, ts, options)
-    if isinstance(key, WithGravity) and not isinstance(result.num_steps, jax.core.Tracer):
+    if isinstance(key, WithGravity) and not is_traced(result.num_steps):
         if int(result.num_steps) > 0:  # outside the table: integrated, and said so
             fields = {f.name: getattr(result, f.name) for f in dataclasses.fields(result)}
             result = ImpactResult(**{**fields, "path": "integrated"})

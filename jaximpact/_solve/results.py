@@ -3,7 +3,8 @@
 import equinox as eqx
 from jaxtyping import Array
 
-from .._format import format_fields, format_value, is_traced, jsonable
+from .._checks import is_traced
+from .._format import format_fields, format_value, jsonable
 from .._status import Status
 
 # the fields of an impact as `summary()` shows them: name, unit (None: a count or a word)

@@ -12,6 +12,7 @@ import numpy as np
 from .._batch import batch_path, impact_batch
 from .._laws import LAW_NAMES, LAWS, law
 from .._laws.closed_forms import exact_batch
+from .._progress import AbstractMeter
 from .._status import Status
 
 # the stiffness axis of every map (N/m^n); the damping axis is the law's row's `map_range`
@@ -66,7 +67,7 @@ def restitution_map(
     method: str = "auto",
     num: int = 41,
     rtol: float = 1e-10,
-    progress: bool = False,
+    progress: bool | AbstractMeter = False,
     **batch_options,
 ) -> RestitutionMap:
     """`e` and `T` of the law `law_name` over the grid `damping x c`, all at once.

@@ -11,6 +11,7 @@ import numpy as np
 
 from .._batch import build_law, cost_key, prepare_rows, run_batch
 from .._laws import LAWS
+from .._progress import AbstractMeter
 from .._solve.impact import impact
 from .maps import C_RANGE, axis
 
@@ -55,7 +56,7 @@ def jacobian_batch(
     g=0.0,
     separation: str = "force",
     rtol: float = 1e-10,
-    progress: bool = False,
+    progress: bool | AbstractMeter = False,
     **batch_options,
 ) -> dict[str, np.ndarray]:
     """`e`, `T` and their derivatives with respect to `wrt` for a batch of impacts.
@@ -125,7 +126,7 @@ def sensitivity_map(
     fixed: dict | None = None,
     num: int = 31,
     rtol: float = 1e-10,
-    progress: bool = False,
+    progress: bool | AbstractMeter = False,
     **batch_options,
 ) -> SensitivityMap:
     """`de/dc`, `de/d(damping)`, `dT/dc`, `dT/d(damping)` of `law_name` over the grid

@@ -7,6 +7,7 @@ import equinox as eqx
 import numpy as np
 
 from .._batch import prepare_rows
+from .._progress import AbstractMeter
 from .._status import Status
 from .sensitivity import jacobian_batch
 
@@ -52,7 +53,7 @@ def propagate_uncertainty(
     seed: int = 0,
     separation: str = "force",
     rtol: float = 1e-10,
-    progress: bool = False,
+    progress: bool | AbstractMeter = False,
     **batch_options,
 ) -> Uncertainty:
     """Spread of `e` and `T` of `law` (hitting at `v0` m/s with mass `m` kg) when the inputs

@@ -20,6 +20,7 @@ from reference import reference_impact
 
 import jaximpact as ji
 from jaximpact._batch import block_length, impact_batch, run_batch, write_table
+from jaximpact._progress import TextMeter
 
 BLOCK = 64  # rows per device per call in every impact batch of these tests
 ET = dict(peaks=False, fields=("e", "T", "status"), chunk_size=BLOCK, progress=False)
@@ -86,7 +87,7 @@ def test_run_batch_chunks_pads_and_restores_order(sharded_exact, capsys):
     x = np.linspace(0.0, 3.0, 37)
     inputs = {"x": x, "w": np.arange(37.0)}
     expected = np.sin(x) * np.arange(37.0)
-    out = run_batch(f, inputs, chunk_size=8, progress=True)
+    out = run_batch(f, inputs, chunk_size=8, progress=TextMeter())  # True: off in the tests
     assert out["y"].shape == (37,) and out["pair"].shape == (37, 2)
     np.testing.assert_array_equal(out["pair"][:, 1], -x)
     assert_rel(out["y"], expected, 1e-15, "chunked result", atol=1e-300)

@@ -231,11 +231,15 @@ def test_plot_impact_panels_and_units():
 def test_console_script_environment():
     """Run as the `jaximpact` console script (and only then), XLA's notes are hidden and
     equinox's run-time checks are NaN rather than host callbacks, so that JAX's persistent
-    cache can keep the compiled fits; a library import leaves both alone."""
+    cache can keep the compiled fits; `main` sets them before JAX loads, and importing the
+    library leaves both alone, whatever the process is called."""
     probe = (
-        "import os, sys; sys.argv[0] = {!r}; import jaximpact, equinox._config as c; "
-        "print(os.environ.get('EQX_ON_ERROR'), os.environ.get('TF_CPP_MIN_LOG_LEVEL'), "
-        "c.EQX_ON_ERROR)"
+        "import os, sys; sys.argv = [{!r}]; import jaximpact; "
+        "imported = os.environ.get('EQX_ON_ERROR'); from jaximpact._cli import main\n"
+        "try: main()\n"
+        "except SystemExit: pass\n"  # no command: the usage error, on stderr
+        "import equinox._config as c; print(imported, os.environ.get('EQX_ON_ERROR'), "
+        "os.environ.get('TF_CPP_MIN_LOG_LEVEL'), c.EQX_ON_ERROR)"
     )
     env = {k: v for k, v in os.environ.items() if k not in ("EQX_ON_ERROR", "TF_CPP_MIN_LOG_LEVEL")}
 
@@ -249,6 +253,6 @@ def test_console_script_environment():
         )
         return done.stdout.split()
 
-    assert run_as("/usr/bin/jaximpact") == ["nan", "3", "nan"]
-    eqx_env, _, eqx_mode = run_as("analysis.py")
+    assert run_as("/usr/bin/jaximpact") == ["None", "nan", "3", "nan"]
+    _, eqx_env, _, eqx_mode = run_as("analysis.py")
     assert (eqx_env, eqx_mode) == ("None", "raise")

@@ -103,7 +103,7 @@ def test_one_impact_json_with_start_values(capsys):
 
 def test_progress_bar(capsys, monkeypatch):
     monkeypatch.setattr(_cli_calibrate, "progress_enabled", lambda: True)
-    monkeypatch.setattr(_cli_calibrate._progress, "__defaults__", (0.0,))  # no delay
+    monkeypatch.setattr(_cli_calibrate._meter, "__defaults__", (0.0,))  # no delay
     status, _, err = run_cli(capsys, ONE)
     assert status == 0
     assert "calibrating hertz_rate [" in err and "1/1" in err and err.endswith("\n")
