@@ -413,3 +413,14 @@ def test_importing_and_reading_every_name_leaves_jax_and_the_environment_alone()
     out, err = child.communicate(timeout=120)
     assert child.returncode == 0, err
     assert out.strip() == "true"
+
+
+@pytest.mark.parametrize("m", [1e-300, 1e300])
+def test_impact_refuses_a_mass_float64_cannot_carry(m):
+    """`ji.impact` itself, not only the command line: 1e-300 kg once printed underflowed
+    values (T = 3.9e-180 ns) as results; refused in one line, as 1e300 kg is."""
+    import jaximpact as ji
+
+    with pytest.raises(ValueError, match="float64 cannot hold") as error:
+        ji.impact(ji.law("hertz_rate", c=2e6, b1=800.0), m=m, v0=2.5)
+    assert "\n" not in str(error.value)

@@ -10,7 +10,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._checks import check_nonnegative, check_positive, is_traced
+from .._checks import check_nonnegative, check_positive, check_scale, is_traced
 from .._curves.gravity import WithGravity, gravity_fields, table_for
 from .._curves.shapes import CurveKey, curve_key
 from .._curves.similarity import serves, similarity_fields
@@ -351,8 +351,11 @@ def impact(
     if rtol is None:
         rtol = DEFAULT_RTOL if law.spec is not None else CUSTOM_RTOL
     _check_options(rtol=rtol, atol=atol, rest_tol=rest_tol, max_steps=max_steps, tau_max=tau_max)
-    m = jnp.asarray(check_positive("mass m", m, "kg"), dtype=float)
-    v0 = jnp.asarray(check_positive("impact speed v0", v0, "m/s"), dtype=float)
+    # 1e-300 kg is refused as 1e300 kg is: the contact's scales would under- or overflow
+    m = check_scale("mass m", check_positive("mass m", m, "kg"), "kg")
+    v0 = check_scale("impact speed v0", check_positive("impact speed v0", v0, "m/s"), "m/s")
+    m = jnp.asarray(m, dtype=float)
+    v0 = jnp.asarray(v0, dtype=float)
     g_is_zero = isinstance(g, (int, float)) and g == 0
     g = jnp.asarray(check_nonnegative("gravity g", g, "m/s^2"), dtype=float)
     if jnp.ndim(m) or jnp.ndim(v0) or jnp.ndim(g):
