@@ -558,21 +558,27 @@ def test_engine_e_stepped_response_is_what_mujoco_realises():
     assert abs(e_s[0] / np.mean(es) - 1) < 0.005 and abs(T_s[0] / np.mean(Ts) - 1) < 0.005
 
 
-def _documented_hertz_impact(E, nu, restitution, *, m, radius, v0, clamp):
+def _documented_hertz_impact(E, nu, restitution, *, m, radius, v0, clamp, ground_mass=None):
     """Two equal spheres under the Hertz law with restitution-based damping as LIGGGHTS
     (gran_model_hertz doc) and Chrono (ChContactSMC.h) write it, integrated by scipy:
     `F = 4/3 Y* sqrt(R* d) d + 2 sqrt(5/6) (-beta) sqrt(S_n m*) v`, `S_n = 2 Y* sqrt(R* d)`,
     clamped at 0 when `clamp`. Returns `(e, T)`, T while the force is positive (clamped) or
-    while the spheres overlap."""
+    while the spheres overlap. With `ground_mass` (kg): one sphere on a fixed flat ground of
+    its material of that mass (`R* = R`, the damping's `m* = m M/(m + M)` as Chrono forms
+    it, the sphere moving with its own mass m)."""
     from scipy.integrate import solve_ivp
 
     Y = E / (2 * (1 - nu**2))
     R, mass = radius / 2, m / 2
+    damping_mass = mass
+    if ground_mass is not None:
+        R, mass = radius, m
+        damping_mass = m if math.isinf(ground_mass) else m * ground_mass / (m + ground_mass)
     beta = math.log(restitution) / math.sqrt(math.log(restitution) ** 2 + math.pi**2)
 
     def raw_force(d, v):
         Sn = 2 * Y * math.sqrt(R * max(d, 0.0))
-        return 2.0 / 3.0 * Sn * d - 2 * math.sqrt(5 / 6) * beta * math.sqrt(Sn * mass) * v
+        return 2.0 / 3.0 * Sn * d - 2 * math.sqrt(5 / 6) * beta * math.sqrt(Sn * damping_mass) * v
 
     def force(d, v):
         f = raw_force(d, v)
@@ -699,3 +705,190 @@ def test_export_curve_at_v0_is_the_promise(engine, kwargs):
     assert x.speeds[3] == 1.0
     assert x.e_engine[3] == pytest.approx(x.e, rel=1e-6)
     assert x.T_engine[3] == pytest.approx(x.T, rel=1e-6)
+
+
+# ------------------------------------------------------- a sphere on a wall (the drop test)
+
+WALL_M, WALL_R = 0.004, 0.005
+
+
+@pytest.mark.parametrize("engine", ["lammps", "liggghts", "yade", "chrono"])
+def test_wall_geometry_leaves_the_default_export_unchanged(engine):
+    """geometry="spheres" is the default, bit for bit; "wall" is another scene with other
+    parameters; an unknown geometry, or "spheres" for a body-on-plane engine, is refused in
+    one line, and MuJoCo's and Drake's scene is already the wall."""
+    kwargs = dict(m=WALL_M, v0=1.0, radius=WALL_R, e=0.6, T=1e-3)
+    default = ji.export(None, engine, **kwargs)
+    spheres = ji.export(None, engine, geometry="spheres", **kwargs)
+    assert default.to_dict() == spheres.to_dict()
+    assert "geometry" not in default.parameters
+    wall = ji.export(None, engine, geometry="wall", **kwargs)
+    assert wall.parameters["geometry"] == "wall" and "wall" in wall.scene
+    assert wall.snippet != default.snippet
+    with pytest.raises(ValueError, match="not 'plate'") as info:
+        ji.export(None, engine, geometry="plate", **kwargs)
+    assert "\n" not in str(info.value)
+    mujoco = ji.export(None, "mujoco", m=0.05, v0=1.0, e=0.6, T=1e-2, curves=False)
+    assert ji.export(None, "mujoco", m=0.05, v0=1.0, e=0.6, T=1e-2, curves=False,
+                     geometry="wall").to_dict() == mujoco.to_dict()  # fmt: skip
+    with pytest.raises(ValueError, match="not 'spheres'"):
+        ji.export(None, "drake", m=0.05, v0=1.0, e=0.6, T=1e-2, geometry="spheres")
+
+
+@pytest.mark.parametrize("limit_damping", [False, True])
+def test_lammps_wall_export_is_the_sphere_on_a_flat(limit_damping):
+    """fix wall/gran takes the sphere's own mass and radius and E* = E/(2 (1 - nu^2)) (the
+    wall of the sphere's material): the exported E gives c = hertz_stiffness(E, nu, R), the
+    Tsuji law on mass m realises the target (continuous), the snippet carries the same
+    model on the wall, and e(v) at v0 is the promise. The same dimensionless contact as
+    the pair: the promise equals the two-sphere export's."""
+    kwargs = dict(m=WALL_M, v0=1.0, radius=WALL_R, e=0.5, T=5e-4, limit_damping=limit_damping)
+    x = ji.export(None, "lammps", geometry="wall", **kwargs)
+    p = x.parameters
+    assert p["k"] == pytest.approx(ji.hertz_stiffness(E=p["youngs_modulus"], nu=0.3, R=WALL_R),
+                                   rel=1e-12)  # fmt: skip
+    model = p["pair_coeff"].removeprefix("pair_coeff * * ")
+    assert p["fix_wall"] == f"fix wall all wall/gran granular {model} zplane 0.0 NULL"
+    assert p["fix_wall"] in x.snippet.splitlines()
+    r = ji.impact(x.law, m=WALL_M, v0=1.0, separation=x.separation)
+    assert float(r.e) == pytest.approx(0.5, rel=1e-6)
+    assert float(r.T) == pytest.approx(5e-4, rel=1e-6)
+    assert x.e_engine[3] == pytest.approx(x.e, rel=1e-6)
+    pair = ji.export(None, "lammps", **kwargs)
+    assert x.e == pytest.approx(pair.e, rel=1e-9) and x.T == pytest.approx(pair.T, rel=1e-9)
+    assert x.timestep == pair.timestep
+    # engine-e on the wall parameters: the same law and stepping
+    params = {"E": p["youngs_modulus"], "coeff_restitution": p["coeff_restitution"],
+              "limit_damping": limit_damping, "geometry": "wall"}  # fmt: skip
+    _, _, e_back, T_back = engine_response("lammps", params, m=WALL_M, speeds=[1.0], radius=WALL_R)
+    assert e_back[0] == pytest.approx(0.5, rel=1e-6) and T_back[0] == pytest.approx(5e-4, rel=1e-6)
+    stepped = stepped_response("lammps", {**params, "timestep": x.timestep}, m=WALL_M,
+                               speeds=[1.0], radius=WALL_R)  # fmt: skip
+    assert stepped[1][0] == pytest.approx(x.e, rel=1e-12)
+
+
+def test_yade_wall_export_uses_yades_mass_convention():
+    """A wall of mass 0 gets massR = m/2 in Yade, acting on the sphere's mass m: the export
+    inverts that (kelvin_voigt with Yade's kn, cn on mass m gives the target), and what
+    the clamped law cannot reach on a wall (e <= 0.2079) is refused in one line."""
+    x = ji.export(None, "yade", m=0.01, v0=1.0, e=0.5, T=1e-3, radius=0.01, geometry="wall")
+    law = yade_engine.law(x.parameters, 0.01)
+    r = ji.impact(law, m=0.01, v0=1.0, separation="force")
+    assert float(r.e) == pytest.approx(0.5, rel=1e-6)
+    assert float(r.T) == pytest.approx(1e-3, rel=1e-6)
+    pair = ji.export(None, "yade", m=0.01, v0=1.0, e=0.5, T=1e-3, radius=0.01)
+    assert x.parameters["en"] < pair.parameters["en"]  # more damping asked of massR = m/2
+    assert "utils.wall(" in x.snippet and "Ig2_Wall_Sphere_ScGeom()" in x.snippet
+    assert x.e_engine[3] == pytest.approx(x.e, rel=1e-6) and abs(x.e / 0.5 - 1) < 0.005
+    with pytest.raises(ValueError, match="e = 0.2 on a wall of mass 0.*0.2079") as info:
+        ji.export(None, "yade", m=0.01, v0=1.0, e=0.2, T=1e-3, radius=0.01, geometry="wall")
+    assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("e", [0.3, 0.8])
+def test_liggghts_and_chrono_wall_exports_meet_their_documented_laws(e):
+    """The wall exports fed to the documented force on a sphere against a flat of its
+    material (R* = R; Chrono's damping mass m M/(m + M) with its heavy ground): the target
+    e and T, LIGGGHTS to 1e-7 and Chrono to 1e-6."""
+    m, radius, v0, T = WALL_M, WALL_R, 1.0, 1e-3
+    x = ji.export(None, "liggghts", m=m, v0=v0, e=e, T=T, radius=radius, geometry="wall",
+                  curves=False)  # fmt: skip
+    got_e, got_T = _documented_hertz_impact(
+        x.parameters["youngs_modulus"], 0.3, x.parameters["coeff_restitution"],
+        m=m, radius=radius, v0=v0, clamp=False, ground_mass=math.inf,
+    )  # fmt: skip
+    assert abs(got_e - e) < 1e-7 and abs(got_T / T - 1) < 1e-7
+    assert "primitive type 1 zplane 0.0" in x.parameters["fix_wall"]
+    y = ji.export(None, "chrono", m=m, v0=v0, e=e, T=T, radius=radius, geometry="wall",
+                  curves=False)  # fmt: skip
+    got_e, got_T = _documented_hertz_impact(
+        y.parameters["SetYoungModulus"], 0.3, y.parameters["SetRestitution"],
+        m=m, radius=radius, v0=v0, clamp=True, ground_mass=y.parameters["ground_mass"],
+    )  # fmt: skip
+    assert abs(got_e - e) < 1e-6 and abs(got_T / T - 1) < 1e-6
+    assert y.parameters["effective_curvature_radius"] == radius
+    assert f"ground.SetMass({y.parameters['ground_mass']:.10g})" in y.snippet
+
+
+def test_cli_export_wall(capsys):
+    """--wall exports the sphere on a wall; without it, the pair (unchanged)."""
+    import json
+
+    from jaximpact._cli import main
+
+    argv = ["export", "lammps", "--e", "0.5", "--T", "5e-4", "--mass", "0.004", "--v0", "1",
+            "--radius", "0.005", "--json"]  # fmt: skip
+    main([*argv, "--wall"])
+    wall = json.loads(capsys.readouterr().out)
+    assert wall["parameters"]["geometry"] == "wall" and "fix wall all wall/gran" in wall["snippet"]
+    main(argv)
+    pair = json.loads(capsys.readouterr().out)
+    assert "geometry" not in pair["parameters"] and "wall/gran" not in pair["snippet"]
+    with pytest.raises(SystemExit):
+        main(["export", "lammps", "--e", "0.5", "--T", "5e-4", "--mass", "0.004", "--v0", "1",
+              "--wall"])  # fmt: skip
+    assert "radius (m) of the sphere" in capsys.readouterr().err
+
+
+WALL_PHASES = (0.05, 0.3, 0.55, 0.8, 0.95)
+
+
+@pytest.mark.engines
+@pytest.mark.parametrize(
+    "e, T, limit_damping",
+    [(0.9, 1e-3, False), (0.5, 5e-4, False), (0.1, 1e-4, False), (0.3, 2e-4, True),
+     (0.8, 5e-4, True)],
+)  # fmt: skip
+def test_lammps_wall_realises_the_promise(e, T, limit_damping):
+    """A sphere on `fix wall/gran granular` (the exported snippet's wall): LAMMPS realises
+    the export's e and T within 0.5 % at five start phases, as for the pair."""
+    _require("lammps")
+    x = ji.export(None, "lammps", m=WALL_M, v0=1.0, radius=WALL_R, e=e, T=T,
+                  limit_damping=limit_damping, geometry="wall", curves=False)  # fmt: skip
+    es, Ts = lammps_engine.simulate(x.parameters, m=WALL_M, v0=1.0, radius=WALL_R,
+                                    phases=WALL_PHASES)  # fmt: skip
+    assert np.all(np.abs(es / x.e - 1) < 0.005), (es, x.e)
+    assert np.all(np.abs(Ts / x.T - 1) < 0.005), (Ts, x.T)
+    assert abs(x.e / e - 1) < 0.005 and abs(x.T / T - 1) < 0.005
+    # the replica is LAMMPS's step on the wall to round-off
+    replica_e, _ = lammps_engine.replica(
+        {"k": x.parameters["k"], "b": x.parameters["b"], "limit_damping": limit_damping,
+         "timestep": x.timestep, "geometry": "wall"}, WALL_M, 1.0, WALL_PHASES,
+    )  # fmt: skip
+    np.testing.assert_allclose(es, replica_e, rtol=1e-9)
+
+
+@pytest.mark.engines
+@pytest.mark.parametrize(
+    "e, T, limit_damping", [(0.9, 1e-3, False), (0.5, 5e-4, False), (0.3, 1e-3, True)]
+)
+def test_liggghts_wall_realises_the_promise(e, T, limit_damping):
+    """A sphere on a primitive `fix wall/gran` (limitForce after the wall): LIGGGHTS
+    realises the export's e and T within 0.5 % at five start phases."""
+    _require_executable("liggghts")
+    x = ji.export(None, "liggghts", m=WALL_M, v0=1.0, radius=WALL_R, e=e, T=T,
+                  limit_damping=limit_damping, geometry="wall", curves=False)  # fmt: skip
+    es, Ts = liggghts_engine.simulate(x.parameters, m=WALL_M, v0=1.0, radius=WALL_R,
+                                      phases=WALL_PHASES)  # fmt: skip
+    assert np.all(np.abs(es / x.e - 1) < 0.005), (es, x.e)
+    assert np.all(np.abs(Ts / x.T - 1) < 0.005), (Ts, x.T)
+    assert abs(x.e / e - 1) < 0.005 and abs(x.T / T - 1) < 0.005
+
+
+@pytest.mark.engines
+@pytest.mark.parametrize("e, T", [(0.8, 5e-4), (0.5, 1e-3), (0.3, 1e-3)])
+def test_yade_wall_realises_the_promise(e, T):
+    """A sphere on a fixed `utils.wall` of mass 0 (Yade's massR = m/2, the sphere's mass m):
+    Yade realises the export's e and T within 0.5 %, equal to the replica phase by phase
+    (the mass convention included)."""
+    _require_executable("yade")
+    m, radius = 0.01, 0.01
+    x = ji.export(None, "yade", m=m, v0=1.0, radius=radius, e=e, T=T, geometry="wall",
+                  curves=False)  # fmt: skip
+    phases = (0.1, 0.5, 0.9)
+    es, Ts = yade_engine.simulate(x.parameters, m=m, v0=1.0, radius=radius, phases=phases)
+    assert np.all(np.abs(es / x.e - 1) < 0.005), (es, x.e)
+    assert np.all(np.abs(Ts / x.T - 1) < 0.005), (Ts, x.T)
+    assert abs(x.e / e - 1) < 0.005 and abs(x.T / T - 1) < 0.005
+    replica_e, _ = yade_engine.replica(x.parameters, m, 1.0, phases=phases)
+    np.testing.assert_allclose(es, replica_e, rtol=1e-9)

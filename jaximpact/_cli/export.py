@@ -72,6 +72,11 @@ def add_export(subparsers):
         "--limit-damping", action="store_true", help="LAMMPS: keep the force non-attractive"
     )
     parser.add_argument(
+        "--wall", action="store_true",
+        help="LAMMPS, LIGGGHTS, Yade, Chrono: one sphere of --mass and --radius hitting a fixed "
+        "flat wall at --v0 (the drop test), instead of two spheres",
+    )  # fmt: skip
+    parser.add_argument(
         "--no-strict", dest="strict", action="store_false",
         help="export what the engine cannot realise at --timestep anyway, with a warning",
     )  # fmt: skip
@@ -124,7 +129,7 @@ def _run_export(args):
         what = " and ".join(missing)
         if "--mass (kg)" in missing:
             raise CLIError(missing_mass(engine, name is not None, f"give {what}"))
-        raise CLIError(f"{engine} needs {what} of the two spheres")
+        raise CLIError(f"{engine} needs {what} of the {'sphere' if args.wall else 'two spheres'}")
     source = None
     if name is not None:
         from .._laws import law
@@ -142,6 +147,7 @@ def _run_export(args):
             e=args.e,
             T=args.T,
             limit_damping=args.limit_damping,
+            **({"geometry": "wall"} if args.wall else {}),
             strict=args.strict,
         )
     except UnrealisedExport as refusal:

@@ -31,6 +31,15 @@ law = lammps.law
 KEYS = (lammps.KEYS[0], ("poisson", "limit_damping"))
 TWO_SPHERES = True
 MASS_DEPENDS = "its Young's modulus scales with the mass"  # what m changes (export)
+GEOMETRIES = ("spheres", "wall")  # `export(..., geometry=)`: the first is the default
+SCENE_WALL = (
+    "a sphere of mass m and radius `radius` hitting a fixed ground box (a flat wall) of its "
+    "material (mass 1e6 m) head-on at speed v0 (by Chrono's source, not run here)"
+)
+# A fixed body still enters eff_mass = m1 m2/(m1 + m2) with its own mass (ChContactSMC.cpp,
+# GetContactableMass): the snippet gives the ground 1e6 m, so eff_mass = m (1 - 1e-6) and gn
+# is 5e-7 (relative) below the design's: e moves by less than 1e-6.
+GROUND_MASS_RATIO = 1e6
 
 
 def response(parameters, *, m: float, radius=None):
@@ -43,10 +52,15 @@ def stepper(parameters, *, m: float, radius=None):
     return None
 
 
-def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=True):
+def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=True,
+           geometry="spheres"):  # fmt: skip
+    """`ChContactMaterialSMC` inputs for target `e` and `T` (s): two spheres, or with
+    `geometry="wall"` a sphere on a fixed ground box of its material (`E_eff = E/(2 (1 -
+    nu^2))`, `eff_radius = R`, `eff_mass` = m up to the ground's mass, 1e6 m)."""
+    wall = geometry == "wall"
     coefficient = lammps.coefficient_for(e, limit_damping=True)
     realised_e, tau = lammps.impact_at_unit_scales(coefficient, "force")
-    m_eff, R_eff = m / 2.0, radius / 2.0
+    m_eff, R_eff = lammps.effective(m, radius, geometry)
     c = m_eff * v0**2 * (tau / (T * v0)) ** 2.5
     E = c * 3.0 / (4.0 * math.sqrt(R_eff)) * 2.0 * (1.0 - poisson**2)
     b = lammps.damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
@@ -73,6 +87,9 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Tru
         "k": c,
         "b": b,
     }
+    if wall:
+        parameters["geometry"] = "wall"
+        parameters["ground_mass"] = GROUND_MASS_RATIO * m
     return dict(
         parameters=parameters,
         e=realised_e,
@@ -101,6 +118,20 @@ def snippet(parameters) -> str:
             f"mat.SetPoissonRatio({parameters['SetPoissonRatio']:.10g})",
             f"mat.SetRestitution({parameters['SetRestitution']:.10g})",
             "mat.SetFriction(0.0)",
+            *(_ground(parameters) if parameters.get("geometry") == "wall" else []),
             f"sys.DoStepDynamics({parameters['time_step']:.6g})  # the step, in the loop",
         ]
     )
+
+
+def _ground(parameters) -> list[str]:
+    """The fixed ground box of the sphere's material, its top face the plane z = 0, heavy:
+    Chrono's eff_mass takes the ground's mass even when it is fixed."""
+    return [
+        "# the ground: fixed, heavy (eff_mass takes its mass), the sphere's material",
+        "ground = chrono.ChBodyEasyBox(1, 1, 0.1, 1000, True, True, mat)",
+        "ground.SetPos(chrono.ChVector3d(0, 0, -0.05))",
+        f"ground.SetMass({parameters['ground_mass']:.10g})",
+        "ground.SetFixed(True)",
+        "sys.Add(ground)",
+    ]

@@ -161,6 +161,7 @@ def export(
     e=None,
     T=None,
     limit_damping: bool = False,
+    geometry: str | None = None,
     curves: bool = True,
     strict: bool = True,
 ) -> Export:
@@ -173,8 +174,13 @@ def export(
     and Yade, two spheres each of mass `m` and radius `radius` (m, required) colliding head-on
     at relative speed `v0` (Chrono by its source's formula, not run here)
     (`poisson`: their Poisson's ratio, default 0.3; `limit_damping`: keep the force
-    non-attractive). `timestep` (s): the engine's step if already chosen (the export then
-    corrects for it where it can and warns where it cannot); default, a recommended step.
+    non-attractive). `geometry="wall"`: instead one sphere of mass `m` and radius `radius`
+    hitting a fixed flat wall at speed `v0` (LAMMPS `fix wall/gran`, LIGGGHTS a primitive
+    wall, Yade a fixed wall body, Chrono a fixed box; the drop test); `"spheres"` (the
+    default for those engines) is the pair. MuJoCo and Drake have only their body on a plane
+    (`"wall"` is accepted for them and changes nothing). `timestep` (s): the engine's step
+    if already chosen (the export then corrects for it where it can and warns where it
+    cannot); default, a recommended step.
     The returned `Export` states what the engine realises, computed through a replica of its
     time stepping (MuJoCo, LAMMPS) checked against the engines in tests/test_engines.py.
 
@@ -194,6 +200,7 @@ def export(
     **Example**: `export(law("hertz_rate", c=2e6, b1=800.0), "mujoco", m=1.0, v0=2.5).parameters`.
     """
     module = _engine(engine)
+    wall = _geometry(engine, module, geometry) == "wall"
     m_given = m is not None
     if not m_given:
         if law_or_fit is not None or module.MASS_DEPENDS is not None:
@@ -228,12 +235,15 @@ def export(
     warnings = []
     if module.TWO_SPHERES:
         if radius is None:
-            raise ValueError(f"{engine} needs the spheres' radius: pass radius= (m)")
+            what = "sphere's" if wall else "spheres'"
+            raise ValueError(f"{engine} needs the {what} radius: pass radius= (m)")
         radius = check_positive("radius", radius, "m")
         if target_T is None:
             raise ValueError(f"{engine} needs a contact duration: pass T= (s) or a law")
     design = dict(m=m, v0=v0, radius=radius, poisson=0.3 if poisson is None else poisson,
                   limit_damping=limit_damping)  # fmt: skip
+    if wall and module.TWO_SPHERES:  # the others' scene is a body on a plane already
+        design["geometry"] = "wall"
     out = module.design(target_e, target_T, timestep=timestep, **design)
     target_T = out.get("target_T", target_T)  # MuJoCo without T: its default timeconst's
     separation, h = out["separation"], out["timestep"]
@@ -246,9 +256,10 @@ def export(
             raise refusal
         warnings.insert(0, str(refusal))
         _warnings.warn(str(refusal), UnrealisedWarning, stacklevel=2)
-    # the law each side realises; LAMMPS's promise is for the pair (effective mass m/2)
+    # the law each side realises; LAMMPS's promise is for the pair (effective mass m/2), or
+    # for the sphere on a wall (its own mass)
     engine_law = module.law(out["parameters"], m)
-    m_engine = m / 2.0 if module.TWO_SPHERES else m
+    m_engine = m / 2.0 if module.TWO_SPHERES and not wall else m
     speeds, e_engine, T_engine, e_target, T_target = (), (), (), None, None
     stepped = None if out.get("stepping") is None else module.stepper(out["stepping"], m=m,
                                                                          radius=radius)  # fmt: skip
@@ -270,7 +281,7 @@ def export(
                 )
     return Export(
         engine=engine,
-        scene=module.SCENE,
+        scene=module.SCENE_WALL if wall and module.TWO_SPHERES else module.SCENE,
         parameters=out["parameters"],
         snippet=module.snippet(out["parameters"]),
         e=out["e"],
@@ -350,14 +361,16 @@ def engine_response(engine: str, parameters: dict, *, m, speeds, radius=None):
     produce, for a body of mass `m` (kg; two-sphere engines: each sphere) at each speed of
     `speeds` (m/s). Parameters: MuJoCo `solref` (`timestep` for refsafe); LAMMPS, LIGGGHTS,
     Chrono `E` (Pa), `coeff_restitution`, `poisson`, `limit_damping`; Yade `tc` (s), `en`;
-    Drake `point_contact_stiffness` (N/m), `hunt_crossley_dissipation` (s/m). The time step
+    Drake `point_contact_stiffness` (N/m), `hunt_crossley_dissipation` (s/m); `"geometry":
+    "wall"` (LAMMPS, LIGGGHTS, Chrono, Yade): one sphere on a wall of its material. The step
     is not part of this answer: `stepped_response` gives what the stepping realises.
     Returns `(law, separation, e, T)`."""
     module = _engine(engine)
     m = check_positive("m", m, "kg")
     speeds = [check_positive("speed", v, "m/s") for v in np.atleast_1d(speeds)]
     law, separation = module.response(parameters, m=m, radius=radius)
-    e, T = _curve(law, m / 2.0 if module.TWO_SPHERES else m, speeds, separation)
+    pair = module.TWO_SPHERES and parameters.get("geometry", "spheres") != "wall"
+    e, T = _curve(law, m / 2.0 if pair else m, speeds, separation)
     return law, separation, e, T
 
 
@@ -386,6 +399,20 @@ def stepped_response(engine: str, parameters: dict, *, m, speeds, radius=None):
         [float(np.min(es)) for es, _ in runs],
         [float(np.max(es)) for es, _ in runs],
     )
+
+
+def _geometry(engine: str, module, geometry) -> str:
+    """The scene `geometry` asks of `engine`'s `module`: "spheres" (two equal spheres, the
+    default of the two-sphere engines) or "wall" (a sphere on a fixed flat wall; MuJoCo's
+    and Drake's body on a plane), or a one-line ValueError."""
+    kinds = getattr(module, "GEOMETRIES", ("spheres",) if module.TWO_SPHERES else ("wall",))
+    if geometry is None:
+        return kinds[0]
+    if geometry not in kinds:
+        raise ValueError(
+            f"{engine} exports geometry {' or '.join(map(repr, kinds))}, not {geometry!r}"
+        )
+    return geometry
 
 
 def _engine(name: str):

@@ -32,6 +32,23 @@ SCENE = (
     "two equal spheres, each of mass m and radius `radius`, colliding head-on at relative "
     "speed v0 (no gravity, no friction effect on a head-on impact)"
 )
+GEOMETRIES = ("spheres", "wall")  # `export(..., geometry=)`: the first is the default
+SCENE_WALL = (
+    "a sphere of mass m and radius `radius` hitting a fixed flat wall (fix wall/gran, the "
+    "sphere's own material) head-on at speed v0 (no gravity, no friction effect)"
+)
+
+
+def effective(m: float, radius: float, geometry: str = "spheres") -> tuple[float, float]:
+    """`(m_eff, R_eff)` of the contact: two equal spheres (`m/2`, `R/2`) or a sphere on a
+    flat wall (`m`, `R`: `fix wall/gran` takes the particle's own mass and radius, the wall's
+    curvature radius being 0 for a plane; src/GRANULAR/fix_wall_gran.cpp). Both have
+    `E_eff = E/(2 (1 - nu^2))`: the pair mixes two spheres of one material, and the wall's
+    `mix_stiffnessE_wall(E, nu)` (src/GRANULAR/gran_sub_mod.cpp) gives the same, i.e. the
+    wall is of the sphere's own material, not rigid."""
+    if geometry == "wall":
+        return m, radius
+    return m / 2.0, radius / 2.0
 
 
 def impact_at_unit_scales(e_coefficient: float, separation: str):
@@ -78,26 +95,36 @@ def damp_coefficient(e: float) -> float:
 
 
 def replica(parameters, m: float, v0: float, phases=_stepping.PHASES):
-    c, b, m_eff = parameters["k"], parameters["b"], m / 2.0
+    """`(e, T)` per start phase of `fix nve/sphere` on the contact `parameters` (`k`, `b`,
+    `limit_damping`, `timestep`; `geometry` "wall": the sphere's own mass `m` on a wall,
+    else two spheres of mass `m`, effective mass `m/2`)."""
+    wall = parameters.get("geometry", "spheres") == "wall"
+    c, b, m_eff = parameters["k"], parameters["b"], m if wall else m / 2.0
     return _stepping.velocity_verlet(
         acceleration(c, b, m_eff, parameters["limit_damping"]), parameters["timestep"], v0, phases
     )
 
 
-def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=False):
+def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=False,
+           geometry="spheres"):  # fmt: skip
     """`pair_style granular` with `hertz/material ... damping coeff_restitution` for target
     `e` and `T` (s), two spheres of mass `m` (kg) and radius `radius` (m) at relative speed
-    `v0` (m/s): a dict with `parameters`, `e`, `T` (the replica's mean over start phases),
-    `e_range`, `T_range`, `steps_per_contact`, `warnings`, `timestep`, `separation`."""
+    `v0` (m/s), or with `geometry="wall"` one such sphere on a flat wall at speed `v0`
+    (`fix wall/gran granular` with the same model): a dict with `parameters`, `e`, `T` (the
+    replica's mean over start phases), `e_range`, `T_range`, `steps_per_contact`,
+    `warnings`, `timestep`, `separation`."""
+    wall = geometry == "wall"
     separation = "force" if limit_damping else "penetration"
     coefficient = coefficient_for(e, limit_damping)
     _, tau = impact_at_unit_scales(coefficient, separation)
-    m_eff, R_eff = m / 2.0, radius / 2.0
+    m_eff, R_eff = effective(m, radius, geometry)
     c = m_eff * v0**2 * (tau / (T * v0)) ** 2.5
     E = c * 3.0 / (4.0 * math.sqrt(R_eff)) * 2.0 * (1.0 - poisson**2)
-    assert abs(hertz_stiffness(E, poisson, radius, R2=radius) / c - 1) < 1e-12
+    assert abs(hertz_stiffness(E, poisson, radius, R2=None if wall else radius) / c - 1) < 1e-12
     b = damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
     params = dict(k=c, b=b, limit_damping=limit_damping)
+    if wall:
+        params["geometry"] = "wall"
     h, es, Ts, warnings = _stepping.step_and_response(
         lambda h: replica({**params, "timestep": h}, m, v0),
         e,
@@ -107,12 +134,13 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Fal
         step="timestep",
     )
     extra = " limit_damping" if limit_damping else ""
+    model = (
+        f"hertz/material {E:.10g} {coefficient:.10g} {poisson:.10g} "
+        f"damping coeff_restitution tangential linear_nohistory 0 0{extra}"
+    )
     parameters = {
         "pair_style": "pair_style granular",
-        "pair_coeff": (
-            f"pair_coeff * * hertz/material {E:.10g} {coefficient:.10g} {poisson:.10g} "
-            f"damping coeff_restitution tangential linear_nohistory 0 0{extra}"
-        ),
+        "pair_coeff": f"pair_coeff * * {model}",
         "timestep": f"timestep {h:.6g}",
         "timestep_s": h,
         "youngs_modulus": E,
@@ -123,18 +151,18 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Fal
         "limit_damping": limit_damping,
         "units": "units si",
     }
+    stepping = dict(E=E, coeff_restitution=coefficient, poisson=poisson,
+                    limit_damping=limit_damping, timestep=h)  # fmt: skip
+    if wall:
+        # the wall at z = 0, the sphere above it: the same model as the pair's (one material)
+        parameters["fix_wall"] = f"fix wall all wall/gran granular {model} zplane 0.0 NULL"
+        parameters["geometry"] = stepping["geometry"] = "wall"
     return dict(
         parameters=parameters,
         **_stepping.realised(es, Ts, h),
         warnings=warnings,
         separation=separation,
-        stepping=dict(
-            E=E,
-            coeff_restitution=coefficient,
-            poisson=poisson,
-            limit_damping=limit_damping,
-            timestep=h,
-        ),  # fmt: skip
+        stepping=stepping,
     )
 
 
@@ -146,6 +174,7 @@ def snippet(parameters) -> str:
             "comm_modify vel yes",
             parameters["pair_style"],
             parameters["pair_coeff"],
+            *([parameters["fix_wall"]] if parameters.get("fix_wall") else []),
             "fix 1 all nve/sphere",
             parameters["timestep"],
         ]
@@ -162,15 +191,20 @@ def law(parameters, m: float):
 def tsuji_response(parameters, *, m: float, radius, clamped: bool, engine: str):
     """`(law, separation)` of a Tsuji-form engine (LAMMPS, LIGGGHTS, Chrono) from its
     Young's modulus `E` (Pa), `coeff_restitution` and `poisson` (default 0.3), for two spheres
-    of mass `m` (kg) and radius `radius` (m); `clamped`: the force is kept non-attractive."""
+    of mass `m` (kg) and radius `radius` (m), or with `geometry` "wall" in `parameters` one
+    such sphere on a flat wall of its material; `clamped`: the force is kept
+    non-attractive."""
+    wall = parameters.get("geometry", "spheres") == "wall"
     if radius is None:
-        raise ValueError(f"{engine} needs the spheres' radius: pass radius= (m)")
+        what = "sphere's" if wall else "spheres'"
+        raise ValueError(f"{engine} needs the {what} radius: pass radius= (m)")
     radius = check_positive("radius", radius, "m")
     E = check_positive("E", parameters["E"], "Pa")
     nu = check_poisson("poisson", parameters.get("poisson", 0.3))
     coefficient = check_restitution(parameters["coeff_restitution"], "coeff_restitution")
-    c = hertz_stiffness(E, nu, radius, R2=radius)
-    b = damp_coefficient(coefficient) * math.sqrt(m / 2.0 * c) if coefficient < 1 else 0.0
+    c = hertz_stiffness(E, nu, radius, R2=None if wall else radius)
+    m_eff = m if wall else m / 2.0
+    b = damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
     return law({"k": c, "b": b}, m), "force" if clamped else "penetration"
 
 
@@ -193,6 +227,7 @@ def stepper(parameters, *, m: float, radius=None):
         b=float(pair.parameters["b"]),
         limit_damping=bool(parameters.get("limit_damping", False)),
         timestep=h,
+        geometry=parameters.get("geometry", "spheres"),
     )
     return h, lambda v: replica(stepping, m, v)
 
@@ -217,16 +252,32 @@ def load():
 
 def simulate(parameters, *, m, v0, radius, phases=(0.5,)):
     """Run LAMMPS on two spheres (mass `m` kg, radius `radius` m each, head-on at relative
-    speed `v0` m/s); returns arrays `(e, T)`, T the number of steps with a non-zero pair force
-    times the step."""
+    speed `v0` m/s), or with `parameters["geometry"] == "wall"` on one such sphere hitting
+    the exported `fix wall/gran` (the plane z = 0) at `v0`; returns arrays `(e, T)`, T the
+    number of steps with a non-zero contact force times the step."""
     lmp_class = load()
     h = parameters["timestep_s"]
+    wall = parameters.get("geometry", "spheres") == "wall"
     rho = m / (4.0 / 3.0 * math.pi * radius**3)
     es, Ts = [], []
     for phase in map(float, phases):
         lmp = lmp_class(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
         gap = v0 * h * phase
         box = 10 * radius
+        if wall:  # the sphere above the wall z = 0, first touch `gap` away
+            atoms = f"""create_atoms 1 single 0 0 {radius + gap!r}
+set atom * diameter {2 * radius!r}
+set atom * density {rho!r}
+velocity all set 0 0 0
+set atom 1 vz {-v0!r}"""
+        else:
+            atoms = f"""create_atoms 1 single {-radius - gap / 2!r} 0 0
+create_atoms 1 single {radius + gap / 2!r} 0 0
+set atom * diameter {2 * radius!r}
+set atom * density {rho!r}
+velocity all set 0 0 0
+set atom 1 vx {v0 / 2!r}
+set atom 2 vx {-v0 / 2!r}"""
         script = f"""units si
 atom_style sphere
 atom_modify map array
@@ -234,32 +285,35 @@ boundary f f f
 comm_modify vel yes
 region box block {-box} {box} {-box} {box} {-box} {box}
 create_box 1 box
-create_atoms 1 single {-radius - gap / 2!r} 0 0
-create_atoms 1 single {radius + gap / 2!r} 0 0
-set atom * diameter {2 * radius!r}
-set atom * density {rho!r}
-velocity all set 0 0 0
-set atom 1 vx {v0 / 2!r}
-set atom 2 vx {-v0 / 2!r}
+{atoms}
 {parameters["pair_style"]}
 {parameters["pair_coeff"]}
+{parameters.get("fix_wall", "") if wall else ""}
 neighbor {0.5 * radius!r} bin
 neigh_modify every 1 delay 0 check no
 fix 1 all nve/sphere
 {parameters["timestep"]}
 run 0 post no"""
         for line in script.splitlines():
-            lmp.command(line)
+            if line.strip():
+                lmp.command(line)
+        axis = 2 if wall else 0
         steps, started = 0, False
         for _ in range(10_000_000):
             lmp.command("run 1 pre no post no")
-            if lmp.numpy.extract_atom("f")[0, 0] != 0.0:
+            if lmp.numpy.extract_atom("f")[0, axis] != 0.0:
                 steps += 1
                 started = True
             elif started:
                 break
         v = lmp.numpy.extract_atom("v")
-        es.append((v[1, 0] - v[0, 0]) / v0)
+        if wall:
+            mass = float(lmp.numpy.extract_atom("rmass")[0])
+            if abs(mass / m - 1) > 1e-9:
+                raise RuntimeError(f"LAMMPS's sphere has mass {mass}, not {m}")
+            es.append(v[0, 2] / v0)
+        else:
+            es.append((v[1, 0] - v[0, 0]) / v0)
         Ts.append(steps * h)
         lmp.close()
     return np.array(es), np.array(Ts)

@@ -24,6 +24,12 @@ from . import lammps
 NAME = "liggghts"
 MIN_COEFFICIENT = 0.05  # createCoeffRest: "0.05 < coefficientRestitution <= 1 required"
 SCENE = lammps.SCENE
+GEOMETRIES = lammps.GEOMETRIES
+SCENE_WALL = (
+    "a sphere of mass m and radius `radius` hitting a fixed flat primitive wall (fix "
+    "wall/gran, of the sphere's own material: atom type 1) head-on at speed v0 (no gravity, "
+    "no friction effect)"
+)
 law = lammps.law
 KEYS = lammps.KEYS
 TWO_SPHERES = True
@@ -37,12 +43,20 @@ def response(parameters, *, m: float, radius=None):
     return lammps.tsuji_response(parameters, m=m, radius=radius, clamped=clamped, engine=NAME)
 
 
-def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=False):
+def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=False,
+           geometry="spheres"):  # fmt: skip
+    """LAMMPS's design in LIGGGHTS's names. `geometry="wall"`: a sphere on a primitive
+    `fix wall/gran` of its own material (atom type 1). Its contact, `fix_wall_gran.cpp` and
+    `normal_model_hertz.h`: the particle's own mass and radius (`reff = radi` on a wall),
+    `Y*` from the sphere's type and the wall's (`createYeff`, type 1 with type 1:
+    `Y/(2 (1 - nu^2))`), i.e. LAMMPS's `fix wall/gran` term for term (checked: the two
+    engines give the same e and T to every digit printed)."""
     if poisson < 0:
         raise ValueError(f"LIGGGHTS requires 0 <= poissonsRatio <= 0.5, got {poisson:g}")
+    wall = {"geometry": "wall"} if geometry == "wall" else {}
     out = lammps.design(
         e, T, m=m, v0=v0, radius=radius, poisson=poisson, timestep=timestep,
-        limit_damping=limit_damping,
+        limit_damping=limit_damping, **wall,
     )  # fmt: skip
     p = out["parameters"]
     if p["coeff_restitution"] <= MIN_COEFFICIENT:
@@ -83,6 +97,12 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Fal
         "units": "units si",
         "particle_range": extra,
     }
+    if wall:
+        out["parameters"]["fix_wall"] = (
+            "fix wall all wall/gran model hertz tangential history primitive type 1 zplane 0.0"
+            + (" limitForce on" if limit_damping else "")  # after the wall, or it is refused
+        )
+        out["parameters"]["geometry"] = "wall"
     return out
 
 
@@ -99,6 +119,7 @@ def snippet(parameters) -> str:
             parameters["coefficientFriction"],
             parameters["pair_style"],
             parameters["pair_coeff"],
+            *([parameters["fix_wall"]] if parameters.get("fix_wall") else []),
             "fix integr all nve/sphere",
             parameters["timestep"],
         ]
@@ -117,8 +138,10 @@ def particle_range_line(youngs_modulus: float) -> str | None:
 
 def simulate(parameters, *, m, v0, radius, phases=(0.5,), executable="liggghts"):
     """Run LIGGGHTS (`executable`) on two spheres (mass `m` kg, radius `radius` m each,
-    head-on at relative speed `v0` m/s) with the exported `parameters`; returns arrays
-    `(e, T)`, T the number of steps with a non-zero pair force times the step."""
+    head-on at relative speed `v0` m/s) with the exported `parameters`, or with
+    `parameters["geometry"] == "wall"` on one such sphere hitting the exported primitive wall
+    (the plane z = 0) at `v0`; returns arrays `(e, T)`, T the number of steps with a non-zero
+    contact force times the step."""
     import math
     import os
     import subprocess
@@ -129,11 +152,29 @@ def simulate(parameters, *, m, v0, radius, phases=(0.5,), executable="liggghts")
     h = parameters["timestep_s"]
     rho = m / (4.0 / 3.0 * math.pi * radius**3)
     steps = int(20 * radius / v0 / h) + 10  # far longer than any contact the export makes
+    wall = parameters.get("geometry", "spheres") == "wall"
+    if wall:  # it rises by at most 4 R, inside the box (10 R), after any contact the export makes
+        steps = int(4 * radius / v0 / h) + 10
     es, Ts = [], []
     for phase in map(float, phases):
         gap = v0 * h * phase
         box = 10 * radius
         extra = particle_range_line(parameters["youngs_modulus"])
+        if wall:  # the sphere above the wall z = 0, first touch `gap` away
+            atoms = f"""{parameters["fix_wall"]}
+create_atoms 1 single 0 0 {radius + gap!r} units box
+set atom 1 diameter {2 * radius!r} density {rho!r} vx 0 vy 0 vz {-v0!r}
+fix integr all nve/sphere
+variable f1 equal fz[1]
+variable dv equal vz[1]"""
+        else:
+            atoms = f"""create_atoms 1 single {-radius - gap / 2!r} 0 0 units box
+create_atoms 1 single {radius + gap / 2!r} 0 0 units box
+set atom 1 diameter {2 * radius!r} density {rho!r} vx {v0 / 2!r} vy 0 vz 0
+set atom 2 diameter {2 * radius!r} density {rho!r} vx {-v0 / 2!r} vy 0 vz 0
+fix integr all nve/sphere
+variable f1 equal fx[1]
+variable dv equal vx[2]-vx[1]"""
         script = f"""atom_style granular
 atom_modify map array
 boundary f f f
@@ -152,13 +193,7 @@ neigh_modify delay 0
 {parameters["pair_style"]}
 {parameters["pair_coeff"]}
 {parameters["timestep"]}
-create_atoms 1 single {-radius - gap / 2!r} 0 0 units box
-create_atoms 1 single {radius + gap / 2!r} 0 0 units box
-set atom 1 diameter {2 * radius!r} density {rho!r} vx {v0 / 2!r} vy 0 vz 0
-set atom 2 diameter {2 * radius!r} density {rho!r} vx {-v0 / 2!r} vy 0 vz 0
-fix integr all nve/sphere
-variable f1 equal fx[1]
-variable dv equal vx[2]-vx[1]
+{atoms}
 variable m1 equal mass[1]
 fix out all print 1 "${{f1}} ${{dv}} ${{m1}}" file out.txt screen no
 run {steps}

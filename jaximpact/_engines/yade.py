@@ -41,6 +41,11 @@ SCENE = (
     "two equal spheres of ViscElMat, each of mass m and radius `radius`, colliding head-on at "
     "relative speed v0 (no gravity, NewtonIntegrator(damping=0))"
 )
+GEOMETRIES = ("spheres", "wall")  # `export(..., geometry=)`: the first is the default
+SCENE_WALL = (
+    "a sphere of ViscElMat, mass m and radius `radius`, hitting a fixed wall body "
+    "(utils.wall, mass 0) head-on at speed v0 (no gravity, NewtonIntegrator(damping=0))"
+)
 CUNDALL_DEFAULT = 0.2  # NewtonIntegrator.damping's default (pkg/dem/NewtonIntegrator.hpp)
 
 
@@ -51,22 +56,31 @@ def stiffness_damping(tc: float, en: float, mass_r: float) -> tuple[float, float
     return mass_r * (math.pi**2 + log_e**2) / tc**2, -2.0 * mass_r * log_e / tc
 
 
-def inputs_for(e: float, T: float) -> tuple[float, float, float]:
+def inputs_for(e: float, T: float, geometry: str = "spheres") -> tuple[float, float, float]:
     """`(en, tc, zeta)`: the ViscElMat inputs whose clamped contact realises `e` and `T` (s),
-    and its damping ratio `zeta = cn / (2 sqrt(kn massR))` (< 1: Pournin's form has no
-    over-damped case)."""
+    and its damping ratio `zeta = cn / (2 sqrt(kn m_eff))` (< 1: Pournin's form has no
+    over-damped case). Two spheres: `m_eff = massR`. A sphere on a wall of mass 0
+    (`geometry="wall"`): Yade forms kn and cn with `massR = m/2` (the wall takes the
+    sphere's mass) but they act on the sphere's own mass m, so `kn/m = (pi^2 + ln^2 en)/(2
+    tc^2)`, `cn/m = -ln(en)/tc`: the damping ratio is `1/sqrt(2)` of the pair's, no `en`
+    gives more than `1/sqrt(2)`, and no e below 0.2079 is reached (the pair's: exp(-2))."""
     if e >= 1.0:
-        return 1.0, T, 0.0
-    floor = math.exp(-2.0)
+        return 1.0, T if geometry != "wall" else T / math.sqrt(2.0), 0.0
+    wall = geometry == "wall"
+    top = 1.0 / math.sqrt(2.0) if wall else 1.0  # the largest damping ratio en -> 0 gives
+    floor = mujoco.continuous(top)[0] if wall else math.exp(-2.0)
     if e <= floor:
+        where = " on a wall of mass 0" if wall else ""
+        value = f"{floor:.4f}" if wall else f"exp(-2) = {floor:.4f}"
         raise ValueError(
-            f"Yade's ViscElMat cannot realise e = {e:g}: its force is kept non-attractive and "
-            f"en -> 0 gives e = exp(-2) = {floor:.4f} (use kn and cn directly for less)"
+            f"Yade's ViscElMat cannot realise e = {e:g}{where}: its force is kept "
+            f"non-attractive and en -> 0 gives e = {value} (use kn and cn directly for less)"
         )
     zeta = mujoco.dampratio_for(e)
     omega0 = mujoco.continuous(zeta)[1] / T
-    en = math.exp(-math.pi * zeta / math.sqrt(1.0 - zeta**2))
-    tc = math.pi / (omega0 * math.sqrt(1.0 - zeta**2))
+    z = zeta / top  # Pournin's damping ratio for massR: sqrt(2) zeta on a wall
+    en = math.exp(-math.pi * z / math.sqrt(1.0 - z**2))
+    tc = math.pi / (omega0 * math.sqrt(1.0 - z**2)) * top
     return en, tc, zeta
 
 
@@ -85,19 +99,27 @@ def acceleration(kn: float, cn: float, mass_r: float, damping: float = 0.0, h: f
 
 def replica(parameters, m: float, v0: float, phases=_stepping.PHASES):
     """`(e, T)` per start phase that Yade's NewtonIntegrator realises for two spheres of mass
-    `m` (kg) at relative speed `v0` (m/s); `parameters`: `tc`, `en`, `timestep` and
-    optionally `damping` (NewtonIntegrator's, default 0 here)."""
+    `m` (kg) at relative speed `v0` (m/s), or with `parameters["geometry"] == "wall"` one
+    such sphere on a wall of mass 0 at speed `v0` (kn, cn from `massR = m/2`, acting on m);
+    `parameters`: `tc`, `en`, `timestep` and optionally `damping` (NewtonIntegrator's,
+    default 0 here)."""
     h = parameters["timestep"]
     kn, cn = stiffness_damping(parameters["tc"], parameters["en"], m / 2.0)
-    accel = acceleration(kn, cn, m / 2.0, parameters.get("damping", 0.0), h)
+    m_eff = m if parameters.get("geometry", "spheres") == "wall" else m / 2.0
+    accel = acceleration(kn, cn, m_eff, parameters.get("damping", 0.0), h)
     return _stepping.semi_implicit_euler(accel, h, v0, phases)
 
 
-def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=True):
-    """ViscElMat inputs and O.dt for target `e` and `T` (s): a dict with `parameters`, `e`,
-    `T` (the mean over start phases of the replica), `e_range`, `T_range`, `warnings`."""
-    en, tc, zeta = inputs_for(e, T)
+def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=True,
+           geometry="spheres"):  # fmt: skip
+    """ViscElMat inputs and O.dt for target `e` and `T` (s), two spheres or (`geometry=
+    "wall"`) a sphere on a fixed wall of mass 0: a dict with `parameters`, `e`, `T` (the
+    mean over start phases of the replica), `e_range`, `T_range`, `warnings`."""
+    wall = geometry == "wall"
+    en, tc, zeta = inputs_for(e, T, geometry)
     params = {"tc": tc, "en": en, "damping": 0.0}
+    if wall:
+        params["geometry"] = "wall"
     h, es, Ts, warnings = _stepping.step_and_response(
         lambda h: replica({**params, "timestep": h}, m, v0),
         e,
@@ -133,6 +155,9 @@ def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=Tru
             f"ViscElMat(tc={tc!r}, en={en!r}, et=1.0, density={rho!r}, frictionAngle=0.0)"
         ),
     }
+    if wall:
+        parameters["geometry"] = "wall"
+        parameters["wall"] = "utils.wall(0.0, axis=2, sense=1, material=mat)"
     return dict(
         parameters=parameters,
         **_stepping.realised(es, Ts, h),
@@ -148,6 +173,21 @@ def _with_cundall(params, m, v0) -> float:
 
 
 def snippet(parameters) -> str:
+    if parameters.get("geometry") == "wall":  # the wall z = 0 (mass 0, fixed)
+        return "\n".join(
+            [
+                f"mat = O.materials.append({parameters['material']})",
+                f"O.bodies.append({parameters['wall']})",
+                "O.engines = [",
+                "    ForceResetter(),",
+                "    InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),",
+                "    InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()], "
+                "[Ip2_ViscElMat_ViscElMat_ViscElPhys()], [Law2_ScGeom_ViscElPhys_Basic()]),",
+                "    NewtonIntegrator(damping=0.0),  # its default 0.2 damps every contact",
+                "]",
+                f"O.dt = {parameters['timestep']!r}",
+            ]
+        )
     return "\n".join(
         [
             f"mat = O.materials.append({parameters['material']})",
@@ -191,7 +231,8 @@ def stepper(parameters, *, m: float, radius=None):
         raise ValueError(f"NewtonIntegrator damping must lie in [0, 1), got {damping!r}")
     tc = check_positive("tc", parameters["tc"], "s")
     en = check_restitution(parameters["en"], "en")
-    stepping = {"tc": tc, "en": en, "timestep": h, "damping": damping}
+    stepping = {"tc": tc, "en": en, "timestep": h, "damping": damping,
+                "geometry": parameters.get("geometry", "spheres")}  # fmt: skip
     return h, lambda v: replica(stepping, m, v)
 
 
@@ -228,11 +269,43 @@ sys.stdout.flush()
 """
 
 
+_SCRIPT_WALL = """
+import sys
+from yade import utils
+tc, en, rho, R, v0, h, phase, damping = {args}
+mat = O.materials.append(ViscElMat(tc=tc, en=en, et=1.0, density=rho, frictionAngle=0.0))
+gap = v0 * h * phase
+O.bodies.append(utils.sphere((0, 0, R + gap), R, material=mat))
+O.bodies.append(utils.wall(0.0, axis=2, sense=1, material=mat))
+O.bodies[0].state.vel = Vector3(0, 0, -v0)
+O.engines = [
+    ForceResetter(),
+    InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),
+    InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()],
+                    [Ip2_ViscElMat_ViscElMat_ViscElPhys()], [Law2_ScGeom_ViscElPhys_Basic()]),
+    NewtonIntegrator(damping=damping, gravity=(0, 0, 0)),
+]
+O.dt = h
+steps, started = 0, False
+for _ in range(10000000):
+    O.step()
+    f = O.forces.f(0)[2]
+    if f != 0.0:
+        steps += 1
+        started = True
+    elif started:
+        break
+print("RESULT %r %r %r" % (O.bodies[0].state.vel[2] / v0, steps * h, O.bodies[0].state.mass))
+sys.stdout.flush()
+"""
+
+
 def simulate(parameters, *, m, v0, radius, phases=(0.5,), damping=0.0, executable="yade"):
     """Run Yade (`executable`, batch mode) on two spheres (mass `m` kg and radius `radius` m
     each, head-on at relative speed `v0` m/s) with `parameters`' `tc`, `en`, `timestep` and
-    NewtonIntegrator `damping`; returns arrays `(e, T)`, T the number of steps with a non-zero
-    contact force times the step."""
+    NewtonIntegrator `damping`, or with `parameters["geometry"] == "wall"` on one such sphere
+    hitting a fixed wall (utils.wall, mass 0, the plane z = 0) at `v0`; returns arrays
+    `(e, T)`, T the number of steps with a non-zero contact force times the step."""
     import os
     import subprocess
     import tempfile
@@ -245,7 +318,8 @@ def simulate(parameters, *, m, v0, radius, phases=(0.5,), damping=0.0, executabl
         with tempfile.TemporaryDirectory() as folder:
             path = os.path.join(folder, "impact.py")
             with open(path, "w") as handle:
-                handle.write(_SCRIPT.format(args=repr(args)))
+                wall = parameters.get("geometry", "spheres") == "wall"
+                handle.write((_SCRIPT_WALL if wall else _SCRIPT).format(args=repr(args)))
             out = subprocess.run(
                 [executable, "-n", "-x", path], capture_output=True, text=True, timeout=600
             )
