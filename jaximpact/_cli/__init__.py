@@ -114,7 +114,16 @@ def _run(args) -> int:
             raise
     except Interrupted as error:
         mark_reported()
-        fail(str(error), status=error.status)
+        # the line, then out at once: a signal that lands while XLA compiles leaves its
+        # threads running, and Python's own teardown beside them crashed (SIGSEGV, measured:
+        # `calibrate --law all` interrupted 4 s in); every file is already complete or not
+        # there under its final name (`_files.atomic_output`)
+        try:
+            fail(str(error), status=error.status)
+        except SystemExit:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            os._exit(error.status)
     except BrokenPipeError:  # e.g. `jaximpact laws | head`: stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         raise SystemExit(1) from None

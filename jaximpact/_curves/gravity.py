@@ -29,7 +29,6 @@ import math
 import os
 import tempfile
 import time
-import zipfile
 from pathlib import Path
 
 import jax
@@ -39,6 +38,7 @@ import numpy as np
 from . import chebyshev
 from .curve import DEGREE, OUTPUTS
 from .shapes import CurveKey, curve_key
+from .store import read_groups
 
 GAMMA_DEGREE = 15  # Chebyshev degree in u = gamma / G_k
 GAMMA_MAX = 1.0  # the largest gamma tabulated
@@ -305,15 +305,7 @@ def save(tables, path: Path):
 
 def load(path: Path) -> dict:
     """`{CurveKey: GravityTable}`; a `ValueError` if anything does not check."""
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            fields = {name: data[name] for name in data.files}
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
-        raise ValueError(f"{path}: not a gravity table file ({error})") from None
-    grouped = {}
-    for field, value in fields.items():
-        name, _, part = field.rpartition("/")
-        grouped.setdefault(name, {})[part] = value
+    grouped = read_groups(path, ValueError, "gravity table file")
     tables = {}
     for name, arrays in grouped.items():
         digest = str(arrays.pop("sha256"))
@@ -386,8 +378,7 @@ def gravity_fields(dynamics, key: CurveKey, *, m, v0, g, peaks: bool) -> tuple[d
     """`ImpactResult` fields from the table (`f(beta, 0) exp(gamma Q)`), the penetration
     at separation (m), and `in_range` (where it is False the fields are not the impact's:
     the caller integrates those)."""
-    from .._status import Status
-    from .similarity import curve_values
+    from .similarity import curve_values, fields_from_values
     from .store import curves_for
 
     outputs = (0, 1, 2, 3, 4) if peaks else (0, 1)
@@ -405,20 +396,7 @@ def gravity_fields(dynamics, key: CurveKey, *, m, v0, g, peaks: bool) -> tuple[d
         x_end = jnp.where(beta > 0, x_end, 0.0)
     else:
         x_end = jnp.zeros_like(e)
-    fields = dict(
-        e=e,
-        T=values[1] * dynamics.t_star,
-        dissipated=0.5 * m * v0**2 * (1.0 - e**2) + m * g * x_end,
-        v_out=-e * v0,
-        status=jnp.asarray(Status.separated, dtype=jnp.int32),
-        num_steps=jnp.asarray(0),
-    )
-    if peaks:
-        fields.update(
-            x_max=values[2] * dynamics.x_star,
-            t_max=values[3] * dynamics.t_star,
-            F_max=values[4] * dynamics.force_scale,
-        )
+    fields = fields_from_values(dynamics, values, e, m=m, v0=v0, gravity_work=m * g * x_end)
     return fields, x_end, in_range
 
 

@@ -70,16 +70,24 @@ def similarity_fields(dynamics, key: CurveKey, *, m, v0, peaks: bool) -> dict:
     # error (<= 3e-12) could put e just above it: clamped, with the slope kept (at b = 0
     # the derivative is the elastic limit's)
     excess = jax.lax.stop_gradient(jnp.maximum(values[0] - 1.0, 0.0))
-    e, tau = values[0] - excess, values[1]
+    return fields_from_values(dynamics, values, values[0] - excess, m=m, v0=v0)
+
+
+def fields_from_values(dynamics, values, e, *, m, v0, gravity_work=None) -> dict:
+    """`ImpactResult` fields of a separated impact from the nondimensional outputs
+    `values` (e, T/t*, and with peaks x_max/x*, t_max/t*, F_max/(m v0^2/x*)), with `e`
+    already clamped; `gravity_work` (J): gravity's work over the final penetration, added
+    to the energy taken."""
+    dissipated = 0.5 * m * v0**2 * (1.0 - e**2)
     fields = dict(
         e=e,
-        T=tau * dynamics.t_star,
-        dissipated=0.5 * m * v0**2 * (1.0 - e**2),
+        T=values[1] * dynamics.t_star,
+        dissipated=dissipated if gravity_work is None else dissipated + gravity_work,
         v_out=-e * v0,
         status=jnp.asarray(Status.separated, dtype=jnp.int32),
         num_steps=jnp.asarray(0),
     )
-    if peaks:
+    if values.shape[0] > 2:  # the peaks
         fields.update(
             x_max=values[2] * dynamics.x_star,
             t_max=values[3] * dynamics.t_star,

@@ -99,17 +99,25 @@ def _checked(name: str, arrays: dict) -> Curves:
     return Curves(key, breaks, coefficients, float(beta_max), capture, tail)
 
 
-def load(path: Path) -> dict:
-    """`{CurveKey: Curves}` from a file; `CorruptCurves` if anything does not check."""
+def read_groups(path: Path, error, what: str) -> dict:
+    """The arrays of an `.npz` file of tables, grouped by table: `{name: {part: array}}`
+    from its fields `name/part`; `error(message)` (an exception class) if it is not such a
+    file (`what` names the kind, e.g. "curves file")."""
     try:
         with np.load(path, allow_pickle=False) as data:
             fields = {name: data[name] for name in data.files}
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
-        raise CorruptCurves(f"{path}: not a curves file ({error})") from None
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as reason:
+        raise error(f"{path}: not a {what} ({reason})") from None
     grouped = {}
     for field, value in fields.items():
         name, _, part = field.rpartition("/")
         grouped.setdefault(name, {})[part] = value
+    return grouped
+
+
+def load(path: Path) -> dict:
+    """`{CurveKey: Curves}` from a file; `CorruptCurves` if anything does not check."""
+    grouped = read_groups(path, CorruptCurves, "curves file")
     try:
         curves = [_checked(name, arrays) for name, arrays in grouped.items()]
     except (KeyError, TypeError, ValueError) as error:

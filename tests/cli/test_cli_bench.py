@@ -86,7 +86,7 @@ def test_plot_is_a_png(quick):
 @pytest.mark.slow
 def test_text_table(quick):
     data = json.loads(quick[1])
-    text = _cli_bench._text(data)
+    text = _cli_bench._text(data, width=400)  # unwrapped (wrapping: test_assumptions.py)
     assert "load average" in text and "CPUs" in text and "backend" in text
     assert "single (>= 50x)" in text and "batch (>= 1000x)" in text
     assert "kelvin_voigt (integrate)" in text and "explicit Euler" in text

@@ -88,15 +88,19 @@ def test_kelvin_voigt_penetration_criterion_under_damped(b):
 @pytest.mark.parametrize("b", OVER)
 def test_kelvin_voigt_penetration_criterion_over_damped(b):
     want = closed(kelvin_voigt(KV_C, b, KV_M, KV_V0, separation="penetration"))
-    got = solver("kelvin_voigt", "penetration", rtol=ORACLE_RTOL)(
-        dict(c=KV_C, b=b), m=KV_M, v0=KV_V0
-    )
     assert_finite(want, "closed form")
     assert int(want["status"]) == ji.Status.captured
     assert want["e"] == 0.0 and math.isfinite(want["T"]) and want["T"] > want["t_max"]
-    if b < 3000:  # b = 5000: see test_overdamped_rest_time
-        assert int(got["status"]) == ji.Status.captured
-    rtol = 1e-9 if b < 5000 else 1e-8  # as in test_kelvin_voigt_force_criterion
+    integrate = solver("kelvin_voigt", "penetration", rtol=ORACLE_RTOL)
+    if b >= 5000:
+        # the integrated creep to rest runs out of steps at rtol 1e-12 (the closed form is
+        # the default path); a failed solve is refused, not returned as numbers
+        with pytest.raises(RuntimeError, match="ran out of steps"):
+            integrate(dict(c=KV_C, b=b), m=KV_M, v0=KV_V0)
+        return
+    got = integrate(dict(c=KV_C, b=b), m=KV_M, v0=KV_V0)
+    assert int(got["status"]) == ji.Status.captured
+    rtol = 1e-9
     compare(got, want, f"over-damped b={b}", keys=("e", "x_max", "t_max", "F_max"), rtol=rtol)
 
 
