@@ -279,6 +279,7 @@ def test_matches_scipy(law, separation):
 
 
 @pytest.mark.slow
+@pytest.mark.very_slow  # minutes per law: the rest instants against scipy at atol 1e-22
 @pytest.mark.parametrize("separation", SEPARATIONS)
 @pytest.mark.parametrize("law", LAWS)
 def test_matches_scipy_full_grid(law, separation):
