@@ -261,7 +261,8 @@ def test_a_corrupt_or_foreign_cache_file_is_rebuilt(tmp_path, monkeypatch):
 
 @pytest.mark.slow
 def test_a_custom_shape_is_built_once_and_reused_across_processes(tmp_path):
-    env = {**os.environ, "JAXIMPACT_CURVES_DIR": str(tmp_path)}
+    # the build reports on stderr (the suite turns default meters off: on here)
+    env = {**os.environ, "JAXIMPACT_CURVES_DIR": str(tmp_path), "JAXIMPACT_PROGRESS": "on"}
     script = textwrap.dedent(
         """
         import time, jax

@@ -60,7 +60,7 @@ FAMILY = {
     "hertz_modified": (1.5, 1.0, "b", None),
     "hertz_rate": (1.5, 0.5, "b1", None),
 }
-STATUS = {"separated": 0, "stuck": 1, "captured": 2, "out_of_steps": 3}
+STATUS = {"separated": 0, "stuck": 1, "captured": 2, "out_of_steps": 3, "failed": 5}
 
 
 def groups_of(name):
@@ -306,9 +306,13 @@ def summarise(name, separation, members, out, refs):
     _, t_star = parameters(name, members)
     status = out["status"]
     values = {k: out[k] for k in ("e", "T", "x_max", "t_max", "F_max", "dissipated") if k in out}
-    finite_values = finite_rows(values)
-    finite_fwd = finite_rows(out["jacfwd"]) if "jacfwd" in out else None
-    finite_rev = finite_rows(out["grad"]) if "grad" in out else None
+    # a failed member (out of steps, failed) has NaN in every field by the failure rule:
+    # counted by its status, and its fields checked to be NaN, not numbers
+    failed = (status == STATUS["out_of_steps"]) | (status == STATUS["failed"])
+    failed_with_numbers = int(np.sum(failed & np.isfinite(np.asarray(out["e"]))))
+    finite_values = finite_rows(values) | failed
+    finite_fwd = finite_rows(out["jacfwd"]) | failed if "jacfwd" in out else None
+    finite_rev = finite_rows(out["grad"]) | failed if "grad" in out else None
     both = (status == 0) & (status_ref == 0)
     e_err = np.abs(out["e"] - e_ref)[both]
     with np.errstate(invalid="ignore"):  # tau_ref is inf where the reference is captured
@@ -333,7 +337,7 @@ def summarise(name, separation, members, out, refs):
             )
             for k in mismatch[:5]
         ],
-        nan_values=int(np.sum(~finite_values)),
+        nan_values=int(np.sum(~finite_values)) + failed_with_numbers,
         nan_jacfwd=None if finite_fwd is None else int(np.sum(~finite_fwd)),
         nan_grad=None if finite_rev is None else int(np.sum(~finite_rev)),
         nan_members=[

@@ -53,6 +53,7 @@ def _check(summary, gradients=True):
         assert summary["nan_jacfwd"] == 0, f"{where}: NaN in jacfwd: {summary['nan_members']}"
         if summary.get("nan_grad") is not None:
             assert summary["nan_grad"] == 0, f"{where}: NaN in grad: {summary['nan_members']}"
+    assert summary["counts"]["failed"] == 0, f"{where}: failed solves {summary}"
     if key in CREEPING_OUT_OF_STEPS:  # out of steps is the only disagreement allowed
         assert summary["status_mismatch"] == summary["counts"]["out_of_steps"], where
     else:
