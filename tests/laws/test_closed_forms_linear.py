@@ -272,8 +272,19 @@ def check_grid(law, separation, full):
     return errors
 
 
-@pytest.mark.parametrize("separation", SEPARATIONS)
-@pytest.mark.parametrize("law", LAWS)
+# the fast suite: each law under one criterion; the slow group: the other criterion too
+FAST_GRID = {("kelvin_voigt", "force"), ("bingham", "penetration"),
+             ("bingham_compression", "force"), ("maxwell", "penetration")}  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "law, separation",
+    [
+        (law, sep) if (law, sep) in FAST_GRID else pytest.param(law, sep, marks=pytest.mark.slow)
+        for law in LAWS
+        for sep in SEPARATIONS
+    ],
+)
 def test_matches_scipy(law, separation):
     check_grid(law, separation, full=False)
 
