@@ -87,6 +87,7 @@ def test_any_chunk_size_gives_the_same_rows(tmp_path):
                                    rtol=1e-14, err_msg=key)  # fmt: skip
 
 
+@pytest.mark.slow  # moved from the fast suite to keep it near 3 minutes
 def test_columns_for_separation_and_failing_rows_kept_with_their_status(tmp_path):
     """Over-damped Kelvin-Voigt under `penetration` is captured (e = 0): kept, not dropped;
     each separation as `impact_batch` gives it in memory."""

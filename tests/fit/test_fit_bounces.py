@@ -84,6 +84,7 @@ def test_clean_rejects_bad_input():
 # ---------------------------------------------------------------- impact-time fit
 
 
+@pytest.mark.slow  # moved from the fast suite to keep it near 3 minutes
 def test_impact_times_round_trip_recovers_e_within_its_uncertainty():
     fit = golf_fit()
     _, e_true, v_true = golf_drop()

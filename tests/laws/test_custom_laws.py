@@ -196,6 +196,7 @@ def test_users_laws_match_scipy_under_the_penetration_criterion(case):
 
 
 @pytest.mark.slow
+@pytest.mark.very_slow  # 60 draws, about 4 minutes: run by hand with -m very_slow
 @settings(PROPERTY, max_examples=60)
 @given(case=_law_and_impact(list(TEMPLATES)))
 def test_users_laws_match_scipy_under_the_force_criterion_many(case):

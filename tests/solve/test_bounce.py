@@ -246,6 +246,7 @@ def histories():
     return b, n, ts, y, u, F
 
 
+@pytest.mark.slow  # moved from the fast suite to keep it near 3 minutes
 def test_height_in_flight_is_the_parabola():
     b, n, ts, y, u, F = histories()
     first = ts < float(b.impact_times[0])

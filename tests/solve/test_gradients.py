@@ -188,6 +188,7 @@ def test_closed_form_penetration_gradients_finite(c, b):
         assert_rel(np.array(got), np.array(exact), 1e-10, f"{f.__name__} forward")
 
 
+@pytest.mark.slow  # moved from the fast suite to keep it near 3 minutes
 def test_closed_form_path_differentiates():
     """`impact` on its closed-form path (Kelvin-Voigt, the default) is differentiable too."""
 

@@ -185,6 +185,7 @@ KV_INTEGRATE_CREEPING = [
 ]
 
 
+@pytest.mark.slow  # moved from the fast suite to keep it near 3 minutes
 def test_regression_kv_closed_form_captured_gradients():
     """Finite `jax.jacfwd` and `jax.grad` on the closed form's captured branch: e of a
     captured member has derivative 0, T (the rest time) a finite one, the same both ways."""
