@@ -364,5 +364,10 @@ def _stream(law, chunks, out, *, m, v0, g, separation, progress, **options):
         raise ValueError("impact_batch over chunks needs out= (a CSV or Parquet path)")
     if chunks is None:
         raise ValueError("impact_batch with out= needs the chunks (an iterable of mappings)")
-    return batch_file(chunks, out, law, m=m, v0=v0, g=g, separation=separation,
+    # impact_batch's own defaults (g = 0, "force") are not a value given for every row:
+    # a chunk's g or separation column then holds (batch_file refuses a column that
+    # disagrees with a value given)
+    default_g = isinstance(g, (int, float)) and not isinstance(g, bool) and g == 0.0
+    return batch_file(chunks, out, law, m=m, v0=v0, g=None if default_g else g,
+                      separation=None if separation == "force" else separation,
                       progress=progress, **options)  # fmt: skip
