@@ -109,6 +109,16 @@ class AbstractLaw(eqx.Module):
     def replace(self, **params) -> "AbstractLaw":
         """The same law with some parameters changed."""
 
+    def _refuse_unknown(self, params: dict, who: str | None = None):
+        """A one-line `ValueError` for names in `params` that are not the law's parameters
+        (what every `replace` checks first)."""
+        unknown = sorted(set(params) - set(self.params))
+        if unknown:
+            raise ValueError(
+                f"{who or f'law {self.name!r}'} has no parameter {', '.join(unknown)}; "
+                f"it has {', '.join(self.params)}"
+            )
+
     @abc.abstractmethod
     def force(self, x, v, **kwargs):
         """The contact force (N) at penetration `x` (m) and velocity `v` (m/s); a law whose

@@ -29,12 +29,7 @@ class CustomLaw(AbstractLaw):
         return None
 
     def replace(self, **params):
-        unknown = sorted(set(params) - set(self.params))
-        if unknown:
-            raise ValueError(
-                f"this custom law has no parameter {', '.join(unknown)}; "
-                f"it has {', '.join(self.params)}"
-            )
+        self._refuse_unknown(params, "this custom law")
         return CustomLaw(self.fn, {**self.params, **_finite_arrays(params)}, self.name)
 
     def dynamics(self, *, m, v0, g):

@@ -32,12 +32,7 @@ class MaxwellLaw(AbstractLaw):
         return MAXWELL
 
     def replace(self, **params):
-        unknown = sorted(set(params) - set(self.params))
-        if unknown:
-            raise ValueError(
-                f"law {self.name!r} has no parameter {', '.join(unknown)}; "
-                f"it has {', '.join(self.params)}"
-            )
+        self._refuse_unknown(params)
         return MaxwellLaw(checked_parameters(MAXWELL, {**self.params, **params}))
 
     def dynamics(self, *, m, v0, g):

@@ -43,12 +43,7 @@ class Law(AbstractLaw):
         return self.spec.coefficients(self.params, v0)
 
     def replace(self, **params):
-        unknown = sorted(set(params) - set(self.params))
-        if unknown:
-            raise ValueError(
-                f"law {self.name!r} has no parameter {', '.join(unknown)}; "
-                f"it has {', '.join(self.params)}"
-            )
+        self._refuse_unknown(params)
         return law(self.name, **{**self.params, **params})
 
     def dynamics(self, *, m, v0, g):
