@@ -5,7 +5,12 @@ status 130 (SIGINT) or 143 (SIGTERM), and says in one line what it kept.
 handler that records the signal and raises `Interrupted` (a `KeyboardInterrupt`) in the main
 thread. That is not always enough: the main thread may be inside a long XLA computation
 (Python runs no handler until it returns), and an exception raised while JAX runs a Python
-callback may be caught there and reported as something else, or printed and ignored. So
+callback may be caught there and reported as something else, or printed and ignored (Python
+prints an exception raised in a garbage-collection callback, such as JAX's, as "Exception
+ignored in ..." and goes on). So
+
+- an `Interrupted` that Python could not raise (`sys.unraisablehook`) is not printed: the
+  signal is recorded and raised again at the next safe point;
 
 - the long loops call `check_interrupt()` at their safe points (between chunks, between
   fits), which raises again if a signal was recorded, whatever became of the first raise;
@@ -22,6 +27,7 @@ callback may be caught there and reported as something else, or printed and igno
 import contextlib
 import os
 import signal
+import sys
 import threading
 
 GRACE = 2.0  # s a stopping command has to reach its own clean exit before the watchdog's
@@ -71,6 +77,18 @@ def _handler(signum, frame):
     with _lock:
         _state["signal"] = _state["signal"] or signum
     raise Interrupted(_state["signal"])
+
+
+def _quiet_unraisable(previous):
+    """An unraisable-exception hook that drops `Interrupted` (recorded; raised again at the
+    next safe point or ended by the watchdog) and passes anything else to `previous`."""
+
+    def hook(unraisable):
+        if isinstance(unraisable.exc_value, Interrupted):
+            return
+        previous(unraisable)
+
+    return hook
 
 
 def _watch(read_fd: int, stop: threading.Event):
@@ -142,6 +160,8 @@ def handle_interrupts():
     stop = threading.Event()
     previous = {s: signal.getsignal(s) for s in _SIGNALS}
     previous_fd = signal.set_wakeup_fd(write_fd, warn_on_full_buffer=False)
+    previous_hook = sys.unraisablehook
+    sys.unraisablehook = _quiet_unraisable(previous_hook)
     for s in _SIGNALS:
         signal.signal(s, _handler)
     _state.update(signal=None, note=None, active=True, reported=False)
@@ -155,6 +175,7 @@ def handle_interrupts():
             for s, handler in previous.items():
                 signal.signal(s, handler)
             signal.set_wakeup_fd(previous_fd)
+            sys.unraisablehook = previous_hook
             os.close(write_fd)  # wakes the watchdog, which returns
             watchdog.join(1.0)
             os.close(read_fd)

@@ -204,6 +204,40 @@ def test_an_interrupt_that_something_swallows_still_stops_the_command(signum):
     ]
 
 
+def test_an_interrupt_landing_in_a_gc_callback_prints_nothing_and_is_raised_again():
+    """CI caught SIGINT raised inside JAX's `_xla_gc_callback`: Python printed "Exception
+    ignored in ..." with a traceback before the one line. Such an unraisable `Interrupted` is
+    recorded, not printed, and the next safe point raises it; other unraisables still print."""
+    child = _python(
+        """
+        import gc, signal
+        from jaximpact._interrupt import check_interrupt, handle_interrupts, Interrupted
+
+        def gc_callback(phase, info):  # as JAX's: a signal's raise lands here
+            if phase == "start":
+                gc.callbacks.remove(gc_callback)
+                signal.raise_signal(signal.SIGINT)
+
+        with handle_interrupts():
+            gc.callbacks.append(gc_callback)
+            gc.collect()
+            print("went on", flush=True)
+            class Other:
+                def __del__(self):
+                    raise ValueError("not an interrupt")
+            Other()
+            try:
+                check_interrupt()
+            except Interrupted as stop:
+                print("raised again:", stop.status, flush=True)
+        """
+    )
+    out, err = child.communicate(timeout=30)
+    assert out.splitlines() == ["went on", "raised again: 130"]
+    assert "Interrupted" not in err and "interrupted by SIGINT" not in err
+    assert "ValueError: not an interrupt" in err  # only our own exception is kept quiet
+
+
 ROWS = 12_000  # at 20 rows a chunk: 600 chunks, a few seconds of batch
 
 
