@@ -68,6 +68,8 @@ _PUBLIC = {
 _PUBLIC.update(
     {
         "hertz_stiffness": "_engines",
+        "yield_overlap": "_engines.materials",
+        "work_of_adhesion": "_engines.materials",
         "effective_mass": "_engines",
         "effective_radius": "_engines",
         "export": "_engines",

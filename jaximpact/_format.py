@@ -21,6 +21,8 @@ def format_quantity(value, unit: str, digits: int = 4) -> str:
     value = float(value)
     if not math.isfinite(value) or value == 0.0:
         return f"{value:g} {unit}"
+    if unit == "kg" and abs(value) < 1 - 0.5 * 10.0**-digits:  # 4 g, not 4 mkg
+        return format_quantity(value * 1e3, "g", digits)
     prefixes = [(s, p) for s, p in _PREFIXES if s <= 1.0 or unit in _MULTIPLE_UNITS]
     threshold = 1 - 0.5 * 10.0**-digits  # 0.99996 s rounds to 1 s, not 1000 ms
     scale, prefix = next(((s, p) for s, p in prefixes if abs(value) >= s * threshold), prefixes[-1])

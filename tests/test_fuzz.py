@@ -80,10 +80,12 @@ def test_law_takes_numbers_or_arrays_of_good_numbers_only(value):
 
 def _refused(name: str, key: str, value: float) -> bool:
     """DESIGN.md's rule: stiffness and exponent > 0, a nominal restitution in (0, 1], the
-    rest >= 0; Maxwell's dashpot > 0 (b = 0 carries no force: the body never stops)."""
+    rest >= 0; Maxwell's dashpot > 0 (b = 0 carries no force: the body never stops),
+    Thornton's yield overlap and JKR's radius > 0."""
     if not math.isfinite(value):
         return True
-    if key in ("c", "n") or (name == "maxwell" and key == "b"):
+    positive = {"maxwell": ("b",), "thornton": ("x_y",), "jkr": ("R",)}.get(name, ())
+    if key in ("c", "n") or key in positive:
         return value <= 0
     if key == "e_nominal":
         return not 0 < value <= 1
@@ -112,7 +114,8 @@ def test_every_law_builds_or_refuses(name, which, value):
 
 
 def _start(name):
-    return ji.starting_law(name, m=1.0, v0=2.5, e=0.8, T=7.8e-3)
+    geometry = {k: 0.01 for k in ji.LAWS[name].geometry}  # JKR's radius, m
+    return ji.starting_law(name, m=1.0, v0=2.5, e=0.8, T=7.8e-3, **geometry)
 
 
 # ----------------------------------------------------------------------------- one impact

@@ -184,6 +184,7 @@ def measurements(args) -> dict:
     import numpy as np
 
     from .._fit.calibrate import check_targets
+    from .._laws import LAWS
 
     flags = [f"--{k}" for k in ("v0", "e", "T") if getattr(args, k) is not None]
     flags += [
@@ -224,6 +225,7 @@ def measurements(args) -> dict:
         None if T is None else np.asarray(T),
         None if sigma_e is None else np.asarray(sigma_e),
         None if sigma_T is None else np.asarray(sigma_T),
+        sticks=args.law in LAWS and LAWS[args.law].captures,  # e = 0: stuck, data
     )  # the library's own messages, before the start values need sane numbers
     return dict(v0=columns["v0"], e=columns["e"], T=T, sigma_e=sigma_e, sigma_T=sigma_T, rows=rows)
 
@@ -302,6 +304,7 @@ def _run_one(args, data):
         v0=data["v0"][row],
         e=data["e"][row],
         T=None if T_row is None or math.isnan(T_row) else T_row,
+        **{k: given[k] for k in LAWS[args.law].geometry if k in given},  # JKR's radius
     )
     if given:
         start = start.replace(**given)

@@ -11,7 +11,14 @@ import sys
 
 import numpy as np
 
-__all__ = ["effective_mass", "effective_radius", "effective_modulus", "hertz_stiffness"]
+__all__ = [
+    "effective_mass",
+    "effective_radius",
+    "effective_modulus",
+    "hertz_stiffness",
+    "yield_overlap",
+    "work_of_adhesion",
+]
 
 
 def _positive(name: str, value, unit: str, *, infinite_ok: bool = False) -> float:
@@ -113,6 +120,44 @@ def hertz_stiffness(E, nu, R, E2=None, nu2=None, R2=None) -> float:
     R_star = R if R2 is None else effective_radius(R, R2)
     return _representable("c", 4.0 / 3.0 * effective_modulus(E, nu, E2, nu2) * math.sqrt(R_star),
                           "N/m^1.5")  # fmt: skip
+
+
+def yield_overlap(E, nu, R, *, p_y=None, Y=None, E2=None, nu2=None, R2=None) -> float:
+    """The yield overlap `x_y` (m) of `law("thornton", c=..., x_y=...)`: where the Hertz
+    contact's mean pressure reaches the limiting pressure `p_y`,
+    `x_y = R* (pi p_y / (2 E*))^2` (Thornton 1997).
+
+    - `p_y` (Pa): the limiting contact pressure; or `Y` (Pa), the yield stress, with
+      `p_y = 1.6 Y` (first yield below the surface, Johnson 1985, section 6.2).
+    - `E` (Pa), `nu`, `R` (m), and `E2`, `nu2`, `R2` for the second body as in
+      `hertz_stiffness` (default: the same material, a flat).
+
+    **Example**: steel (E = 210 GPa, nu = 0.3, Y = 1 GPa) ball of R = 5 mm on a rigid flat:
+    `yield_overlap(E=2.1e11, nu=0.3, R=5e-3, Y=1e9, E2=math.inf)`, about 0.36 µm.
+    """
+    if (p_y is None) == (Y is None):
+        raise ValueError("give the limiting contact pressure p_y (Pa) or the yield stress Y (Pa)")
+    p_y = 1.6 * _positive("Y", Y, "Pa") if p_y is None else _positive("p_y", p_y, "Pa")
+    R = _positive("R", R, "m")
+    R_star = R if R2 is None else effective_radius(R, R2)
+    E_star = effective_modulus(E, nu, E2, nu2)
+    return _representable("x_y", R_star * (math.pi * p_y / (2.0 * E_star)) ** 2, "m")
+
+
+def work_of_adhesion(gamma, gamma2=None, gamma12=0.0) -> float:
+    """The work of adhesion `w` (J/m^2) of `law("jkr", ..., w=...)` from surface energies
+    (J/m^2) by Dupre's rule, `w = gamma + gamma2 - gamma12`: twice the surface energy for
+    like surfaces (`gamma2` defaults to `gamma`, the interface energy `gamma12` to 0).
+    Mind the convention: a pull-off force written `3 pi Gamma R` uses `Gamma = w / 2`.
+
+    **Example**: `work_of_adhesion(0.2)` is 0.4 J/m^2.
+    """
+    gamma = _positive("gamma", gamma, "J/m^2")
+    gamma2 = gamma if gamma2 is None else _positive("gamma2", gamma2, "J/m^2")
+    w = gamma + gamma2 - float(gamma12)
+    if not w > 0:
+        raise ValueError(f"the work of adhesion gamma + gamma2 - gamma12 must be > 0, got {w:g}")
+    return w
 
 
 def _representable(name: str, value: float, unit: str) -> float:

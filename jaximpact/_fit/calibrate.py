@@ -327,8 +327,9 @@ def _as_rows(name, value, rows, allow_missing=False):
     return xp.broadcast_to(value, (rows,)) if rows is not None else value
 
 
-def check_targets(m, v0, e, T, sigma_e, sigma_T):
-    """One-line ValueErrors for impossible targets (only for concrete inputs)."""
+def check_targets(m, v0, e, T, sigma_e, sigma_T, *, sticks=False):
+    """One-line ValueErrors for impossible targets (only for concrete inputs); `sticks`: the
+    law can hold the body (`LawSpec.captures`), so `e = 0` is a measurement."""
     concrete = not any(is_traced(a) for a in (m, v0, e, T, sigma_e, sigma_T))
     if not concrete:
         return
@@ -340,8 +341,10 @@ def check_targets(m, v0, e, T, sigma_e, sigma_T):
         ea = np.asarray(e)
         if np.any(np.isnan(ea)):
             raise ValueError("e contains NaN; every row needs a measured restitution")
-        if np.any((ea <= 0) | (ea > 1)):
-            raise ValueError(f"restitution e must lie in (0, 1], got {ea[(ea <= 0) | (ea > 1)]}")
+        bad = ((ea < 0) if sticks else (ea <= 0)) | (ea > 1)
+        if np.any(bad):
+            interval = "[0, 1] (0: stuck)" if sticks else "(0, 1]"
+            raise ValueError(f"restitution e must lie in {interval}, got {ea[bad]}")
     if T is not None:
         Ta = np.asarray(T)
         if np.all(np.isnan(Ta)):
@@ -619,7 +622,8 @@ def calibrate(
     T = _as_rows("T", T, rows, allow_missing=True)
     sigma_e = _as_rows("sigma_e", sigma_e, rows)
     sigma_T = _as_rows("sigma_T", sigma_T, rows)
-    check_targets(m, v0, e, T, sigma_e, sigma_T)
+    sticks = law.spec is not None and law.spec.captures
+    check_targets(m, v0, e, T, sigma_e, sigma_T, sticks=sticks)
     m = jnp.asarray(m, dtype=float) if is_traced(m) else np.float64(m)
     has_sigma = sigma_e is not None or sigma_T is not None
     free = default_free(law, stiffness=T is not None) if free is None else tuple(free)
@@ -861,7 +865,10 @@ def _fit(law, data, m, g, target_tol, options):
         filled = jnp.arange(history.shape[0]) < iterations
         history = jnp.where(filled, history, final_loss)
     fitted = law_with(law, free, theta)
-    separated = jnp.all(status == Status.separated)
+    # every impact separated; with a law that holds the body (adhesion), a row measured as
+    # stuck (e = 0) is matched by a captured impact
+    stuck_row = (law.spec is not None and law.spec.captures) & (e == 0) & options.has_e
+    separated = jnp.all((status == Status.separated) | (stuck_row & (status == Status.captured)))
     reproduces = jnp.all(jnp.abs(r) <= target_tol) & separated
     if exact:  # no optimiser ran: converged where the curves' solution meets the targets
         known = jnp.isfinite(T)

@@ -14,7 +14,11 @@ from .._progress import AbstractMeter, metered
 from .calibrate import Fit, calibrate
 from .parameters import default_free
 
-PAPER_LAWS = tuple(name for name, spec in LAWS.items() if spec.equation != "-")
+# the laws `compare_laws` fits by default: every row with an equation that needs no geometry
+# (a law with a radius, JKR's, takes part as a law object built with it)
+PAPER_LAWS = tuple(
+    name for name, spec in LAWS.items() if spec.equation != "-" and not spec.geometry
+)
 
 
 def _undamped_tau(n: float) -> float:
@@ -24,11 +28,25 @@ def _undamped_tau(n: float) -> float:
     return 2.0 * ((n + 1.0) / 2.0) ** k * beta / (n + 1.0)
 
 
-def starting_law(name: str, *, m: float, v0: float, e: float, T: float | None):
+def starting_law(name: str, *, m: float, v0: float, e: float, T: float | None, **geometry):
     """A law `name` whose parameters roughly reproduce `e` and `T` at speed `v0`: the
     undamped contact time sets `c`, an equivalent linear damping ratio sets the rest
-    (`calibrate` then refines them)."""
+    (`calibrate` then refines them); a row with its own start (`LawSpec.start`: Thornton's,
+    JKR's) uses it. `geometry`: the law's geometry parameters (JKR's radius `R`, m), which
+    no fit guesses."""
     spec = LAWS[name]
+    missing = [k for k in spec.geometry if k not in geometry]
+    unknown = sorted(set(geometry) - set(spec.geometry))
+    if missing or unknown:
+        raise ValueError(
+            f"law {name!r} needs its {', '.join(missing)} (m), which no fit guesses: give it "
+            f"(--param {missing[0]}=... on the command line), or pass a law object"
+            if missing
+            else f"starting_law({name!r}) takes no {', '.join(unknown)}: only the law's "
+            f"geometry ({', '.join(spec.geometry) or 'none'})"
+        )
+    if spec.start is not None:
+        return law(name, **spec.start(m=m, v0=v0, e=e, T=T, **geometry))
     T = 1e-3 if T is None or not np.isfinite(T) else T
     log_e = math.log(min(max(e, 1e-6), 0.999999))
     zeta = -log_e / math.sqrt(math.pi**2 + log_e**2)

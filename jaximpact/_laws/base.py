@@ -49,7 +49,12 @@ class LawSpec:
     the formula `D(e, v0)` (s/m) of a Hunt-Crossley variant whose damping is set from a
     nominal restitution, so that its impact is `hunt_crossley`'s with `a = D / 1.5`.
     `positive`: the parameters that must be > 0 (the others >= 0); Maxwell's dashpot with
-    b = 0 carries no force, and the body would never stop.
+    b = 0 carries no force, and the body would never stop. `captures`: the law holds the
+    body below a speed (an adhesive neck), so a measured `e = 0` is data a fit matches
+    with a `captured` impact, not an error. `geometry`: parameters that are the bodies'
+    geometry (a radius), which the user gives and no fit frees or guesses. `start`: the
+    row's own start for a fit, `start(m, v0, e, T) -> params` (SI; `T` may be None), where
+    the family's (an undamped contact time and a damping ratio) does not apply.
     """
 
     name: str
@@ -74,6 +79,9 @@ class LawSpec:
     restitution_table: bool = False
     nominal: Callable | None = None
     positive: tuple[str, ...] = ("c", "n")
+    captures: bool = False
+    geometry: tuple[str, ...] = ()
+    start: Callable | None = None
 
     def __post_init__(self):
         if (self.coefficients is None) == (self.state is None):

@@ -54,6 +54,12 @@ class AbstractDynamics(eqx.Module):
         """Positive while the contact pushes; crosses zero transversally where it stops
         pushing (the `"force"` separation criterion)."""
 
+    def penetration_gap(self, y: Array) -> Array:
+        """Positive while in contact under the `"penetration"` criterion: `X` (the body
+        leaves the surface at `X = 0`), unless the contact holds beyond it (an adhesive
+        neck, which breaks at pull-off)."""
+        return self.position(y)
+
     def surface_gap(self, y: Array) -> Array | None:
         """`None`, or a condition that crosses zero where the body leaves the surface
         (`X = 0`) and that ends contact under the force criterion besides `force_gap` (a

@@ -15,7 +15,9 @@ from .closed_forms import (
     bingham_compression_closed_form,
     kelvin_voigt_closed_form,
 )
+from .jkr import JKR
 from .maxwell import MAXWELL
+from .thornton import THORNTON
 
 _PAPER = "Polukoshko et al. 2007"
 _UNITS = {
@@ -305,6 +307,9 @@ _SPECS += [
         shape=(1.0, 1.0),
     ),
 ]
+
+# laws with a contact state beyond the seed paper: plastic (thornton.py), adhesive (jkr.py)
+_SPECS += [THORNTON, JKR]
 
 LAWS: dict[str, LawSpec] = {spec.name: spec for spec in _SPECS}
 LAW_NAMES: tuple[str, ...] = tuple(LAWS)

@@ -46,7 +46,7 @@ def _event_conditions(dynamics, separation, plan, rest_tol):
         if separation == "force":
             gap = dynamics.force_gap(y, args < _TO_SEPARATION)
         else:
-            gap = dynamics.position(y)
+            gap = dynamics.penetration_gap(y)
         condition = jnp.where(args < _TO_SEPARATION, dynamics.velocity(y), gap)
         if _TO_PEAK in plan:
             condition = jnp.where(args == _TO_PEAK, dynamics.force_rate(y, True), condition)

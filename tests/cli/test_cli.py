@@ -171,6 +171,8 @@ def test_parse_params_and_formatting():
     assert _format.format_quantity(1033.45, "N") == "1.033 kN"
     assert _format.format_quantity(0.9999999, "m") == "1 m"
     assert _format.format_quantity(0.0, "J") == "0 J"
+    assert _format.format_quantity(4e-3, "kg") == "4 g"  # not "4 mkg"
+    assert _format.format_quantity(2.5, "kg") == "2.5 kg"
     assert _format.format_number(2e6) == "2e6" and _format.format_number(800.0) == "800"
     assert _format.jsonable({"a": np.float64(np.nan), "b": np.arange(2)}) == {
         "a": None,

@@ -34,6 +34,9 @@ OTHER_LAWS = {
     "tsuji_restitution": dict(c=2e6, e_nominal=0.8, m_eff=1.0),
     "spring_dashpot_restitution": dict(c=2e6, e_nominal=0.8, m_eff=1.0),
     "point_contact": dict(c=2e6, d=0.2),
+    # laws with a contact state: plastic, adhesive
+    "thornton": dict(c=2e6, x_y=1e-3),
+    "jkr": dict(c=2e6, R=0.01, w=200.0),
 }
 # laws whose every term carries a fractional power of x: no force at all outside contact
 FRACTIONAL = ("hertz_rate", "hunt_crossley") + NOMINAL_LAWS
