@@ -1,6 +1,7 @@
 """Drake's discrete plant against the continuous promise: the e that Drake realises with the
 exported `point_contact_stiffness` and `hunt_crossley_dissipation` at several time steps and
-discrete contact approximations (real Drake, sphere on a half space, gravity off).
+discrete contact approximations (real Drake, sphere on a half space, gravity off), run by
+the test harness (tests/engines/harness.py).
 
     python benchmarks/drake_discrete.py    # writes benchmarks/drake_discrete.md
 """
@@ -12,13 +13,15 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, ".."))
+sys.path.insert(0, os.path.join(HERE, "..", "tests", "engines"))
 
 import jax  # noqa: E402
 
 jax.config.update("jax_enable_x64", True)
 
+from harness import run_drake  # noqa: E402
+
 import jaximpact as ji  # noqa: E402
-from jaximpact._engines import drake  # noqa: E402
 
 M, V0, T = 1.0, 1.0, 1e-2
 TARGETS = (0.9, 0.6)
@@ -41,7 +44,7 @@ def main():
     ]
     for e in TARGETS:
         x = ji.export(None, "drake", m=M, v0=V0, e=e, T=T, curves=False)
-        es_cont, _ = drake.simulate(x.parameters, m=M, v0=V0)
+        es_cont, _ = run_drake(x.parameters, m=M, v0=V0)
         header = "| time step (s) | steps per contact | " + " | ".join(APPROXIMATIONS) + " |"
         lines += [f"## target e = {e}, continuous plant e = {es_cont:.6f}", "", header,
                   "|" + "---|" * (len(APPROXIMATIONS) + 2)]  # fmt: skip
@@ -49,7 +52,7 @@ def main():
             cells = []
             for approximation in APPROXIMATIONS:
                 try:
-                    got, _ = drake.simulate(
+                    got, _ = run_drake(
                         x.parameters, m=M, v0=V0, time_step=h, approximation=approximation
                     )
                     cells.append(f"{got:.4f} ({got / e - 1:+.1%})")

@@ -1,6 +1,10 @@
 """Requested vs realised e and T in the real engines (MuJoCo, LAMMPS, Drake continuous and
-discrete, LIGGGHTS, Yade), for docs/engines.md.
+discrete, LIGGGHTS, Yade), for docs/engines.md, through the test harness that runs them
+(tests/engines/harness.py).
 Run: python benchmarks/engines_table.py > benchmarks/engines_table.md"""
+
+import sys
+from pathlib import Path
 
 import jax
 
@@ -12,7 +16,9 @@ import subprocess  # noqa: E402
 import numpy as np  # noqa: E402
 
 import jaximpact as ji  # noqa: E402
-from jaximpact._engines import drake, lammps, liggghts, mujoco, yade  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "engines"))
+from harness import run_drake, run_lammps, run_liggghts, run_mujoco, run_yade  # noqa: E402
 
 PHASES = (0.05, 0.3, 0.55, 0.8, 0.95)
 print(
@@ -22,7 +28,7 @@ print(
 print("|---|---|---|---|---|---|---|---|")
 for e, T in [(0.95, 0.02), (0.75, 0.01), (0.5, 2e-3), (0.2, 5e-3), (0.05, 1e-3)]:
     x = ji.export(None, "mujoco", m=0.05, v0=1.0, e=e, T=T, curves=False)
-    es, Ts = mujoco.simulate(x.parameters, 1.0, m=0.05, phases=PHASES)
+    es, Ts = run_mujoco(x.parameters, v0=1.0, m=0.05, phases=PHASES)
     print(
         f"| MuJoCo {__import__('mujoco').__version__} | {e} | {T:g} | {x.e:.5f} | "
         f"{es.min():.5f} to {es.max():.5f} | {x.T:.5g} | {Ts.min():.5g} to {Ts.max():.5g} | "
@@ -38,7 +44,7 @@ for e, T, limit in [
     x = ji.export(
         None, "lammps", m=0.004, v0=1.0, radius=0.005, e=e, T=T, limit_damping=limit, curves=False
     )
-    es, Ts = lammps.simulate(x.parameters, m=0.004, v0=1.0, radius=0.005, phases=PHASES)
+    es, Ts = run_lammps(x.parameters, m=0.004, v0=1.0, radius=0.005, phases=PHASES)
     name = "LAMMPS 22Jul2025" + (" limit_damping" if limit else "")
     print(
         f"| {name} | {e} | {T:g} | {x.e:.5f} | {es.min():.5f} to {es.max():.5f} | "
@@ -53,7 +59,7 @@ try:
 
     for e, T in [(0.8, 1e-3), (0.5, 5e-3), (0.3, 2e-3)]:
         x = ji.export(None, "drake", m=0.05, v0=1.0, e=e, T=T, curves=False)
-        e_d, T_d = drake.simulate(x.parameters, m=0.05, v0=1.0)
+        e_d, T_d = run_drake(x.parameters, m=0.05, v0=1.0)
         print(
             f"| Drake {DRAKE} "
             f"continuous | {e} | {T:g} | {x.e:.5f} | {e_d:.5f} | {x.T:.5g} | {T_d:.5g} | 0 |"
@@ -66,10 +72,7 @@ try:
             None, "drake", m=1.0, v0=1.0, e=e, T=T, timestep=h, curves=False, strict=False
         )
         runs = np.array(
-            [
-                drake.simulate(x.parameters, m=1.0, v0=1.0, time_step=h, gap=phase * h)
-                for phase in PHASES
-            ]
+            [run_drake(x.parameters, m=1.0, v0=1.0, time_step=h, gap=phase * h) for phase in PHASES]
         )
         print(
             f"| Drake {DRAKE} "
@@ -92,7 +95,7 @@ if shutil.which("liggghts"):
             limit_damping=limit,
             curves=False,
         )
-        es, Ts = liggghts.simulate(x.parameters, m=0.004, v0=1.0, radius=0.005, phases=PHASES)
+        es, Ts = run_liggghts(x.parameters, m=0.004, v0=1.0, radius=0.005, phases=PHASES)
         name = "LIGGGHTS 3.8.0" + (" limitForce" if limit else "")
         print(
             f"| {name} | {e} | {T:g} | {x.e:.5f} | {es.min():.5f} to {es.max():.5f} | "
@@ -105,13 +108,13 @@ if shutil.which("yade"):
     version = (version.split() or ["?"])[-1]
     for e, T in [(0.8, 5e-4), (0.5, 1e-3), (0.2, 1e-3)]:
         x = ji.export(None, "yade", m=0.01, v0=1.0, radius=0.01, e=e, T=T, curves=False)
-        es, Ts = yade.simulate(x.parameters, m=0.01, v0=1.0, radius=0.01, phases=PHASES)
+        es, Ts = run_yade(x.parameters, m=0.01, v0=1.0, radius=0.01, phases=PHASES)
         print(
             f"| Yade {version} | {e} | {T:g} | {x.e:.5f} | {es.min():.5f} to {es.max():.5f} | "
             f"{x.T:.5g} | {Ts.min():.5g} to {Ts.max():.5g} | {x.timestep:g} |"
         )
     x = ji.export(None, "yade", m=0.01, v0=1.0, radius=0.01, e=0.5, T=1e-3, curves=False)
-    es, _ = yade.simulate(x.parameters, m=0.01, v0=1.0, radius=0.01, phases=(0.5,), damping=0.2)
+    es, _ = run_yade(x.parameters, m=0.01, v0=1.0, radius=0.01, phases=(0.5,), damping=0.2)
     print(
         f"\nYade with NewtonIntegrator's default damping 0.2 (the export sets 0): asked 0.5, "
         f"Yade gives e = {es[0]:.4f}"
@@ -135,7 +138,7 @@ for damping, limit in [
             pair_coeff=f"pair_coeff * * hertz/material 1e8 {cor} 0.3 damping {damping} "
             f"tangential linear_nohistory 0 0{limit}",
         )
-        es, _ = lammps.simulate(params, m=0.004, v0=1.0, radius=0.005, phases=(0.5,))
+        es, _ = run_lammps(params, m=0.004, v0=1.0, radius=0.005, phases=(0.5,))
         print(f"| {damping}{limit} | {cor} | {es[0]:.4f} |")
 # a sphere on a wall (geometry="wall": fix wall/gran, a primitive wall, utils.wall)
 print(
@@ -155,12 +158,12 @@ for engine, name, m, radius, cases in WALL_CASES:
     if engine != "lammps" and not shutil.which(engine):
         print(f"\n{engine} not run: no {engine} executable")
         continue
-    module = {"lammps": lammps, "liggghts": liggghts, "yade": yade}[engine]
+    run = {"lammps": run_lammps, "liggghts": run_liggghts, "yade": run_yade}[engine]
     for e, T, limit in cases:
         kwargs = {} if limit is None else {"limit_damping": limit}
         x = ji.export(None, engine, m=m, v0=1.0, radius=radius, e=e, T=T, geometry="wall",
                       curves=False, **kwargs)  # fmt: skip
-        es, Ts = module.simulate(x.parameters, m=m, v0=1.0, radius=radius, phases=PHASES)
+        es, Ts = run(x.parameters, m=m, v0=1.0, radius=radius, phases=PHASES)
         tag = name + ({"lammps": " limit_damping", "liggghts": " limitForce"}[engine]
                       if limit else "")  # fmt: skip
         print(

@@ -1,5 +1,6 @@
 """`jaximpact export` (a law or target e, T -> an engine's contact parameters and what the
-engine realises) and `jaximpact engine-e` (engine parameters -> e(v), T(v))."""
+engine realises) and `jaximpact engine-e` (engine parameters -> e(v), T(v)). The engines, their
+names and what the help says of each come from the one registry, `_engines.export.ENGINES`."""
 
 import json
 import sys
@@ -13,28 +14,62 @@ from .common import (
     parse_params,
 )
 
-_ENGINES = ("mujoco", "lammps", "drake", "liggghts", "chrono", "yade")
+
+def _engines() -> dict:
+    """The registry of engines, name -> `AbstractEngine` (light to import: the engines'
+    numerics load on use)."""
+    from .._engines.export import ENGINES
+
+    return ENGINES
+
+
+def _listed(words, last: str = "and") -> str:
+    """`"a, b and c"`."""
+    words = list(words)
+    return words[0] if len(words) == 1 else f"{', '.join(words[:-1])} {last} {words[-1]}"
+
+
+def _labels(where=lambda engine: True, last: str = "and") -> str:
+    """The engines' labels (as their documentation spells them) where `where(engine)`."""
+    return _listed([e.LABEL for e in _engines().values() if where(e)], last)
+
+
+def _names(last: str = "or") -> str:
+    """The engines' names as `--engine` takes them."""
+    return _listed(_engines(), last)
+
+
+def _export_description() -> str:
+    plane = _labels(lambda e: not e.TWO_SPHERES)
+    per_kg = _labels(lambda e: e.MASS_DEPENDS is None)
+    return (
+        "Turn a law (--law, --param), a fit (--from FILE, the JSON of 'jaximpact calibrate "
+        f"--json') or target --e and --T into the contact parameters of {_labels(last='or')}, "
+        "in the engine's own names and units, with a snippet to paste, a recommended time "
+        "step, and the e and T the engine realises (its time stepping included). Scenes: "
+        f"{plane}, a body of --mass on a plane; the others, two spheres each of --mass and "
+        "--radius colliding head-on at relative speed --v0 (--wall: one sphere on a fixed "
+        "flat wall). docs/engines.md has the formulas and measured tables.\n\n"
+        "--mass has no default: every engine's parameters depend on it "
+        f"({per_kg} from --e and --T alone excepted: its contact is per unit mass), and so "
+        "do a law's e and T. An export the engine cannot realise at --timestep (a parameter "
+        "not finite, e outside [0, 1], fewer than 5 steps per contact, or e or T more than "
+        "5 % off the target) is refused with the step that would work; --no-strict exports "
+        "it anyway, with a warning."
+    )
+
+
+def _takes(key: str):
+    """Whether an engine's parameters have the key `key`."""
+    return lambda engine: any(k.name == key for k in engine.KEYS)
 
 
 def add_export(subparsers):
     parser = command_parser(
         subparsers,
         "export",
-        help="an engine's contact parameters (MuJoCo, Drake, LAMMPS, LIGGGHTS, Chrono, Yade) "
-        "for a law, a fit or target e, T",
-        description="Turn a law (--law, --param), a fit (--from FILE, the JSON of "
-        "'jaximpact calibrate --json') or target --e and --T into the contact "
-        "parameters of MuJoCo, Drake, LAMMPS, LIGGGHTS, Chrono or Yade, in the engine's own "
-        "names and units, with a "
-        "snippet to paste, a recommended time step, and the e and T the engine realises "
-        "(its time stepping included). Scenes: MuJoCo and Drake, a body of --mass on a "
-        "plane; the others, two spheres each of --mass and --radius colliding head-on at "
-        "relative speed --v0. docs/engines.md has the formulas and measured tables.\n\n"
-        "--mass has no default: every engine's parameters depend on it (MuJoCo from --e and "
-        "--T alone excepted: solref is per unit mass), and so do a law's e and T. An export "
-        "the engine cannot realise at --timestep (a parameter not finite, e outside [0, 1], "
-        "fewer than 5 steps per contact, or e or T more than 5 % off the target) is refused "
-        "with the step that would work; --no-strict exports it anyway, with a warning.",
+        help=f"an engine's contact parameters ({_labels()}) for a law, a fit or target e, T",
+        description=_export_description(),
         example="jaximpact export mujoco --e 0.75 --T 0.01 --v0 1\n"
         "jaximpact export lammps --law hertz_rate --param c=2e6 b1=800 "
         "--mass 1 --v0 2.5 --radius 0.02 --json\n"
@@ -44,7 +79,7 @@ def add_export(subparsers):
     )
     parser.add_argument(
         "engine_name", nargs="?", metavar="ENGINE",
-        help="mujoco, lammps, drake, liggghts, chrono or yade (or --engine NAME)",
+        help=f"{_names()} (or --engine NAME)",
     )  # fmt: skip
     parser.add_argument("--engine", metavar="NAME", help="the engine, as ENGINE")
     parser.add_argument(
@@ -58,23 +93,29 @@ def add_export(subparsers):
     parser.add_argument("--T", type=float, metavar="S", help="target contact duration, s")
     parser.add_argument(
         "--mass", type=float, metavar="KG",
-        help="mass, kg (two-sphere engines: of each sphere); required, except for MuJoCo "
-        "from --e/--T, and with --from (the fit's)",
+        help="mass, kg (two-sphere engines: of each sphere); required, except for "
+        f"{_labels(lambda e: e.MASS_DEPENDS is None)} from --e/--T, and with --from (the "
+        "fit's)",
     )  # fmt: skip
     parser.add_argument(
         "--v0", type=float, metavar="M/S",
         help="impact speed, m/s (with --from: the fit's, if it has one speed)",
     )  # fmt: skip
     parser.add_argument("--timestep", type=float, metavar="S", help="the engine's step, s")
-    parser.add_argument("--radius", type=float, metavar="M", help="sphere radius, m (LAMMPS)")
-    parser.add_argument("--poisson", type=float, help="Poisson's ratio (LAMMPS; default 0.3)")
+    _add_radius(parser)
     parser.add_argument(
-        "--limit-damping", action="store_true", help="LAMMPS: keep the force non-attractive"
-    )
+        "--poisson", type=float,
+        help=f"Poisson's ratio ({_labels(_takes('poisson'))}; default 0.3)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--limit-damping", action="store_true",
+        help=f"{_labels(_takes('limit_damping'))}: keep the force non-attractive",
+    )  # fmt: skip
     parser.add_argument(
         "--wall", action="store_true",
-        help="LAMMPS, LIGGGHTS, Yade, Chrono: one sphere of --mass and --radius hitting a fixed "
-        "flat wall at --v0 (the drop test), instead of two spheres",
+        help=f"{_labels(lambda e: e.TWO_SPHERES and 'wall' in e.SCENES)}: one sphere of "
+        "--mass and --radius hitting a fixed flat wall at --v0 (the drop test), instead of "
+        "two spheres",
     )  # fmt: skip
     parser.add_argument(
         "--no-strict", dest="strict", action="store_false",
@@ -84,22 +125,33 @@ def add_export(subparsers):
     parser.set_defaults(handler=_run_export)
 
 
+def _add_radius(parser):
+    parser.add_argument(
+        "--radius", type=float, metavar="M",
+        help=f"sphere radius, m ({_labels(lambda e: e.TWO_SPHERES)})",
+    )  # fmt: skip
+
+
 def _engine_name(args) -> str:
     """ENGINE or --engine (one of them, the same if both), checked."""
     names = {n for n in (args.engine_name, args.engine) if n is not None}
     if not names:
-        raise CLIError(f"name the engine: jaximpact export ENGINE, one of {', '.join(_ENGINES)}")
+        raise CLIError(f"name the engine: jaximpact export ENGINE, one of {', '.join(_engines())}")
     if len(names) > 1:
         raise CLIError(f"ENGINE {args.engine_name!r} and --engine {args.engine!r} disagree")
     (name,) = names
-    if name not in _ENGINES:
-        raise CLIError(f"unknown engine {name!r}; choose one of: {', '.join(_ENGINES)}")
+    _check_engine(name)
     return name
+
+
+def _check_engine(name: str) -> None:
+    if name not in _engines():
+        raise CLIError(f"unknown engine {name!r}; choose one of: {', '.join(_engines())}")
 
 
 def _run_export(args):
     from .._engines import export
-    from .._engines.export import ENGINES, UnrealisedExport, missing_mass
+    from .._engines.export import UnrealisedExport, missing_mass
 
     engine = _engine_name(args)
     notes = []
@@ -119,11 +171,11 @@ def _run_export(args):
         if args.v0 is None:
             raise CLIError("--v0 is required: the impact speed, m/s")
         name, params = args.law, parse_params(args.param)
-    module = ENGINES[engine]
+    chosen = _engines()[engine]
     missing = []
-    if args.mass is None and (name is not None or module.MASS_DEPENDS is not None):
+    if args.mass is None and (name is not None or chosen.MASS_DEPENDS is not None):
         missing.append("--mass (kg)")
-    if args.radius is None and module.TWO_SPHERES:
+    if args.radius is None and chosen.TWO_SPHERES:
         missing.append("--radius (m)")
     if missing:
         what = " and ".join(missing)
@@ -314,20 +366,7 @@ def add_engine_e(subparsers):
         subparsers,
         "engine-e",
         help="the e(v) and T(v) that given engine contact parameters produce",
-        description="The inverse of export: given an engine's contact parameters as JSON "
-        '(MuJoCo {"solref": [timeconst, dampratio], "timestep": s} (default step 0.002 s, '
-        'for its refsafe rule); LAMMPS {"E": Pa, '
-        '"coeff_restitution": e, "poisson": nu, "limit_damping": false} for '
-        "hertz/material with damping coeff_restitution, and the same keys for LIGGGHTS "
-        "(limit_damping: its limitForce) and Chrono (its Young's modulus, restitution and "
-        "Poisson ratio; its force is always kept non-attractive); Drake "
-        '{"point_contact_stiffness": N/m, "hunt_crossley_dissipation": s/m}), the e and T '
-        "of the continuous law the engine integrates, at each --speed, and beside them what "
-        "the engine's time stepping realises (MuJoCo at its timestep; LAMMPS when "
-        '"timestep" is given; the mean over where first touch falls inside a step, with the '
-        'range of e); Yade {"tc": s, "en": e} (ViscElMat; "timestep" and '
-        'NewtonIntegrator "damping" for its stepping); Drake with "time_step" > 0: its '
-        "discrete plant (Lagged, Similar, TAMSI).",
+        description=_engine_e_description(),
         example="jaximpact engine-e --engine mujoco --params '{\"solref\": [0.02, 1]}' "
         "--mass 0.05 --speed 0.5 1 2",
     )
@@ -335,30 +374,50 @@ def add_engine_e(subparsers):
         "--engine",
         required=True,
         metavar="NAME",
-        help="mujoco, lammps, drake, liggghts, chrono or yade",
+        help=_names(),
     )
     parser.add_argument("--params", required=True, metavar="JSON", help="engine parameters")
     parser.add_argument(
         "--mass", type=float, metavar="KG",
-        help="mass, kg (two-sphere engines: of each sphere); required except for MuJoCo, "
-        "whose solref is per unit mass",
+        help="mass, kg (two-sphere engines: of each sphere); required except for "
+        f"{_labels(lambda e: e.MASS_DEPENDS is None)}, whose parameters are per unit mass",
     )  # fmt: skip
     parser.add_argument("--speed", type=float, nargs="+", required=True, metavar="M/S")
-    parser.add_argument("--radius", type=float, metavar="M", help="sphere radius, m (LAMMPS)")
+    _add_radius(parser)
     add_output_arguments(parser, plot=False)
     parser.set_defaults(handler=_run_engine_e)
 
 
-def _check_engine_params(engine, params):
-    """Every needed key there, every key one that `engine` reads (its module's `KEYS`), every
-    value a number (`solref` two numbers, `limit_damping` true or false)."""
-    from .._engines.export import ENGINES
+def _engine_e_description() -> str:
+    """What engine-e does, then one paragraph per engine: its keys and how it steps."""
+    each = []
+    for engine in _engines().values():
+        needed, optional = (
+            ", ".join(f'"{k.name}" ({k.unit})' for k in engine.KEYS if k.needed is flag)
+            for flag in (True, False)
+        )
+        each.append(
+            f"{engine.LABEL} (--engine {engine.NAME}): {needed}"
+            + (f"; optional {optional}" if optional else "")
+            + f". Stepping: {engine.STEPPING}."
+        )
+    return (
+        "The inverse of export: given an engine's contact parameters as JSON (--params), the "
+        "e and T of the continuous law the engine integrates, at each --speed, and beside "
+        "them what the engine's time stepping realises where it is replicated (the mean "
+        "over where first touch falls inside a step, with the range of e). The parameters, "
+        "and the stepping, of each engine:\n\n" + "\n\n".join(each)
+    )
 
-    needed, optional = ENGINES[engine].KEYS
-    missing = [k for k in needed if k not in params]
+
+def _check_engine_params(engine, params):
+    """Every needed key there, every key one that `engine` reads (its `KEYS`), every value a
+    number (`solref` two numbers, `limit_damping` true or false)."""
+    keys = _engines()[engine].KEYS
+    missing = [k.name for k in keys if k.needed and k.name not in params]
     if missing:
         raise CLIError(f"--params for {engine} needs {', '.join(missing)}")
-    known = (*needed, *optional)
+    known = [k.name for k in keys]
     unknown = [k for k in params if k not in known]
     if unknown:
         raise CLIError(
@@ -383,8 +442,7 @@ def _number(value) -> bool:
 def _run_engine_e(args):
     from .._engines import engine_response, stepped_response
 
-    if args.engine not in _ENGINES:
-        raise CLIError(f"unknown engine {args.engine!r}; choose one of: {', '.join(_ENGINES)}")
+    _check_engine(args.engine)
     try:
         params = json.loads(args.params)
     except json.JSONDecodeError as error:
@@ -392,12 +450,10 @@ def _run_engine_e(args):
     if not isinstance(params, dict):
         raise CLIError("--params must be a JSON object, e.g. '{\"solref\": [0.02, 1]}'")
     _check_engine_params(args.engine, params)
-    from .._engines.export import ENGINES
-
-    module = ENGINES[args.engine]
+    chosen = _engines()[args.engine]
     if args.mass is None:
-        if module.MASS_DEPENDS is not None:
-            each = ", of each sphere" if module.TWO_SPHERES else ""
+        if chosen.MASS_DEPENDS is not None:
+            each = ", of each sphere" if chosen.TWO_SPHERES else ""
             raise CLIError(
                 f"{args.engine} needs --mass (kg{each}): the e and T its parameters give "
                 "depend on it"

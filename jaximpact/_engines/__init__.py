@@ -1,6 +1,14 @@
-"""The engines people run (MuJoCo, Drake, LAMMPS): material inputs, and exports of a law to
-an engine's own contact parameters with the e and T the engine realises (docs/engines.md)."""
+"""The engines people run (MuJoCo, Drake, LAMMPS, LIGGGHTS, Chrono, Yade): material inputs,
+and exports of a law to an engine's own contact parameters with the e and T the engine
+realises (docs/engines.md). `base.AbstractEngine` is what an engine declares and provides;
+`export.ENGINES` is the one registry of them (docs/layout.md, "Adding an engine")."""
 
+from .base import (
+    AbstractEngine as AbstractEngine,
+    Design as Design,
+    Key as Key,
+    Stepping as Stepping,
+)
 from .export import (
     ENGINES as ENGINES,
     Export as Export,

@@ -24,104 +24,12 @@ a large one). (3) `cr_eff` is the smaller of the two materials' restitutions.
 import math
 
 from . import _stepping, lammps
+from .base import AbstractEngine, Design, Key, Stepping
 
-NAME = "chrono"
-SCENE = lammps.SCENE
-law = lammps.law
-KEYS = (lammps.KEYS[0], ("poisson", "limit_damping"))
-TWO_SPHERES = True
-MASS_DEPENDS = "its Young's modulus scales with the mass"  # what m changes (export)
-GEOMETRIES = ("spheres", "wall")  # `export(..., geometry=)`: the first is the default
-SCENE_WALL = (
-    "a sphere of mass m and radius `radius` hitting a fixed ground box (a flat wall) of its "
-    "material (mass 1e6 m) head-on at speed v0 (by Chrono's source, not run here)"
-)
 # A fixed body still enters eff_mass = m1 m2/(m1 + m2) with its own mass (ChContactSMC.cpp,
 # GetContactableMass): the snippet gives the ground 1e6 m, so eff_mass = m (1 - 1e-6) and gn
 # is 5e-7 (relative) below the design's: e moves by less than 1e-6.
 GROUND_MASS_RATIO = 1e6
-
-
-def response(parameters, *, m: float, radius=None):
-    """`(law, separation)`: the Tsuji form with the force always kept non-attractive."""
-    return lammps.tsuji_response(parameters, m=m, radius=radius, clamped=True, engine=NAME)
-
-
-def stepper(parameters, *, m: float, radius=None):
-    """None: Chrono's implicit stepper is not replicated."""
-    return None
-
-
-def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=True,
-           geometry="spheres"):  # fmt: skip
-    """`ChContactMaterialSMC` inputs for target `e` and `T` (s): two spheres, or with
-    `geometry="wall"` a sphere on a fixed ground box of its material (`E_eff = E/(2 (1 -
-    nu^2))`, `eff_radius = R`, `eff_mass` = m up to the ground's mass, 1e6 m)."""
-    wall = geometry == "wall"
-    coefficient = lammps.coefficient_for(e, limit_damping=True)
-    realised_e, tau = lammps.impact_at_unit_scales(coefficient, "force")
-    m_eff, R_eff = lammps.effective(m, radius, geometry)
-    c = m_eff * v0**2 * (tau / (T * v0)) ** 2.5
-    E = c * 3.0 / (4.0 * math.sqrt(R_eff)) * 2.0 * (1.0 - poisson**2)
-    b = lammps.damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
-    h = _stepping.nice_down(T / 100.0) if timestep is None else float(timestep)
-    warnings = [
-        f"set the effective curvature radius to {R_eff:.6g} m (the snippet does): Chrono's "
-        "default Bullet collision system uses 0.1 m for every contact",
-        "Chrono's time stepper is not replicated: e and T are the continuous law's "
-        f"(with about {T / h:.0f} steps per contact)",
-    ]
-    if T / h < 50:
-        warnings.append(
-            f"timestep {h:.3g} s gives {T / h:.0f} steps per contact: use T/100 or less"
-        )
-    parameters = {
-        "SetYoungModulus": E,
-        "SetPoissonRatio": poisson,
-        "SetRestitution": coefficient,
-        "SetFriction": 0.0,
-        "contact_force_model": "ChSystemSMC.Hertz",
-        "UseMaterialProperties": True,
-        "time_step": h,
-        "effective_curvature_radius": R_eff,
-        "k": c,
-        "b": b,
-    }
-    if wall:
-        parameters["geometry"] = "wall"
-        parameters["ground_mass"] = GROUND_MASS_RATIO * m
-    return dict(
-        parameters=parameters,
-        e=realised_e,
-        T=tau * (m_eff * v0**2 / c) ** 0.4 / v0,
-        e_range=None,
-        T_range=None,
-        steps_per_contact=T / h,
-        warnings=warnings,
-        separation="force",
-        timestep=h,
-    )
-
-
-def snippet(parameters) -> str:
-    return "\n".join(
-        [
-            "import pychrono as chrono",
-            "sys = chrono.ChSystemSMC()",
-            "sys.SetContactForceModel(chrono.ChSystemSMC.Hertz)",
-            "sys.UseMaterialProperties(True)",
-            "# Bullet (the default collision system) reports no curvature: set the pair's",
-            "chrono.ChCollisionInfo.SetDefaultEffectiveCurvatureRadius("
-            f"{parameters['effective_curvature_radius']:.10g})",
-            "mat = chrono.ChContactMaterialSMC()",
-            f"mat.SetYoungModulus({parameters['SetYoungModulus']:.10g})",
-            f"mat.SetPoissonRatio({parameters['SetPoissonRatio']:.10g})",
-            f"mat.SetRestitution({parameters['SetRestitution']:.10g})",
-            "mat.SetFriction(0.0)",
-            *(_ground(parameters) if parameters.get("geometry") == "wall" else []),
-            f"sys.DoStepDynamics({parameters['time_step']:.6g})  # the step, in the loop",
-        ]
-    )
 
 
 def _ground(parameters) -> list[str]:
@@ -135,3 +43,111 @@ def _ground(parameters) -> list[str]:
         "ground.SetFixed(True)",
         "sys.Add(ground)",
     ]
+
+
+class Chrono(AbstractEngine):
+    """Chrono's SMC Hertz contact from material properties (`ChContactMaterialSMC`), its force
+    always kept non-attractive; its stepper is not replicated (the module's docstring has
+    the formulas, sources and pitfalls)."""
+
+    NAME = "chrono"
+    LABEL = "Chrono"
+    SCENES = {
+        "spheres": lammps.Lammps.SCENES["spheres"],
+        "wall": "a sphere of mass m and radius `radius` hitting a fixed ground box (a flat "
+        "wall) of its material (mass 1e6 m) head-on at speed v0 (by Chrono's source, not run "
+        "here)",
+    }
+    TWO_SPHERES = True
+    MASS_DEPENDS = "its Young's modulus scales with the mass"
+    KEYS = (
+        *(key for key in lammps.Lammps.KEYS if key.name in ("E", "coeff_restitution", "poisson")),
+        Key("limit_damping", "true or false; its force is always kept non-attractive", False),
+    )
+    LAW = lammps.Lammps.LAW
+    STEPPING = (
+        "its implicit stepper is not replicated: the continuous law's e and T, at a "
+        "recommended step of T/100 or less"
+    )
+    CONTINUOUS_PLANT = False
+
+    def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
+               limit_damping=False, geometry=None) -> Design:  # fmt: skip
+        """`ChContactMaterialSMC` inputs for target `e` and `T` (s): two spheres of mass `m`
+        (kg) and radius `radius` (m) at relative speed `v0` (m/s), or with `geometry="wall"`
+        a sphere on a fixed ground box of its material (`E_eff = E/(2 (1 - nu^2))`,
+        `eff_radius = R`, `eff_mass` = m up to the ground's mass, 1e6 m). Its force is
+        always kept non-attractive, whatever `limit_damping`."""
+        coefficient = lammps.coefficient_for(e, limit_damping=True)
+        realised_e, tau = lammps.impact_at_unit_scales(coefficient, "force")
+        m_eff, R_eff = lammps.effective(m, radius, geometry)
+        c = m_eff * v0**2 * (tau / (T * v0)) ** 2.5
+        E = c * 3.0 / (4.0 * math.sqrt(R_eff)) * 2.0 * (1.0 - poisson**2)
+        b = lammps.damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
+        h = _stepping.nice_down(T / 100.0) if timestep is None else float(timestep)
+        warnings = [
+            f"set the effective curvature radius to {R_eff:.6g} m (the snippet does): "
+            "Chrono's default Bullet collision system uses 0.1 m for every contact",
+            "Chrono's time stepper is not replicated: e and T are the continuous law's "
+            f"(with about {T / h:.0f} steps per contact)",
+        ]
+        if T / h < 50:
+            warnings.append(
+                f"timestep {h:.3g} s gives {T / h:.0f} steps per contact: use T/100 or less"
+            )
+        parameters = {
+            "SetYoungModulus": E,
+            "SetPoissonRatio": poisson,
+            "SetRestitution": coefficient,
+            "SetFriction": 0.0,
+            "contact_force_model": "ChSystemSMC.Hertz",
+            "UseMaterialProperties": True,
+            "time_step": h,
+            "effective_curvature_radius": R_eff,
+            "k": c,
+            "b": b,
+        }
+        if geometry == "wall":
+            parameters["geometry"] = "wall"
+            parameters["ground_mass"] = GROUND_MASS_RATIO * m
+        return Design(
+            parameters=parameters,
+            e=realised_e,
+            T=tau * (m_eff * v0**2 / c) ** 0.4 / v0,
+            timestep=h,
+            separation="force",
+            warnings=tuple(warnings),
+            steps_per_contact=T / h,
+        )
+
+    def law_parameters(self, parameters, m):
+        """As LAMMPS's: `tsuji`'s `c` = k and `b`."""
+        return {"c": parameters["k"], "b": parameters["b"]}
+
+    def response(self, parameters, *, m, radius=None):
+        """`(law, separation)`: the Tsuji form with the force always kept non-attractive."""
+        return lammps.tsuji_response(self, parameters, m=m, radius=radius, clamped=True)
+
+    def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
+        """None: Chrono's implicit stepper is not replicated."""
+        return None
+
+    def snippet(self, parameters) -> str:
+        return "\n".join(
+            [
+                "import pychrono as chrono",
+                "sys = chrono.ChSystemSMC()",
+                "sys.SetContactForceModel(chrono.ChSystemSMC.Hertz)",
+                "sys.UseMaterialProperties(True)",
+                "# Bullet (the default collision system) reports no curvature: set the pair's",
+                "chrono.ChCollisionInfo.SetDefaultEffectiveCurvatureRadius("
+                f"{parameters['effective_curvature_radius']:.10g})",
+                "mat = chrono.ChContactMaterialSMC()",
+                f"mat.SetYoungModulus({parameters['SetYoungModulus']:.10g})",
+                f"mat.SetPoissonRatio({parameters['SetPoissonRatio']:.10g})",
+                f"mat.SetRestitution({parameters['SetRestitution']:.10g})",
+                "mat.SetFriction(0.0)",
+                *(_ground(parameters) if parameters.get("geometry") == "wall" else []),
+                f"sys.DoStepDynamics({parameters['time_step']:.6g})  # the step, in the loop",
+            ]
+        )

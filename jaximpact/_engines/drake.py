@@ -13,7 +13,7 @@ Lagged (Drake's default approximation) and Similar, a point contact found at a s
 (`x > 0`) gives the new speed from `m (v1 - v) = -h k (x + h v1)_+ (1 + d v1)_+`
 (Castro et al., "An unconstrained convex formulation of compliant contact", 2022, and TAMSI,
 Castro et al. 2019): `replica` integrates that and equals Drake 1.51.1 to 5 digits phase by
-phase (tests/test_engines.py). That step damps (e = 0.9 came out 0.59 at 10 steps per
+phase (tests/engines). That step damps (e = 0.9 came out 0.59 at 10 steps per
 contact), so with a `timestep` the export corrects k and d for it, or warns where even
 d = 0 damps too much. kSap ignores `hunt_crossley_dissipation`.
 """
@@ -21,21 +21,10 @@ d = 0 damps too much. kSap ignores `hunt_crossley_dissipation`.
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 from . import _stepping
+from .base import AbstractEngine, Design, Key, Stepping
 from .materials import check_positive
-
-NAME = "drake"
-# the keys `engine-e` takes: (needed, optional)
-KEYS = (("point_contact_stiffness", "hunt_crossley_dissipation"), ("time_step",))
-TWO_SPHERES = False  # the scene: a body of mass m on a half space
-MASS_DEPENDS = "its point_contact_stiffness scales with the mass"  # what m changes
-SCENE = (
-    "a body of mass m on a fixed half space (both geometries with the exported properties), "
-    "no gravity, approaching along the normal at v0; continuous plant (time_step = 0), or "
-    "discrete with the Lagged, Similar or TAMSI approximation when a timestep is given"
-)
 
 
 def _tau(alpha: float) -> float:
@@ -48,6 +37,10 @@ def _tau(alpha: float) -> float:
 
 
 def alpha_for(e: float) -> float:
+    """The damping group `alpha = d v0` whose restitution (`f = k x (1 + d v)`, the
+    force-criterion closed form) is `e` (0 for `e = 1`), or a one-line ValueError."""
+    from scipy.optimize import brentq
+
     from ..closed_forms import hunt_crossley_restitution
 
     if e >= 1.0:
@@ -59,76 +52,6 @@ def alpha_for(e: float) -> float:
         if hi > 1e12:
             raise ValueError(f"Drake's point contact cannot realise e = {e:g}")
     return brentq(f, 0.0, hi, xtol=1e-15, rtol=1e-13)
-
-
-def design(e, T, *, m, v0, timestep=None, **_):
-    """`point_contact_stiffness` k (N/m) and `hunt_crossley_dissipation` d (s/m) that realise
-    `e` and `T` (s) for mass `m` (kg) at `v0` (m/s): on the continuous plant (`timestep`
-    None or 0: exact, from the closed-form e of `f = k x (1 + d v)`), or on a discrete plant
-    of step `timestep` (s) with the Lagged (Drake's default), Similar or TAMSI approximation,
-    whose implicit step damps further: k and d are then corrected through `replica` (mean
-    over where first touch falls inside a step), and a warning says when no d >= 0 can
-    give `e` at that step."""
-    from ..closed_forms import hunt_crossley_restitution
-
-    if T is None:
-        raise ValueError("Drake needs a contact duration: pass T= (s) or a law")
-    warnings = []
-    alpha = alpha_for(e)
-    d = alpha / v0
-    k = m * (_tau(alpha) / T) ** 2
-    if not timestep:
-        parameters = _parameters(k, d, 0.0)
-        return dict(
-            parameters=parameters,
-            e=float(hunt_crossley_restitution(alpha)),
-            T=float(_tau(alpha) * math.sqrt(m / k)),
-            e_range=None,
-            T_range=None,
-            steps_per_contact=None,
-            warnings=warnings,
-            timestep=0.0,
-            separation="force",
-        )
-    h = float(timestep)
-    params = _parameters(k, d, h)
-    reachable = True
-    for _ in range(40):
-        es, Ts = replica(params, m, v0, h)
-        e_mean, T_mean = float(es.mean()), float(Ts.mean())
-        if abs(e_mean / e - 1) < 1e-5 and abs(T_mean / T - 1) < 1e-4:
-            break
-        k *= (T_mean / T) ** 2
-        if e_mean > 0 and e < 1:
-            alpha = max(0.0, alpha + alpha_for(e) - alpha_for(min(e_mean, 1.0)))
-        if alpha == 0.0 and e_mean < e * (1 - 1e-5):
-            reachable = False
-        params = _parameters(k, alpha / v0, h)
-    es, Ts = replica(params, m, v0, h)
-    steps = float(Ts.mean() / h)
-    if not reachable or abs(es.mean() / e - 1) > 0.005:
-        warnings.append(
-            f"a discrete plant at time_step {h:.3g} s ({steps:.0f} steps per contact) damps "
-            f"more than e = {e:.4g} allows: even with hunt_crossley_dissipation = 0 it realises "
-            f"e = {es.mean():.4g} (its implicit step; TAMSI, Lagged and Similar alike, "
-            "measured); use time_step = 0 or a smaller step"
-        )
-    if (es.max() - es.min()) / 2 > 0.005 * es.mean():
-        warnings.append(
-            f"time_step {h:.3g} s: e ranges {es.min():.4g} to {es.max():.4g} with where first "
-            "touch falls inside a step"
-        )
-    warnings.append(
-        "the promise is for the Lagged (Drake's default), Similar or TAMSI discrete "
-        "approximation; kSap ignores hunt_crossley_dissipation (e near 0)"
-    )
-    return dict(
-        parameters=params,
-        **_stepping.realised(es, Ts, h),
-        warnings=warnings,
-        separation="force",
-        stepping=params,
-    )
 
 
 def _parameters(k: float, d: float, time_step: float) -> dict:
@@ -167,7 +90,7 @@ def replica(parameters, m: float, v0: float, timestep: float, phases=None):
     """`(e, T)` per start phase that a discrete plant (`time_step = timestep` s) realises with
     `parameters` for a body of mass `m` (kg) at `v0` (m/s): `discrete_step` from first touch,
     `phase * timestep` after a step's start, to the step where the contact is no longer
-    found. Checked against Drake's TAMSI, Lagged and Similar in tests/test_engines.py."""
+    found. Checked against Drake's TAMSI, Lagged and Similar (tests/engines)."""
     phases = _stepping.PHASES if phases is None else phases
     k = parameters["point_contact_stiffness"]
     d = parameters["hunt_crossley_dissipation"]
@@ -177,132 +100,144 @@ def replica(parameters, m: float, v0: float, timestep: float, phases=None):
     )
 
 
-def snippet(parameters) -> str:
-    per = parameters["per_geometry"]
-    return (
-        "from pydrake.geometry import AddContactMaterial, ProximityProperties\n"
-        "props = ProximityProperties()\n"
-        f"AddContactMaterial(dissipation={per['hunt_crossley_dissipation']!r}, "
-        f"point_stiffness={per['point_contact_stiffness']!r}, properties=props)\n"
-        "# give these props to BOTH geometries in contact (they combine in series)\n"
-        f"plant = MultibodyPlant(time_step={parameters['time_step']!r})"
-        + (
-            "  # continuous: the promise holds\n"
-            if not parameters["time_step"]
-            else "\nplant.set_discrete_contact_approximation("
-            "DiscreteContactApproximation.kLagged)  # not kSap\n"
-        )
-        + "plant.set_contact_model(ContactModel.kPoint)"
-    )
-
-
-def law(parameters, m: float):
-    from .._laws import law as make_law
-
-    return make_law(
-        "point_contact",
-        c=parameters["point_contact_stiffness"],
-        d=parameters["hunt_crossley_dissipation"],
-    )
-
-
-def response(parameters, *, m: float, radius=None):
-    """`(law, separation)`: the point contact of `parameters` (`point_contact_stiffness`
-    N/m > 0, `hunt_crossley_dissipation` s/m >= 0) for a body of mass `m` (kg)."""
-    k = check_positive("point_contact_stiffness", parameters["point_contact_stiffness"], "N/m")
-    d = float(parameters["hunt_crossley_dissipation"])
-    if not (math.isfinite(d) and d >= 0):
-        raise ValueError(f"hunt_crossley_dissipation must be >= 0 s/m, got {d:g}")
-    return law({"point_contact_stiffness": k, "hunt_crossley_dissipation": d}, m), "force"
-
-
-def stepper(parameters, *, m: float, radius=None):
-    """`(time_step, run)`: the discrete plant's implicit step (`replica`) when
-    `parameters["time_step"] > 0`, else None (the continuous plant has no step error)."""
-    if not parameters.get("time_step"):
-        return None
-    h = check_positive("time_step", parameters["time_step"], "s")
-    response(parameters, m=m)  # the values checked
-    return h, lambda v: replica(parameters, m, v, h)
-
-
-def simulate(
-    parameters, *, m, v0, radius=0.01, time_step=0.0, accuracy=1e-10, approximation=None, gap=0.0
-):
-    """Run Drake: a sphere (mass `m`, radius `radius`) onto a half space, gravity off, its
-    first touch `gap` (m) ahead (a discrete plant: `phase * v0 * time_step`).
-    Returns `(e, T)`, T from the contact force's first and last non-zero sample (continuous
-    plant: dense sampling through the integrator's steps). `time_step > 0`: a discrete plant,
-    with `approximation` (`"tamsi"`, `"sap"`, `"lagged"`, `"similar"`; None: Drake's
-    default)."""
-    from pydrake.geometry import AddContactMaterial, HalfSpace, ProximityProperties, Sphere
-    from pydrake.math import RigidTransform
-    from pydrake.multibody.plant import (
-        AddMultibodyPlantSceneGraph,
-        ContactModel,
-        CoulombFriction,
-    )
-    from pydrake.multibody.tree import SpatialInertia, UnitInertia
-    from pydrake.systems.analysis import Simulator
-    from pydrake.systems.framework import DiagramBuilder
-
-    per = parameters["per_geometry"]
-    builder = DiagramBuilder()
-    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=time_step)
-    plant.set_contact_model(ContactModel.kPoint)
-    if approximation is not None:
-        from pydrake.multibody.plant import DiscreteContactApproximation
-
-        plant.set_discrete_contact_approximation(
-            getattr(DiscreteContactApproximation, "k" + approximation.capitalize())
-        )
-    props = ProximityProperties()
-    AddContactMaterial(
-        dissipation=per["hunt_crossley_dissipation"],
-        point_stiffness=per["point_contact_stiffness"],
-        friction=CoulombFriction(0.0, 0.0),
-        properties=props,
-    )
-    body = plant.AddRigidBody(
-        "ball", SpatialInertia(m, np.zeros(3), UnitInertia.SolidSphere(radius))
-    )
-    plant.RegisterCollisionGeometry(body, RigidTransform(), Sphere(radius), "ball", props)
-    plant.RegisterCollisionGeometry(
-        plant.world_body(),
-        HalfSpace.MakePose([0, 0, 1], [0, 0, 0]),
-        HalfSpace(),
-        "ground",
-        props,
-    )
-    plant.mutable_gravity_field().set_gravity_vector([0, 0, 0])
-    plant.Finalize()
-    diagram = builder.Build()
-    simulator = Simulator(diagram)
-    context = simulator.get_mutable_context()
-    plant_context = plant.GetMyMutableContextFromRoot(context)
-    plant.SetFreeBodyPose(plant_context, body, RigidTransform([0, 0, radius + gap]))
-    from pydrake.multibody.math import SpatialVelocity
-
-    plant.SetFreeBodySpatialVelocity(plant_context, body, SpatialVelocity(np.zeros(3), [0, 0, -v0]))
-    integrator = simulator.get_mutable_integrator()
-    integrator.set_target_accuracy(accuracy)
-    k = parameters["point_contact_stiffness"]
-    t_scale = math.sqrt(m / k)
-    integrator.set_maximum_step_size(t_scale / 200)
-    integrator.request_initial_step_size_target(t_scale / 1000)
-    simulator.Initialize()
-    t_end = None
-    t = 0.0
-    dt = t_scale / 200
-    for _ in range(1_000_000):
-        t += dt
-        simulator.AdvanceTo(t)
-        z = plant.GetFreeBodyPose(plant_context, body).translation()[2]
-        vz = body.EvalSpatialVelocityInWorld(plant_context).translational()[2]
-        if z > radius and vz > 0:
-            t_end = t
+def _discrete(e: float, T: float, k: float, alpha: float, m: float, v0: float, h: float):
+    """`(parameters, es, Ts, reachable)`: `k` (N/m) and `alpha = d v0` corrected until a
+    discrete plant of step `h` (s) realises `e` and `T` (s) on the phase mean (`replica`),
+    what it realises per start phase, and whether some `d >= 0` reaches `e`."""
+    params = _parameters(k, alpha / v0, h)
+    reachable = True
+    for _ in range(40):
+        es, Ts = replica(params, m, v0, h)
+        e_mean, T_mean = float(es.mean()), float(Ts.mean())
+        if abs(e_mean / e - 1) < 1e-5 and abs(T_mean / T - 1) < 1e-4:
             break
-    # refine the exit: the ball leaves x = 0 at constant speed after the force vanished
-    # (f = k x (1 + d v) vanishes only at x = 0 for d v > -1)
-    T = t_end - (z - radius) / vz - gap / v0
-    return float(vz / v0), float(T)
+        k *= (T_mean / T) ** 2
+        if e_mean > 0 and e < 1:
+            alpha = max(0.0, alpha + alpha_for(e) - alpha_for(min(e_mean, 1.0)))
+        if alpha == 0.0 and e_mean < e * (1 - 1e-5):
+            reachable = False
+        params = _parameters(k, alpha / v0, h)
+    es, Ts = replica(params, m, v0, h)
+    return params, es, Ts, reachable
+
+
+class Drake(AbstractEngine):
+    """Drake's point contact `f = k x (1 + d v)` for a body on a half space: its continuous
+    plant, or a discrete plant's implicit step (the module's docstring has the sources)."""
+
+    NAME = "drake"
+    LABEL = "Drake"
+    SCENES = {
+        "wall": "a body of mass m on a fixed half space (both geometries with the exported "
+        "properties), no gravity, approaching along the normal at v0; continuous plant "
+        "(time_step = 0), or discrete with the Lagged, Similar or TAMSI approximation when a "
+        "timestep is given"
+    }
+    TWO_SPHERES = False
+    MASS_DEPENDS = "its point_contact_stiffness scales with the mass"
+    KEYS = (
+        Key("point_contact_stiffness", "N/m"),
+        Key("hunt_crossley_dissipation", "s/m"),
+        Key("time_step", "s; 0 or none: its continuous plant", needed=False),
+    )
+    LAW = "point_contact"
+    STEPPING = (
+        "with time_step > 0 its discrete plant's implicit step (Lagged, Similar, TAMSI): "
+        "replicated; the continuous plant (time_step = 0) has no step error"
+    )
+    CONTINUOUS_PLANT = True
+
+    def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
+               limit_damping=False, geometry=None) -> Design:  # fmt: skip
+        """`point_contact_stiffness` k (N/m) and `hunt_crossley_dissipation` d (s/m) that
+        realise `e` and `T` (s) for mass `m` (kg) at `v0` (m/s): on the continuous plant
+        (`timestep` None or 0: exact, from the closed-form e of `f = k x (1 + d v)`), or on a
+        discrete plant of step `timestep` (s) with the Lagged (Drake's default), Similar or
+        TAMSI approximation, whose implicit step damps further: k and d are then corrected
+        through `replica` (mean over where first touch falls inside a step), and a warning
+        says when no d >= 0 can give `e` at that step. The other options do not apply."""
+        from ..closed_forms import hunt_crossley_restitution
+
+        if T is None:
+            raise ValueError("Drake needs a contact duration: pass T= (s) or a law")
+        alpha = alpha_for(e)
+        k = m * (_tau(alpha) / T) ** 2
+        if not timestep:
+            return Design(
+                parameters=_parameters(k, alpha / v0, 0.0),
+                e=float(hunt_crossley_restitution(alpha)),
+                T=float(_tau(alpha) * math.sqrt(m / k)),
+                timestep=0.0,
+                separation="force",
+            )
+        h = float(timestep)
+        params, es, Ts, reachable = _discrete(e, T, k, alpha, m, v0, h)
+        steps = float(Ts.mean() / h)
+        warnings = []
+        if not reachable or abs(es.mean() / e - 1) > 0.005:
+            warnings.append(
+                f"a discrete plant at time_step {h:.3g} s ({steps:.0f} steps per contact) "
+                f"damps more than e = {e:.4g} allows: even with hunt_crossley_dissipation = 0 "
+                f"it realises e = {es.mean():.4g} (its implicit step; TAMSI, Lagged and "
+                "Similar alike, measured); use time_step = 0 or a smaller step"
+            )
+        if (es.max() - es.min()) / 2 > 0.005 * es.mean():
+            warnings.append(
+                f"time_step {h:.3g} s: e ranges {es.min():.4g} to {es.max():.4g} with where "
+                "first touch falls inside a step"
+            )
+        warnings.append(
+            "the promise is for the Lagged (Drake's default), Similar or TAMSI discrete "
+            "approximation; kSap ignores hunt_crossley_dissipation (e near 0)"
+        )
+        return Design(
+            parameters=params,
+            **_stepping.realised(es, Ts, h),
+            warnings=tuple(warnings),
+            separation="force",
+            stepping=params,
+        )
+
+    def law_parameters(self, parameters, m):
+        """`point_contact`'s `c` = k (N/m) and `d` (s/m), whatever the mass."""
+        return {
+            "c": parameters["point_contact_stiffness"],
+            "d": parameters["hunt_crossley_dissipation"],
+        }
+
+    def response(self, parameters, *, m, radius=None):
+        """`(law, separation)`: the point contact of `parameters` (`point_contact_stiffness`
+        N/m > 0, `hunt_crossley_dissipation` s/m >= 0) for a body of mass `m` (kg)."""
+        k = check_positive("point_contact_stiffness", parameters["point_contact_stiffness"], "N/m")
+        d = float(parameters["hunt_crossley_dissipation"])
+        if not (math.isfinite(d) and d >= 0):
+            raise ValueError(f"hunt_crossley_dissipation must be >= 0 s/m, got {d:g}")
+        law = self.law({"point_contact_stiffness": k, "hunt_crossley_dissipation": d}, m)
+        return law, "force"
+
+    def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
+        """The discrete plant's implicit step (`replica`) when `parameters["time_step"] > 0`,
+        else None (the continuous plant has no step error)."""
+        if not parameters.get("time_step"):
+            return None
+        h = check_positive("time_step", parameters["time_step"], "s")
+        self.response(parameters, m=m)  # the values checked
+        return Stepping(h, lambda v: replica(parameters, m, v, h))
+
+    def snippet(self, parameters) -> str:
+        per = parameters["per_geometry"]
+        return (
+            "from pydrake.geometry import AddContactMaterial, ProximityProperties\n"
+            "props = ProximityProperties()\n"
+            f"AddContactMaterial(dissipation={per['hunt_crossley_dissipation']!r}, "
+            f"point_stiffness={per['point_contact_stiffness']!r}, properties=props)\n"
+            "# give these props to BOTH geometries in contact (they combine in series)\n"
+            f"plant = MultibodyPlant(time_step={parameters['time_step']!r})"
+            + (
+                "  # continuous: the promise holds\n"
+                if not parameters["time_step"]
+                else "\nplant.set_discrete_contact_approximation("
+                "DiscreteContactApproximation.kLagged)  # not kSap\n"
+            )
+            + "plant.set_contact_model(ContactModel.kPoint)"
+        )

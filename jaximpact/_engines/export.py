@@ -1,5 +1,6 @@
 """`export`: from a law, a fit or target e and T to an engine's own contact parameters, with
-the e and T that the engine will realise."""
+the e and T that the engine will realise; `ENGINES`, the one registry of the engines that
+`export`, `engine_response`, `stepped_response` and the command line read."""
 
 import dataclasses
 import warnings as _warnings
@@ -7,30 +8,34 @@ import warnings as _warnings
 import numpy as np
 
 from . import _stepping, chrono, drake, lammps, liggghts, mujoco, yade
-from .materials import check_positive, check_restitution
+from .base import AbstractEngine, Design
+from .materials import check_poisson, check_positive, check_restitution
 
-ENGINES = {
-    "mujoco": mujoco,
-    "lammps": lammps,
-    "drake": drake,
-    "liggghts": liggghts,
-    "chrono": chrono,
-    "yade": yade,
+# The registry, in the order messages list the engines: one final `AbstractEngine` each.
+# A new engine is its module and one line here (docs/layout.md, "Adding an engine").
+ENGINES: dict[str, AbstractEngine] = {
+    engine.NAME: engine
+    for engine in (
+        mujoco.Mujoco(),
+        lammps.Lammps(),
+        drake.Drake(),
+        liggghts.Liggghts(),
+        chrono.Chrono(),
+        yade.Yade(),
+    )
 }
-# Each engine module holds its own facts: NAME, SCENE, KEYS (what engine-e takes),
-# TWO_SPHERES (its scene: two equal spheres head-on, effective mass m/2, or a body on a
-# plane), design (targets -> parameters and what the engine realises), law and response
-# (parameters -> its continuous law), stepper (its time stepping, replicated), snippet.
 _SPEED_FACTORS = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0)
 
 
 class UnrealisedExport(ValueError):
     """An export its engine cannot realise at the given step (`_stepping.unrealised`): the
     `engine`, its time `step` (s), the `reason`, and `working` (s), a step that realises the
-    target (0.0: Drake's continuous plant; None where none was found)."""
+    target (0.0: Drake's continuous plant; None where none was found); `continuous`: the
+    engine also has a continuous plant (time step 0)."""
 
-    def __init__(self, engine: str, step, reason: str, working):
+    def __init__(self, engine: str, step, reason: str, working, *, continuous: bool = False):
         self.engine, self.step, self.reason, self.working = engine, step, reason, working
+        self.continuous = continuous
         super().__init__(self.message("pass strict=False to export it anyway"))
 
     def message(self, anyway: str) -> str:
@@ -41,7 +46,7 @@ class UnrealisedExport(ValueError):
             fix = "use time_step = 0 (its continuous plant)"
         else:
             fix = f"use a time step of {self.working:.3g} s or less"
-            if self.engine == "drake":
+            if self.continuous:
                 fix += " (or time_step = 0, its continuous plant)"
         return (
             f"{self.engine} cannot realise the target at time step {self.step:.3g} s: "
@@ -55,13 +60,14 @@ class UnrealisedWarning(UserWarning):
 
 def missing_mass(engine: str, from_law: bool, how: str) -> str:
     """The one-line reason an export to `engine` needs the mass (`how`: how to give it)."""
-    module = _engine(engine)
-    each = " of each sphere" if module.TWO_SPHERES else ""
-    why = [module.MASS_DEPENDS] if module.MASS_DEPENDS else []
+    chosen = _engine(engine)
+    each = " of each sphere" if chosen.TWO_SPHERES else ""
+    why = [chosen.MASS_DEPENDS] if chosen.MASS_DEPENDS else []
     if from_law:
         why.append("the law's e and T at v0 depend on it")
+    per_kg = " and ".join(e.LABEL for e in ENGINES.values() if e.MASS_DEPENDS is None)
     return (
-        f"{engine} needs the mass{each}: {how}; {' and '.join(why)} (MuJoCo from target e "
+        f"{engine} needs the mass{each}: {how}; {' and '.join(why)} ({per_kg} from target e "
         "and T alone needs none)"
     )
 
@@ -182,7 +188,7 @@ def export(
     if already chosen (the export then corrects for it where it can and warns where it
     cannot); default, a recommended step.
     The returned `Export` states what the engine realises, computed through a replica of its
-    time stepping (MuJoCo, LAMMPS) checked against the engines in tests/test_engines.py.
+    time stepping (MuJoCo, LAMMPS) checked against the engines in tests/engines.
 
     `m` has no default: every engine's parameters depend on it (LAMMPS, LIGGGHTS, Chrono:
     the Young's modulus; Yade: the density; Drake: the stiffness), and so do a law's e and T
@@ -190,7 +196,7 @@ def export(
     contact per unit mass (the `Export`'s `m` is then None, its `law` per kg).
 
     An export the engine cannot realise at `timestep` is refused: an `UnrealisedExport`
-    (a `ValueError`) that names the step that would work (`.step`), or with `strict=False`
+    (a `ValueError`) that names the step that would work (`.working`), or with `strict=False`
     a warning (also in `Export.warnings`) and the export anyway. It cannot realise it when a
     parameter is not finite, when what it realises is no impact (e or T not finite, e
     outside [0, 1], T <= 0), when fewer than 5 steps resolve the contact (T over the step),
@@ -199,142 +205,164 @@ def export(
 
     **Example**: `export(law("hertz_rate", c=2e6, b1=800.0), "mujoco", m=1.0, v0=2.5).parameters`.
     """
-    module = _engine(engine)
-    wall = _geometry(engine, module, geometry) == "wall"
+    chosen = _engine(engine)
+    geometry = chosen.geometry(geometry)
     m_given = m is not None
-    if not m_given:
-        if law_or_fit is not None or module.MASS_DEPENDS is not None:
-            raise ValueError(missing_mass(engine, law_or_fit is not None, "pass m= (kg)"))
+    m, v0, timestep, poisson = _inputs(chosen, law_or_fit, m, v0, timestep, poisson)
+    source, target_e, target_T = _targets(law_or_fit, e=e, T=T, m=m, v0=v0)
+    if target_T is not None:
+        _check_scales(m, v0, target_T)
+    if chosen.TWO_SPHERES:
+        if radius is None:
+            what = "sphere's" if geometry == "wall" else "spheres'"
+            raise ValueError(f"{engine} needs the {what} radius: pass radius= (m)")
+        radius = check_positive("radius", radius, "m")
+        if target_T is None:
+            raise ValueError(f"{engine} needs a contact duration: pass T= (s) or a law")
+    options = dict(m=m, v0=v0, radius=radius, poisson=0.3 if poisson is None else poisson,
+                   limit_damping=limit_damping, geometry=geometry)  # fmt: skip
+    out = chosen.design(target_e, target_T, timestep=timestep, **options)
+    if out.target_T is not None:  # MuJoCo without T: its default timeconst's
+        target_T = out.target_T
+    warnings = list(out.warnings)
+    reason = _unrealised(out, target_e, target_T)
+    if reason is not None:
+        step = _working_step(chosen, target_e, target_T, options)
+        refusal = UnrealisedExport(
+            engine, out.timestep, reason, step, continuous=chosen.CONTINUOUS_PLANT
+        )
+        if strict:
+            raise refusal
+        warnings.insert(0, str(refusal))
+        _warnings.warn(str(refusal), UnrealisedWarning, stacklevel=2)
+    # the law each side realises; a two-sphere engine's promise is for the pair (effective
+    # mass m/2), or for the sphere on a wall (its own mass)
+    engine_law = chosen.law(out.parameters, m)
+    response = {}
+    if curves:
+        stepping = None if out.stepping is None else chosen.stepper(out.stepping, m=m,
+                                                                    radius=radius)  # fmt: skip
+        response, note = _responses(engine_law, chosen.effective_mass(m, geometry), out,
+                                    stepping, source, m=m, v0=v0)  # fmt: skip
+        warnings += [note] if note else []
+    return Export(
+        engine=engine,
+        scene=chosen.SCENES[geometry],
+        parameters=out.parameters,
+        snippet=chosen.snippet(out.parameters),
+        e=out.e,
+        T=out.T,
+        timestep=out.timestep,
+        warnings=tuple(warnings),
+        target_e=target_e,
+        target_T=target_T,
+        m=m if m_given else None,
+        v0=v0,
+        e_range=out.e_range,
+        T_range=out.T_range,
+        steps_per_contact=out.steps_per_contact,
+        law=engine_law,
+        separation=out.separation,
+        **response,
+    )
+
+
+def _inputs(chosen: AbstractEngine, law_or_fit, m, v0, timestep, poisson):
+    """`(m, v0, timestep, poisson)` checked (kg, m/s, s or None, Poisson's ratio or None),
+    `m` 1.0 where the engine `chosen` does not need it (its parameters per unit mass, from
+    targets); one-line ValueErrors."""
+    if m is None:
+        if law_or_fit is not None or chosen.MASS_DEPENDS is not None:
+            raise ValueError(missing_mass(chosen.NAME, law_or_fit is not None, "pass m= (kg)"))
         m = 1.0  # MuJoCo from targets: per unit mass (the export does not depend on it)
     m = check_positive("m", m, "kg")
     v0 = check_positive("v0", v0, "m/s")
     if timestep is not None:
         timestep = check_positive("timestep", timestep, "s")
     if poisson is not None:
-        from .materials import check_poisson
-
         poisson = check_poisson("poisson", poisson)
-    source = None
+    return m, v0, timestep, poisson
+
+
+def _targets(law_or_fit, *, e, T, m: float, v0: float):
+    """`(source, target_e, target_T)`: the law of `law_or_fit` (None with targets) and the e
+    and T (s; None where not given) an export aims at: the targets `e` and `T`, checked, or
+    the law's e and T for mass `m` (kg) at `v0` (m/s); a one-line ValueError where neither
+    or both are given, or the law does not separate."""
     if law_or_fit is None:
         if e is None:
             raise ValueError("export needs a law or fit, or the target e= (and T=)")
-        target_e = check_restitution(e)
-        target_T = None if T is None else check_positive("T", T, "s")
-    else:
-        if e is not None or T is not None:
-            raise ValueError("give either a law (or fit) or the targets e= and T=, not both")
-        source = _law_of(law_or_fit)
-        from .._solve.impact import impact
+        return None, check_restitution(e), None if T is None else check_positive("T", T, "s")
+    if e is not None or T is not None:
+        raise ValueError("give either a law (or fit) or the targets e= and T=, not both")
+    source = _law_of(law_or_fit)
+    from .._solve.impact import impact
 
-        result = impact(source, m=m, v0=v0)
-        if int(result.status) != 0:
-            raise ValueError("the law does not separate at this m and v0 (e = 0): no engine target")
-        target_e, target_T = float(result.e), float(result.T)
-    if target_T is not None:
-        _check_scales(m, v0, target_T)
-    warnings = []
-    if module.TWO_SPHERES:
-        if radius is None:
-            what = "sphere's" if wall else "spheres'"
-            raise ValueError(f"{engine} needs the {what} radius: pass radius= (m)")
-        radius = check_positive("radius", radius, "m")
-        if target_T is None:
-            raise ValueError(f"{engine} needs a contact duration: pass T= (s) or a law")
-    design = dict(m=m, v0=v0, radius=radius, poisson=0.3 if poisson is None else poisson,
-                  limit_damping=limit_damping)  # fmt: skip
-    if wall and module.TWO_SPHERES:  # the others' scene is a body on a plane already
-        design["geometry"] = "wall"
-    out = module.design(target_e, target_T, timestep=timestep, **design)
-    target_T = out.get("target_T", target_T)  # MuJoCo without T: its default timeconst's
-    separation, h = out["separation"], out["timestep"]
-    warnings += out["warnings"]
-    reason = _unrealised(out, target_e, target_T)
-    if reason is not None:
-        step = _working_step(module, target_e, target_T, design)
-        refusal = UnrealisedExport(engine, h, reason, step)
-        if strict:
-            raise refusal
-        warnings.insert(0, str(refusal))
-        _warnings.warn(str(refusal), UnrealisedWarning, stacklevel=2)
-    # the law each side realises; LAMMPS's promise is for the pair (effective mass m/2), or
-    # for the sphere on a wall (its own mass)
-    engine_law = module.law(out["parameters"], m)
-    m_engine = m / 2.0 if module.TWO_SPHERES and not wall else m
-    speeds, e_engine, T_engine, e_target, T_target = (), (), (), None, None
-    stepped = None if out.get("stepping") is None else module.stepper(out["stepping"], m=m,
-                                                                         radius=radius)  # fmt: skip
-    if curves:
-        speeds = tuple(v0 * f for f in _SPEED_FACTORS)
-        if stepped is None:  # the continuous plant, or a stepper not replicated (Chrono)
-            e_engine, T_engine = _curve(engine_law, m_engine, speeds, separation)
-        else:  # what the engine's stepping realises: the mean over first-touch phases
-            runs = [stepped[1](v) for v in speeds]
-            e_engine = tuple(float(np.mean(es)) for es, _ in runs)
-            T_engine = tuple(float(np.mean(Ts)) for _, Ts in runs)
-        if source is not None:
-            e_target, T_target = _curve(source, m, speeds, "force")
-            spread = max(abs(a - b) for a, b in zip(e_engine, e_target, strict=True))
-            if spread > 0.02:
-                warnings.append(
-                    f"the engine's e(v) departs from the law's by up to {spread:.3f} between "
-                    f"{speeds[0]:.3g} and {speeds[-1]:.3g} m/s: the export is exact at v0 only"
-                )
-    return Export(
-        engine=engine,
-        scene=module.SCENE_WALL if wall and module.TWO_SPHERES else module.SCENE,
-        parameters=out["parameters"],
-        snippet=module.snippet(out["parameters"]),
-        e=out["e"],
-        T=out["T"],
-        timestep=h,
-        warnings=tuple(warnings),
-        target_e=target_e,
-        target_T=target_T,
-        m=m if m_given else None,
-        v0=v0,
-        e_range=out["e_range"],
-        T_range=out["T_range"],
-        steps_per_contact=out["steps_per_contact"],
-        law=engine_law,
-        separation=separation,
-        speeds=speeds,
-        e_engine=e_engine,
-        T_engine=T_engine,
-        e_target=e_target,
-        T_target=T_target,
+    result = impact(source, m=m, v0=v0)
+    if int(result.status) != 0:
+        raise ValueError("the law does not separate at this m and v0 (e = 0): no engine target")
+    return source, float(result.e), float(result.T)
+
+
+def _responses(engine_law, m_engine: float, out: Design, stepping, source, *, m, v0):
+    """`(fields, note)`: the `Export` fields `speeds` (m/s, `v0` times `_SPEED_FACTORS`),
+    `e_engine`, `T_engine` (what the engine realises: its `stepping`'s mean over first-touch
+    phases where it is replicated, else its continuous law `engine_law` on mass `m_engine`,
+    kg) and `e_target`, `T_target` (the `source` law's on mass `m`; None from targets), and a
+    warning where the two e(v) part by more than 0.02 (else None)."""
+    speeds = tuple(v0 * f for f in _SPEED_FACTORS)
+    if stepping is None:  # the continuous plant, or a stepper not replicated (Chrono)
+        e_engine, T_engine = _curve(engine_law, m_engine, speeds, out.separation)
+    else:  # what the engine's stepping realises: the mean over first-touch phases
+        runs = [stepping.run(v) for v in speeds]
+        e_engine = tuple(float(np.mean(es)) for es, _ in runs)
+        T_engine = tuple(float(np.mean(Ts)) for _, Ts in runs)
+    fields = dict(speeds=speeds, e_engine=e_engine, T_engine=T_engine)
+    if source is None:
+        return fields, None
+    e_target, T_target = _curve(source, m, speeds, "force")
+    fields.update(e_target=e_target, T_target=T_target)
+    spread = max(abs(a - b) for a, b in zip(e_engine, e_target, strict=True))
+    if spread <= 0.02:
+        return fields, None
+    return fields, (
+        f"the engine's e(v) departs from the law's by up to {spread:.3f} between "
+        f"{speeds[0]:.3g} and {speeds[-1]:.3g} m/s: the export is exact at v0 only"
     )
 
 
-def _unrealised(out: dict, target_e: float, target_T) -> str | None:
+def _unrealised(out: Design, target_e: float, target_T) -> str | None:
     """Why the design `out` of an engine does not realise `target_e`, `target_T` (s)."""
-    h = out["timestep"]
+    h = out.timestep
     steps = target_T / h if (h and target_T is not None) else None
     return _stepping.unrealised(
-        out["e"], out["T"], target_e=target_e, target_T=target_T, steps_per_contact=steps,
-        parameters=out["parameters"],
+        out.e, out.T, target_e=target_e, target_T=target_T, steps_per_contact=steps,
+        parameters=out.parameters,
     )  # fmt: skip
 
 
-def _working_step(module, target_e: float, target_T, design: dict):
-    """A time step (s) at which `module` realises the target: its recommended step (the
-    design without a step), or where that is Drake's continuous plant (0.0), the first of
-    T/50, T/100, ... T/51200 whose discrete plant does; None where none does."""
+def _working_step(chosen: AbstractEngine, target_e: float, target_T, options: dict):
+    """A time step (s) at which engine `chosen` realises the target: its recommended step
+    (the design without a step), or where that is a continuous plant (0.0), the first of
+    T/50, T/100, ... T/51200 whose discrete plant does; None where none does. `options`:
+    the design's other arguments."""
     try:
-        out = module.design(target_e, target_T, timestep=None, **design)
+        out = chosen.design(target_e, target_T, timestep=None, **options)
     except ValueError:
         return None
-    target_T = out.get("target_T", target_T)
-    if out["timestep"] and _unrealised(out, target_e, target_T) is None:
-        return float(out["timestep"])
-    if out["timestep"] == 0.0 and target_T is not None:  # a continuous plant: 0 or a step
+    if out.target_T is not None:
+        target_T = out.target_T
+    if out.timestep and _unrealised(out, target_e, target_T) is None:
+        return float(out.timestep)
+    if out.timestep == 0.0 and target_T is not None:  # a continuous plant: 0 or a step
         steps = 50
         while steps <= 51200:
             h = _stepping.nice_down(target_T / steps)
             try:
-                out = module.design(target_e, target_T, timestep=h, **design)
+                out = chosen.design(target_e, target_T, timestep=h, **options)
             except ValueError:
                 return 0.0
-            near = abs(out["e"] / target_e - 1) <= 0.005 and abs(out["T"] / target_T - 1) <= 0.005
+            near = abs(out.e / target_e - 1) <= 0.005 and abs(out.T / target_T - 1) <= 0.005
             if near and _unrealised(out, target_e, target_T) is None:
                 return h
             steps *= 2
@@ -359,18 +387,18 @@ def _check_scales(m: float, v0: float, T: float) -> None:
 def engine_response(engine: str, parameters: dict, *, m, speeds, radius=None):
     """The inverse: e(v) and T(v) (continuous law of the engine) that given engine parameters
     produce, for a body of mass `m` (kg; two-sphere engines: each sphere) at each speed of
-    `speeds` (m/s). Parameters: MuJoCo `solref` (`timestep` for refsafe); LAMMPS, LIGGGHTS,
-    Chrono `E` (Pa), `coeff_restitution`, `poisson`, `limit_damping`; Yade `tc` (s), `en`;
-    Drake `point_contact_stiffness` (N/m), `hunt_crossley_dissipation` (s/m); `"geometry":
-    "wall"` (LAMMPS, LIGGGHTS, Chrono, Yade): one sphere on a wall of its material. The step
-    is not part of this answer: `stepped_response` gives what the stepping realises.
-    Returns `(law, separation, e, T)`."""
-    module = _engine(engine)
+    `speeds` (m/s). Parameters: the names of the engine's `KEYS` (MuJoCo `solref`,
+    `timestep` for refsafe; LAMMPS, LIGGGHTS, Chrono `E` (Pa), `coeff_restitution`,
+    `poisson`, `limit_damping`; Yade `tc` (s), `en`; Drake `point_contact_stiffness` (N/m),
+    `hunt_crossley_dissipation` (s/m)); `"geometry": "wall"` (LAMMPS, LIGGGHTS, Chrono,
+    Yade): one sphere on a wall of its material. The step is not part of this answer:
+    `stepped_response` gives what the stepping realises. Returns `(law, separation, e, T)`."""
+    chosen = _engine(engine)
     m = check_positive("m", m, "kg")
     speeds = [check_positive("speed", v, "m/s") for v in np.atleast_1d(speeds)]
-    law, separation = module.response(parameters, m=m, radius=radius)
-    pair = module.TWO_SPHERES and parameters.get("geometry", "spheres") != "wall"
-    e, T = _curve(law, m / 2.0 if pair else m, speeds, separation)
+    law, separation = chosen.response(parameters, m=m, radius=radius)
+    m_engine = chosen.effective_mass(m, parameters.get("geometry"))
+    e, T = _curve(law, m_engine, speeds, separation)
     return law, separation, e, T
 
 
@@ -383,17 +411,17 @@ def stepped_response(engine: str, parameters: dict, *, m, speeds, radius=None):
     `damping`, default 0 here), Drake with `time_step > 0` (its implicit discrete step, the
     Lagged, Similar and TAMSI approximations). `None` where the step does not apply or is
     not known: a two-sphere engine without a `timestep`, Drake's continuous plant
-    (error-controlled integration: no step error), and Chrono (its stepper not modelled)."""
-    module = _engine(engine)
+    (error-controlled integration: no step error), and Chrono (its stepper not modelled);
+    each engine's `STEPPING` says which."""
+    chosen = _engine(engine)
     m = check_positive("m", m, "kg")
     speeds = [check_positive("speed", v, "m/s") for v in np.atleast_1d(speeds)]
-    stepping = module.stepper(parameters, m=m, radius=radius)
+    stepping = chosen.stepper(parameters, m=m, radius=radius)
     if stepping is None:
         return None
-    h, run = stepping
-    runs = [run(v) for v in speeds]
+    runs = [stepping.run(v) for v in speeds]
     return (
-        h,
+        stepping.timestep,
         [float(np.mean(es)) for es, _ in runs],
         [float(np.mean(Ts)) for _, Ts in runs],
         [float(np.min(es)) for es, _ in runs],
@@ -401,22 +429,8 @@ def stepped_response(engine: str, parameters: dict, *, m, speeds, radius=None):
     )
 
 
-def _geometry(engine: str, module, geometry) -> str:
-    """The scene `geometry` asks of `engine`'s `module`: "spheres" (two equal spheres, the
-    default of the two-sphere engines) or "wall" (a sphere on a fixed flat wall; MuJoCo's
-    and Drake's body on a plane), or a one-line ValueError."""
-    kinds = getattr(module, "GEOMETRIES", ("spheres",) if module.TWO_SPHERES else ("wall",))
-    if geometry is None:
-        return kinds[0]
-    if geometry not in kinds:
-        raise ValueError(
-            f"{engine} exports geometry {' or '.join(map(repr, kinds))}, not {geometry!r}"
-        )
-    return geometry
-
-
-def _engine(name: str):
-    """The module of engine `name`, or a one-line ValueError naming the engines."""
+def _engine(name: str) -> AbstractEngine:
+    """The engine `name` of `ENGINES`, or a one-line ValueError naming the engines."""
     if name not in ENGINES:
         raise ValueError(f"unknown engine {name!r}; choose one of: {', '.join(ENGINES)}")
     return ENGINES[name]

