@@ -215,31 +215,3 @@ def metered(progress, total: int, label: str):
     finally:
         meter.close()
 
-
-class Progress:
-    """`with Progress(total, what, enabled=...) as bar: bar.update(note)`, the interface
-    before the meters: a `TextMeter` (with `options`) or none. Kept for `_curves/gravity.py`
-    until it takes `metered`; new code uses `metered`."""
-
-    def __init__(self, total, what, enabled=True, **options):
-        self._meter = TextMeter(**options) if enabled else NoMeter()
-        self._total, self._what = total, what
-
-    @property
-    def total(self):
-        return self._meter.total
-
-    @total.setter
-    def total(self, value):
-        self._meter.total = value
-
-    def __enter__(self):
-        self._meter.start(self._total, self._what)
-        return self
-
-    def update(self, note=""):
-        self._meter.update(1, note)
-
-    def __exit__(self, *exc):
-        self._meter.close()
-        return False

@@ -35,6 +35,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .._progress import metered
 from . import chebyshev
 from .curve import DEGREE, OUTPUTS
 from .shapes import CurveKey, curve_key
@@ -174,10 +175,10 @@ def _fit_piece(key, a, b, G, zero_cache):
     return c, True
 
 
-def build_gravity(key: CurveKey, *, progress: bool = True) -> GravityTable:
-    """Tabulate `key`'s correction `Q` (see the module's docstring)."""
-    from .._progress import Progress
-
+def build_gravity(key: CurveKey, *, progress=True) -> GravityTable:
+    """Tabulate `key`'s correction `Q` (see the module's docstring). `progress`: `True`
+    reports on the default meter (and prints a summary at the end), `False` says nothing,
+    or any `jaximpact.AbstractMeter`."""
     started = time.perf_counter()
     s_lo, s_hi = math.log(BETA_LO), math.log(BETA_HI)
     # the capture threshold on a grid of beta (it falls with beta): a piece's G is a
@@ -190,11 +191,10 @@ def build_gravity(key: CurveKey, *, progress: bool = True) -> GravityTable:
         inside = (scan_s >= a - h) & (scan_s <= b + h)
         return float(thresholds[inside].min())
 
-    bar = Progress(1, f"building gravity table {key.name}", enabled=progress)
     edges = np.linspace(s_lo, s_hi, 9)
     pending = [(a, b, np.inf) for a, b in zip(edges[:-1], edges[1:], strict=True)]
     accepted, end, zero_cache = {}, s_hi, {}
-    with bar:
+    with metered(progress, 1, f"building gravity table {key.name}") as bar:
         while pending:
             bar.total += 1
             split = []
@@ -239,7 +239,7 @@ def build_gravity(key: CurveKey, *, progress: bool = True) -> GravityTable:
                     m = 0.5 * (a + b)
                     split += [(a, m, tail_s.max()), (m, b, tail_s.max())]
             pending = split
-            bar.update(f"{len(accepted)} pieces")
+            bar.update(1, f"{len(accepted)} pieces")
     order = sorted(piece for piece in accepted if piece[1] <= end)
     if not order or order[0][0] > s_lo:
         raise RuntimeError(f"{key.name}: no gravity table from beta = {BETA_LO:g} on")

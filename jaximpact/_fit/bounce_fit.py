@@ -1,6 +1,7 @@
 """`BounceFit`, the result of `fit_bounces`, and the statistics it reports: standard errors
 from the Jacobian at the optimum, undetermined parameters, outliers."""
 
+import dataclasses
 import math
 
 import equinox as eqx
@@ -9,7 +10,7 @@ import numpy as np
 
 from .._laws import AbstractLaw
 from .._solve.bounce import BounceResult, bounce_options, solve_bounce
-from .bounce_model import round_up
+from .bounce_model import BounceProblem, Stage, round_up
 from .parameters import law_with
 
 
@@ -111,11 +112,31 @@ class BounceFit(eqx.Module):
         return self.nuisance["floor"] + self.y_sign * self.nuisance["length_scale"] * height
 
 
-def statistics(theta, r, J, extra, names, sigma_given, n_data, log_params):
-    """Covariance from the Jacobian at the optimum; undetermined parameters; e errors."""
-    p = theta.size
-    dof = max(n_data - p, 1)
-    s2 = 1.0 if sigma_given else float(r @ r) / dof
+@dataclasses.dataclass(frozen=True)
+class Measurements:
+    """The measurements of a finished fit, as `BounceFit` reports them.
+
+    - `used`: bool per measurement (the detections in input order, or the trajectory's
+      samples from the release on), True for those the last stage fitted.
+    - `sigma_given`: whether the noise was given (`sigma=`), or is estimated from the
+      residuals.
+    - `fields`: `BounceFit`'s fields about the data: for impact times `times` (s), `index`,
+      `missed`, `dropped`; for a trajectory `t` (s), `y`, `y_fit` (y units), `dropped`.
+    """
+
+    used: np.ndarray
+    sigma_given: bool
+    fields: dict
+
+
+def statistics(problem: BounceProblem, stage: Stage, measured: Measurements):
+    """Covariance from the Jacobian at `stage`'s optimum: the degrees of freedom, the
+    variance factor, the parameters' standard errors (in `theta`'s coordinates),
+    the undetermined parameters, and the standard error of each modelled impact's e."""
+    p = stage.theta.size
+    r, J = stage.residuals[: measured.used.size], stage.jacobian
+    dof = max(int(measured.used.sum()) - p, 1)
+    s2 = 1.0 if measured.sigma_given else float(r @ r) / dof
     U, S, Vt = np.linalg.svd(J, full_matrices=False)
     cutoff = S.max(initial=0.0) * 1e-8
     good = S > cutoff
@@ -123,61 +144,32 @@ def statistics(theta, r, J, extra, names, sigma_given, n_data, log_params):
     cov = s2 * (Vt.T * inv) @ Vt
     null = Vt[~good]
     se_theta = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    log_params = [True] * len(problem.free) + [name in _LOG_NUISANCE for name in problem.nuisance]
     undetermined = []
-    for i, name in enumerate(names):
+    for i, name in enumerate(problem.free + problem.nuisance):
         in_null = null.size and np.max(np.abs(null[:, i])) > 1e-3
         if in_null or (log_params[i] and se_theta[i] > 1.0):
             undetermined.append(name)
             se_theta[i] = np.inf
-    e, J_e, _ = extra
+    J_e = stage.e_jacobian
     cov_e = np.einsum("ki,ij,kj->k", J_e, cov, J_e)
-    return dof, s2, se_theta, undetermined, e, np.sqrt(np.maximum(cov_e, 0.0))
+    return dof, s2, se_theta, undetermined, np.sqrt(np.maximum(cov_e, 0.0))
 
 
-def finish(
-    *,
-    kind,
-    law,
-    free,
-    nuisance_names,
-    theta,
-    r,
-    J,
-    extra,
-    history,
-    converged,
-    iterations,
-    data,
-    sigma_used,
-    sigma_given,
-    n_data,
-    m,
-    g,
-    separation,
-    y_sign,
-    used,
-    **extra_fields,
-):
-    """The `BounceFit` of a finished fit: statistics at the optimum `theta` (law parameters
-    `free`, then `nuisance_names`), the fitted chain's e and impacts from `extra`."""
-    nf = len(free)
-    fitted_law = law_with(law, free, jnp.asarray(theta[:nf]))
-    log_params = [True] * nf + [
-        name in ("v_impact", "length_scale", "drag") for name in nuisance_names
-    ]
-    names = list(free) + list(nuisance_names)
-    dof, s2, se_theta, undetermined, e, e_se = statistics(
-        theta, r, J, extra, names, sigma_given, n_data, log_params
-    )
-    params = {k: float(v) for k, v in fitted_law.parameters.items()}
-    stderr = {}
-    for i, name in enumerate(free):
-        stderr[name] = float(params[name] * se_theta[i]) if np.isfinite(se_theta[i]) else math.inf
-    q = dict(zip(nuisance_names, theta[nf:], strict=True))
+_LOG_NUISANCE = ("v_impact", "length_scale", "drag")  # fitted as logarithms
+
+
+def _nuisance(problem: BounceProblem, theta, se_theta):
+    """The nuisance parameters at `theta` in their units (see `BounceFit`), and their
+    standard errors from `se_theta` (`theta`'s coordinates)."""
+    data = {k: float(v) for k, v in problem.data.items() if np.ndim(v) == 0}
+    nf, g = len(problem.free), problem.g
+    q = dict(zip(problem.nuisance, theta[nf:], strict=True))
+    se_q = dict(zip(problem.nuisance, se_theta[nf:], strict=True))
     t1 = float(data["t1"] + q["t_impact"] * data["t_unit"])
     v1 = float(data["v1"] * math.exp(q["v_impact"]))
     nuisance = {"t_impact": t1, "v_impact": v1}
-    se_q = dict(zip(nuisance_names, se_theta[nf:], strict=True))
+    stderr = {}
     stderr["t_impact"] = float(se_q["t_impact"] * data["t_unit"])
     stderr["v_impact"] = float(v1 * se_q["v_impact"])
     drag = None
@@ -195,7 +187,7 @@ def finish(
     nuisance["drop_height"] = height
     nuisance["release_time"] = t1 - fall
     stderr["drop_height"] = float(2 * height * se_q["v_impact"])
-    if kind == "trajectory":
+    if problem.kind == "trajectory":
         nuisance["floor"] = float(data["floor"] + q["floor"] * data["y_unit"])
         stderr["floor"] = float(se_q["floor"] * data["y_unit"])
         scale = float(data["scale"] * math.exp(q.get("length_scale", 0.0)))
@@ -203,40 +195,58 @@ def finish(
         stderr["length_scale"] = (
             float(scale * se_q["length_scale"]) if "length_scale" in se_q else 0.0
         )
-    aux = extra[2]
+    return nuisance, stderr
+
+
+def finish(problem: BounceProblem, stage: Stage, measured: Measurements) -> BounceFit:
+    """The `BounceFit` of a finished fit: statistics at the optimum of its last `stage`
+    (law parameters `problem.free`, then `problem.nuisance`), the fitted chain's e and
+    impacts, and the `measured` data."""
+    free, theta = problem.free, stage.theta
+    nf = len(free)
+    fitted_law = law_with(problem.law, free, jnp.asarray(theta[:nf]))
+    dof, s2, se_theta, undetermined, e_se = statistics(problem, stage, measured)
+    params = {k: float(v) for k, v in fitted_law.parameters.items()}
+    stderr = {}
+    for i, name in enumerate(free):
+        stderr[name] = float(params[name] * se_theta[i]) if np.isfinite(se_theta[i]) else math.inf
+    nuisance, nuisance_stderr = _nuisance(problem, theta, se_theta)
+    stderr.update(nuisance_stderr)
+    aux, fields = stage.chain, measured.fields
     valid = aux["valid"]
     count = int(np.sum(valid))
-    if kind == "impacts":  # the impacts the detections cover
-        count = min(count, int(np.max(extra_fields["index"])) + 1)
+    if problem.kind == "impacts":  # the impacts the detections cover
+        count = min(count, int(np.max(fields["index"])) + 1)
     else:
-        count = min(count, int(np.sum(aux["t_land"][:count] <= np.max(extra_fields["t"]))))
-    sigma = float(sigma_used * math.sqrt(s2))
+        count = min(count, int(np.sum(aux["t_land"][:count] <= np.max(fields["t"]))))
+    sigma = float(float(problem.data["sigma"]) * math.sqrt(s2))
+    r = stage.residuals[: measured.used.size]
     return BounceFit(
-        kind=kind,
+        kind=problem.kind,
         law=fitted_law,
         params=params,
         stderr=stderr,
         free=tuple(free),
         undetermined=tuple(undetermined),
         nuisance=nuisance,
-        e=np.where(valid, extra[0], np.nan)[:count],
+        e=np.where(valid, stage.e, np.nan)[:count],
         e_stderr=np.where(valid, e_se, np.nan)[:count],
         impact_speeds=aux["v_in"][:count],
         impact_times=aux["t_land"][:count],
         T=aux["T"][:count],
         num_impacts=count,
-        residuals=r[used] / math.sqrt(s2),
+        residuals=r[measured.used] / math.sqrt(s2),
         loss=float(0.5 * r @ r),
         sigma=sigma,
         dof=int(dof),
-        converged=bool(converged),
-        iterations=int(iterations),
-        history=history,
-        m=m,
-        g=g,
-        separation=separation,
-        y_sign=y_sign,
-        **extra_fields,
+        converged=bool(stage.converged),
+        iterations=int(stage.iterations),
+        history=stage.history,
+        m=problem.m,
+        g=problem.g,
+        separation=problem.options.impact.separation,
+        y_sign=problem.y_sign,
+        **fields,
     )
 
 

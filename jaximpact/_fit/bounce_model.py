@@ -1,7 +1,7 @@
 """The model a bounce fit runs: `bounce`'s chain (closed-form flights, one impact solve per
 contact) started at the first observed impact, its weighted residuals and their Jacobian in
 one forward-mode pass (compiled once per law, data kind and size bucket), and the stages a
-fit is made of (`run_stage`, `tune_damping`, `rebase`)."""
+fit is made of (`BounceProblem`, `Stage`; `run_stage`, `tune_damping`, `rebase`)."""
 
 import dataclasses
 import math
@@ -86,19 +86,22 @@ def evaluate_chain(theta, law, m, g, data, spec):
 @dataclasses.dataclass(frozen=True)
 class BounceProblem:
     """What a stage of a bounce fit works on: the `law` (its `free` parameters at their
-    current values), the `nuisance` names, the mass `m` (kg) and gravity `g` (m/s^2), the
-    `data` arrays (reference values of the nuisance included), the `kind` of data, the sign
-    of the data's y axis `y_sign`, and the chain's `options`."""
+    current values), the mass `m` (kg) and gravity `g` (m/s^2), the `kind` of data
+    ("impacts" or "trajectory"), the sign of the data's y axis `y_sign` (+1 up, -1 down),
+    the chain's `options` (a `BounceOptions`: the separation, the solver, `max_impacts`
+    modelled impacts), the `nuisance` names and the `data` arrays (reference values of the
+    nuisance included; see `chain_residuals`). `fit_bounces` starts one without data; its
+    stages fill them in."""
 
     law: AbstractLaw
     free: tuple
-    nuisance: tuple
     m: float
     g: float
-    data: dict
     kind: str
     y_sign: float
     options: object
+    nuisance: tuple = ()
+    data: dict = dataclasses.field(default_factory=dict)
 
     def spec(self, free=None) -> ChainSpec:
         """The static part of the compiled model (`free`: default the problem's)."""
@@ -111,10 +114,64 @@ class BounceProblem:
             options=self.options,
         )
 
+    @property
+    def size(self) -> int:
+        """The number of fitted parameters: the law's `free` ones, then the `nuisance`."""
+        return len(self.free) + len(self.nuisance)
 
-def run_stage(problem: BounceProblem, active, *, max_iter: int, tol: float, log: list):
+    def masked(self, mask, index=None) -> "BounceProblem":
+        """The problem fitting the data where `mask` (bool, one per measurement) holds, the
+        detections being impacts number `index` (impact times; capped at the last modelled
+        impact), both padded to the data's size bucket."""
+        n_pad = self.data["times" if self.kind == "impacts" else "t"].size
+        data = dict(self.data)
+        if index is not None:
+            last = self.options.max_impacts - 1
+            data["index"] = np.pad(np.minimum(index, last), (0, n_pad - index.size))
+        data["mask"] = np.pad(mask, (0, n_pad - mask.size))
+        return dataclasses.replace(self, data=data)
+
+
+@dataclasses.dataclass(frozen=True)
+class Stage:
+    """One Levenberg-Marquardt fit of a `BounceProblem` (`run_stage`), and where it ended.
+
+    The parameters `theta` are the law's `free` parameters, then the `nuisance`, in the
+    coordinates the optimiser moves: a law parameter as `to_unbounded` of its SI value (its
+    logarithm); the nuisance as offsets from the problem's reference values, `t_impact` in
+    units of `data["t_unit"]` (s), `floor` in units of `data["y_unit"]` (y units),
+    `v_impact`, `length_scale` and `drag` as the logarithm of their ratio to the reference.
+
+    - `active`: bool per parameter, the ones this stage moved (the others were held).
+    - `theta`: the optimum.
+    - `residuals`: `(model - data) / sigma` there (dimensionless; 0 where masked or
+      padded); `jacobian`: `d residuals / d theta`.
+    - `e`: the restitution of each modelled impact there; `e_jacobian`: `d e / d theta`.
+    - `chain`: the chain's arrays there: per modelled impact `t_land` (s), `v_in` (m/s),
+      `T` (s), `valid`, `status`; per measurement `predicted` (s or y units).
+    - `history`: the loss `|residuals|^2 / 2` at each accepted step of this stage.
+    - `converged`: whether this stage met its tolerance.
+    - `iterations`: the accepted steps of this stage and of every stage before it.
+    """
+
+    active: np.ndarray
+    theta: np.ndarray
+    residuals: np.ndarray
+    jacobian: np.ndarray
+    e: np.ndarray
+    e_jacobian: np.ndarray
+    chain: dict
+    history: np.ndarray
+    converged: bool
+    iterations: int
+
+
+def run_stage(
+    problem: BounceProblem, active, *, max_iter: int, tol: float, before: Stage | None = None
+) -> Stage:
     """One Levenberg-Marquardt fit of `problem`'s `active` parameters through the compiled
-    model, from zero nuisance offsets; appends its number of accepted steps to `log`."""
+    model, from zero nuisance offsets, with at most `max_iter` steps and tolerance `tol`;
+    its `iterations` count on from the stage `before` it."""
     spec = problem.spec()
     data = {k: jnp.asarray(v) for k, v in problem.data.items()}
     m_, g_ = jnp.asarray(problem.m, float), jnp.asarray(problem.g, float)
@@ -134,9 +191,21 @@ def run_stage(problem: BounceProblem, active, *, max_iter: int, tol: float, log:
             np.zeros(len(problem.nuisance)),
         ]
     )
+    active = np.asarray(active, dtype=bool)
     result = levenberg_marquardt(evaluate, theta0, active, max_iter=max_iter, tol=tol)
-    log.append(result.iterations)
-    return result
+    e, e_jacobian, chain = result.extra
+    return Stage(
+        active=active,
+        theta=result.theta,
+        residuals=result.residuals,
+        jacobian=result.jacobian,
+        e=e,
+        e_jacobian=e_jacobian,
+        chain=chain,
+        history=result.history,
+        converged=result.converged,
+        iterations=result.iterations + (0 if before is None else before.iterations),
+    )
 
 
 def tune_damping(problem: BounceProblem, e_target: float):
@@ -187,11 +256,13 @@ def rebase(problem: BounceProblem, theta) -> BounceProblem:
     return dataclasses.replace(problem, law=law, data=data)
 
 
-def first_stage(law, free, nuisance):
+def first_stage(problem: BounceProblem):
     """What a first fit frees: the nuisance and the damping alone (a stiffness freed from the
     start can wander to a distant local minimum before the damping has settled)."""
-    damping = damping_name(law, free)
-    return np.asarray([k == damping or damping is None for k in free] + [True] * len(nuisance))
+    damping = damping_name(problem.law, problem.free)
+    return np.asarray(
+        [k == damping or damping is None for k in problem.free] + [True] * len(problem.nuisance)
+    )
 
 
 def damping_name(law, free):

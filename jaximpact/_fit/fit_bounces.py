@@ -18,6 +18,11 @@ What the data can and cannot say:
   solution.
 - Parameters whose standard error in log space exceeds 1 (a factor e), or that lie in a null
   direction of the Jacobian, are listed in `undetermined` with an infinite standard error.
+
+How the work is shared: `fit_bounces` checks the input, keeps its options in `Settings` and
+starts a `BounceProblem` (law, mass, gravity, kind of data, the chain's options);
+`_fit_impacts` and `_fit_trajectory` give it its data and run its stages (`run_stage`, each a
+`Stage`); `finish(problem, stage, measurements)` turns the last stage into a `BounceFit`.
 """
 
 import dataclasses
@@ -28,9 +33,10 @@ import numpy as np
 
 from .._laws import AbstractLaw
 from .._solve.bounce import bounce_options
-from .bounce_fit import BounceFit, find_outliers, finish
+from .bounce_fit import BounceFit, Measurements, find_outliers, finish
 from .bounce_model import (
     BounceProblem,
+    Stage,
     first_stage,
     rebase,
     round_up,
@@ -43,6 +49,58 @@ from .parameters import default_free
 
 KINDS = ("impacts", "trajectory")
 Y_AXES = ("up", "down")
+
+
+@dataclasses.dataclass(frozen=True)
+class Settings:
+    """How `fit_bounces` fits, checked on creation (ValueError).
+
+    - `sigma`: the measurement noise (s for impact times, y units for a trajectory), or
+      None: estimated from the residuals.
+    - `drag`: quadratic air drag in flight (1/m), held or the start of `fit_drag`; None: none.
+    - `fit_drag`: whether the drag is fitted.
+    - `clean_tol`: how far (a fraction of the neighbouring interval) a detection may lie
+      from its impact.
+    - `outlier_sigma`: how far (robust standard deviations) a datum may lie off the fit.
+    - `max_iter`, `tol`: each Levenberg-Marquardt stage's step budget and (relative)
+      tolerance.
+    """
+
+    sigma: float | None
+    drag: float | None
+    fit_drag: bool
+    clean_tol: float
+    outlier_sigma: float
+    max_iter: int
+    tol: float
+
+    def __post_init__(self):
+        for name in ("sigma", "clean_tol", "tol", "outlier_sigma"):
+            value = getattr(self, name)
+            if value is not None and not (np.ndim(value) == 0 and 0 < float(value) < math.inf):
+                raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+        n = self.max_iter
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+            raise ValueError(f"max_iter must be a positive integer, got {n!r}")
+        if self.fit_drag and self.drag is None:
+            raise ValueError("fit_drag needs a starting value: drag=k (1/m)")
+        if self.drag is not None and not (np.isfinite(self.drag) and self.drag > 0):
+            raise ValueError(f"drag must be a finite number > 0 (1/m), got {self.drag}")
+
+    @property
+    def sigma_given(self) -> bool:
+        """Whether the noise was given (else it is estimated from the residuals)."""
+        return self.sigma is not None
+
+    def capped(self, v1, g):
+        """An impact speed `v1` (m/s) kept below nine tenths of the terminal speed (m/s)
+        under gravity `g` (m/s^2) and the drag, if any."""
+        return v1 if self.drag is None else min(v1, 0.9 * math.sqrt(g / self.drag))
+
+    def stage(self, problem: BounceProblem, active, before: Stage | None = None) -> Stage:
+        """`run_stage` of `problem`'s `active` parameters with these step budget and
+        tolerance, counting on from the stage `before`."""
+        return run_stage(problem, active, max_iter=self.max_iter, tol=self.tol, before=before)
 
 
 def _guess_trajectory(t, h, g):
@@ -161,16 +219,15 @@ def fit_bounces(
         raise ValueError(f"mass m must be a finite number > 0 kg, got {m}")
     if not (np.isfinite(g) and g > 0):
         raise ValueError(f"gravity g must be a finite number > 0 m/s^2, got {g}")
-    for name, value in (("sigma", sigma), ("clean_tol", clean_tol), ("tol", tol),
-                        ("outlier_sigma", outlier_sigma)):  # fmt: skip
-        if value is not None and not (np.ndim(value) == 0 and 0 < float(value) < math.inf):
-            raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
-    if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) or max_iter < 1:
-        raise ValueError(f"max_iter must be a positive integer, got {max_iter!r}")
-    if fit_drag and drag is None:
-        raise ValueError("fit_drag needs a starting value: drag=k (1/m)")
-    if drag is not None and not (np.isfinite(drag) and drag > 0):
-        raise ValueError(f"drag must be a finite number > 0 (1/m), got {drag}")
+    settings = Settings(
+        sigma=sigma,
+        drag=drag,
+        fit_drag=fit_drag,
+        clean_tol=clean_tol,
+        outlier_sigma=outlier_sigma,
+        max_iter=max_iter,
+        tol=tol,
+    )
     free = default_free(law, stiffness=False) if free is None else tuple(free)
     unknown = [k for k in free if k not in law.parameters]
     if unknown:
@@ -186,67 +243,64 @@ def fit_bounces(
         adjoint=dfx.ForwardMode(),
         peaks=False,
     )
-    m = float(m)
-    g = float(g)
-    if kind == "impacts":
-        return _fit_impacts(
-            law,
-            free,
-            m,
-            g,
-            impact_times,
-            drag,
-            fit_drag,
-            sigma,
-            clean_tol,
-            outlier_sigma,
-            max_iter,
-            tol,
-            options,
-            separation,
-        )
-    return _fit_trajectory(
-        law,
-        free,
-        m,
-        g,
-        t,
-        y,
-        drag,
-        fit_drag,
-        length_scale,
-        y_axis,
-        sigma,
-        outlier_sigma,
-        max_iter,
-        tol,
-        options,
-        separation,
+    problem = BounceProblem(
+        law=law,
+        free=free,
+        m=float(m),
+        g=float(g),
+        kind=kind,
+        y_sign=-1.0 if kind == "trajectory" and y_axis == "down" else 1.0,
+        options=options,
     )
+    if kind == "impacts":
+        return _fit_impacts(problem, impact_times, settings)
+    return _fit_trajectory(problem, t, y, length_scale, settings)
 
 
-def _fit_impacts(
-    law,
-    free,
-    m,
-    g,
-    impact_times,
-    drag,
-    fit_drag,
-    sigma,
-    clean_tol,
-    outlier_sigma,
-    max_iter,
-    tol,
-    options,
-    separation,
-):
+def _refit(problem: BounceProblem, stage: Stage, settings: Settings, mask, index=None):
+    """The next stage: `problem` moved to `stage`'s optimum (`rebase`), fitting the data
+    where `mask` holds (impact times: detections of impacts number `index`), every
+    parameter free. Returns the new problem and its stage."""
+    problem = rebase(problem, stage.theta).masked(mask, index)
+    return problem, settings.stage(problem, np.ones(problem.size, dtype=bool), stage)
+
+
+def _fit_impacts(problem: BounceProblem, impact_times, settings: Settings) -> BounceFit:
     """Three fits with one compiled model: on the detections before the first anomaly that
     `clean_impact_times` finds; on every detection within `clean_tol` of the fitted
     model's impacts; without the outliers of that fit."""
-    log = []  # accepted steps of each fit
     raw = times_in_order(impact_times, "impact_times")
-    cleaned = prepare_impacts(raw, clean_tol)
+    problem = _impacts_problem(problem, raw, settings)
+    stage = settings.stage(problem, first_stage(problem))
+    # every detection against the fitted model's impacts
+    aux = stage.chain
+    predicted = aux["t_land"][aux["valid"]] if np.any(aux["valid"]) else aux["t_land"]
+    keep, number = assign(raw, predicted, settings.clean_tol)
+    problem, stage = _refit(problem, stage, settings, keep, number)
+    if keep.sum() >= 10:  # a robust spread from fewer points is itself too uncertain
+        r = stage.residuals[: raw.size]
+        outliers = find_outliers(r, keep, settings.outlier_sigma, settings.sigma_given)
+        if outliers.any():
+            keep = keep & ~outliers
+            problem, stage = _refit(problem, stage, settings, keep, number)
+    index = number[keep]
+    fields = dict(
+        times=raw[keep],
+        index=index,
+        missed=np.setdiff1d(np.arange(index.max() + 1), index),
+        dropped=np.flatnonzero(~keep),
+    )
+    return finish(problem, stage, Measurements(keep, settings.sigma_given, fields))
+
+
+def _impacts_problem(problem: BounceProblem, raw, settings: Settings) -> BounceProblem:
+    """`problem` set up for the detections `raw` (s, in order): the nuisance, the data
+    and the model's size; its starting values (first impact at the first detection, its
+    speed from the first interval and the intervals' ratio as e); the detections before
+    the first anomaly that `clean_impact_times` finds masked in, and the damping set so
+    that the first impact's e is that ratio."""
+    g = problem.g
+    cleaned = prepare_impacts(raw, settings.clean_tol)
     kept_positions = np.setdiff1d(np.arange(raw.size), cleaned.dropped)
     anomalies = np.concatenate(
         [cleaned.dropped, kept_positions[1:][np.diff(cleaned.index) > 1], [raw.size]]
@@ -260,13 +314,11 @@ def _fit_impacts(
         consecutive = np.flatnonzero(np.diff(cleaned.index) == 1)[0]
         gap = cleaned.times[consecutive + 1] - cleaned.times[consecutive]
         v1 = g * gap / (2 * e0 ** (cleaned.index[consecutive] + 1))
-    if drag is not None:
-        v1 = min(v1, 0.9 * math.sqrt(g / drag))
-    sigma_used = float(sigma) if sigma is not None else 1e-3
-    nuisance = ("t_impact", "v_impact") + (("drag",) if fit_drag else ())
+    v1 = settings.capped(v1, g)
+    nuisance = ("t_impact", "v_impact") + (("drag",) if settings.fit_drag else ())
     data = dict(
         times=np.pad(raw, (0, n_pad - raw.size), constant_values=raw[-1]),
-        sigma=np.asarray(sigma_used),
+        sigma=np.asarray(float(settings.sigma) if settings.sigma_given else 1e-3),
         t1=np.asarray(raw[0]),
         t_unit=np.asarray(1e-3),
         v1=np.asarray(v1),
@@ -276,94 +328,22 @@ def _fit_impacts(
         t_end=np.asarray(np.inf),
         min_flight=np.asarray(0.0),
     )
-    if drag is not None:
-        data["drag"] = np.asarray(float(drag))
-
-    def with_mask(data, keep, number):
-        data = dict(data)
-        data["index"] = np.pad(np.minimum(number, n_model - 1), (0, n_pad - raw.size))
-        data["mask"] = np.pad(keep, (0, n_pad - raw.size))
-        return data
-
+    if settings.drag is not None:
+        data["drag"] = np.asarray(float(settings.drag))
     number = np.zeros(raw.size, dtype=int)
     number[kept_positions] = cleaned.index
     keep = np.zeros(raw.size, dtype=bool)
     keep[kept_positions[prefix]] = True
-    opts = with_impacts(options, n_model)
-    problem = BounceProblem(
-        law, free, nuisance, m, g, with_mask(data, keep, number), "impacts", 1.0, opts
-    )
-    problem = dataclasses.replace(problem, law=tune_damping(problem, e0))
-    active = np.ones(len(free) + len(nuisance), dtype=bool)
-    first = first_stage(problem.law, free, nuisance)
-    result = run_stage(problem, first, max_iter=max_iter, tol=tol, log=log)
-    # every detection against the fitted model's impacts
-    problem = rebase(problem, result.theta)
-    aux = result.extra[2]
-    predicted = aux["t_land"][aux["valid"]] if np.any(aux["valid"]) else aux["t_land"]
-    keep, number = assign(raw, predicted, clean_tol)
-    problem = dataclasses.replace(problem, data=with_mask(problem.data, keep, number))
-    result = run_stage(problem, active, max_iter=max_iter, tol=tol, log=log)
-    r = result.residuals[: raw.size]
-    if keep.sum() >= 10:  # a robust spread from fewer points is itself too uncertain
-        outliers = find_outliers(r, keep, outlier_sigma, sigma is not None)
-        if outliers.any():
-            problem = rebase(problem, result.theta)
-            keep = keep & ~outliers
-            problem = dataclasses.replace(problem, data=with_mask(problem.data, keep, number))
-            result = run_stage(problem, active, max_iter=max_iter, tol=tol, log=log)
-    law, data = problem.law, problem.data
-    theta, r, J, extra = result.theta, result.residuals, result.jacobian, result.extra
-    history, converged = result.history, result.converged
-    iterations = sum(log)
-    index = number[keep]
-    return finish(
-        kind="impacts",
-        law=law,
-        free=free,
-        nuisance_names=nuisance,
-        theta=theta,
-        r=r[: raw.size],
-        J=J,
-        extra=extra,
-        history=history,
-        converged=converged,
-        iterations=iterations,
-        data={k: float(v) for k, v in data.items() if np.ndim(v) == 0},
-        sigma_used=sigma_used,
-        sigma_given=sigma is not None,
-        n_data=int(keep.sum()),
-        m=m,
-        g=g,
-        separation=separation,
-        y_sign=1.0,
-        used=keep,
-        times=raw[keep],
-        index=index,
-        missed=np.setdiff1d(np.arange(index.max() + 1), index),
-        dropped=np.flatnonzero(~keep),
-    )
+    options = with_impacts(problem.options, n_model)
+    problem = dataclasses.replace(problem, nuisance=nuisance, data=data, options=options)
+    problem = problem.masked(keep, number)
+    return dataclasses.replace(problem, law=tune_damping(problem, e0))
 
 
-def _fit_trajectory(
-    law,
-    free,
-    m,
-    g,
-    t,
-    y,
-    drag,
-    fit_drag,
-    length_scale,
-    y_axis,
-    sigma,
-    outlier_sigma,
-    max_iter,
-    tol,
-    options,
-    separation,
-):
-    log = []  # accepted steps of each fit
+def _fit_trajectory(problem: BounceProblem, t, y, length_scale, settings: Settings) -> BounceFit:
+    """Fits of a track `t` (s), `y` (y units): the nuisance alone first (the start can be
+    far in time), then the damping with it (if more is free), then everything, then
+    everything without the outliers of that fit."""
     t = np.asarray(t, dtype=float)
     y = np.asarray(y, dtype=float)
     if t.ndim != 1 or t.shape != y.shape or t.size < 8:
@@ -372,107 +352,68 @@ def _fit_trajectory(
     positions = np.flatnonzero(good)
     times_in_order(t[positions], "the times t of a trajectory")
     t, y = t[positions], y[positions]
-    y_sign = 1.0 if y_axis == "up" else -1.0
-    guess = _guess_trajectory(t, y_sign * y, g)
+    guess = _guess_trajectory(t, problem.y_sign * y, problem.g)
+    problem = _trajectory_problem(problem, t, y, guess, length_scale, settings)
+    keep_from = guess["release"]
+    tu, yu = t[keep_from:], y[keep_from:]
+    nuisance_only = np.arange(problem.size) >= len(problem.free)
+    stage = run_stage(problem, nuisance_only, max_iter=20, tol=1e-6)
+    problem = rebase(problem, stage.theta)
+    first = first_stage(problem)
+    if not first.all():
+        stage = settings.stage(problem, first, stage)
+        problem = rebase(problem, stage.theta)
+    stage = settings.stage(problem, np.ones(problem.size, dtype=bool), stage)
+    r = stage.residuals[: tu.size]
+    outliers = find_outliers(
+        r, np.ones(tu.size, dtype=bool), settings.outlier_sigma, settings.sigma_given
+    )
+    mask = ~outliers
+    if outliers.any():
+        problem, stage = _refit(problem, stage, settings, mask)
+    predicted = stage.chain["predicted"][: tu.size]
+    dropped = np.concatenate([positions[:keep_from], positions[keep_from:][outliers]]).astype(int)
+    fields = dict(t=tu[mask], y=yu[mask], y_fit=predicted[mask], dropped=np.sort(dropped))
+    return finish(problem, stage, Measurements(mask, settings.sigma_given, fields))
+
+
+def _trajectory_problem(
+    problem: BounceProblem, t, y, guess, length_scale, settings: Settings
+) -> BounceProblem:
+    """`problem` set up for the track `t` (s), `y` (y units) from the release on, from the
+    first look at it (`guess`, see `_guess_trajectory`): the nuisance, the data, the
+    model's size (enough contacts for the record: flights shrink as e^2 ... down to the
+    sample spacing) and the damping set so that the first impact's e is the guessed one."""
+    g = problem.g
     fit_scale = isinstance(length_scale, str)
     if fit_scale and length_scale != "fit":
         raise ValueError(f"length_scale must be a number, None or 'fit', got {length_scale!r}")
     scale0 = guess["scale"] if fit_scale else (1.0 if length_scale is None else float(length_scale))
-    v1 = guess["v1"] * guess["scale"] / scale0
-    if drag is not None:
-        v1 = min(v1, 0.9 * math.sqrt(g / drag))
-    keep_from = guess["release"]
-    used = np.arange(t.size) >= keep_from
+    v1 = settings.capped(guess["v1"] * guess["scale"] / scale0, g)
     dt = float(np.median(np.diff(t)))
-    tu, yu = t[used], y[used]
+    tu, yu = t[guess["release"] :], y[guess["release"] :]
     n_pad = round_up(tu.size, 64)
     span = float(np.ptp(yu)) or 1.0
-    sigma_used = float(sigma) if sigma is not None else 1e-3 * span
     nuisance = ("t_impact", "v_impact", "floor") + (("length_scale",) if fit_scale else ())
-    nuisance += ("drag",) if fit_drag else ()
-    # enough contacts for the record: flights shrink as e^2 ... down to the sample spacing
-    bounces = (
-        int(
-            np.ceil(
-                np.log(max(dt / (2 * guess["e"] * v1 / g), 1e-12)) / np.log(max(guess["e"], 0.05))
-            )
-        )
-        + 2
+    nuisance += ("drag",) if settings.fit_drag else ()
+    e = guess["e"]
+    bounces = int(np.ceil(np.log(max(dt / (2 * e * v1 / g), 1e-12)) / np.log(max(e, 0.05)))) + 2
+    data = dict(
+        t=np.pad(tu, (0, n_pad - tu.size), constant_values=tu[-1]),
+        y=np.pad(yu, (0, n_pad - tu.size), constant_values=yu[-1]),
+        sigma=np.asarray(float(settings.sigma) if settings.sigma_given else 1e-3 * span),
+        t1=np.asarray(guess["t1"]),
+        t_unit=np.asarray(dt),
+        v1=np.asarray(v1),
+        floor=np.asarray(problem.y_sign * guess["floor"]),
+        y_unit=np.asarray(0.01 * span),
+        scale=np.asarray(scale0),
+        t_end=np.asarray(float(tu[-1])),
+        min_flight=np.asarray(0.5 * dt),
     )
-    n_model = round_up(min(max(bounces, 2), 64), 8)
-
-    def data_for(mask, t1, v1_, floor, scale, drag_):
-        data = dict(
-            t=np.pad(tu, (0, n_pad - tu.size), constant_values=tu[-1]),
-            y=np.pad(yu, (0, n_pad - tu.size), constant_values=yu[-1]),
-            mask=np.pad(mask, (0, n_pad - tu.size)),
-            sigma=np.asarray(sigma_used),
-            t1=np.asarray(t1),
-            t_unit=np.asarray(dt),
-            v1=np.asarray(v1_),
-            floor=np.asarray(floor),
-            y_unit=np.asarray(0.01 * span),
-            scale=np.asarray(scale),
-            t_end=np.asarray(float(tu[-1])),
-            min_flight=np.asarray(0.5 * dt),
-        )
-        if drag_ is not None:
-            data["drag"] = np.asarray(float(drag_))
-        return data
-
-    opts = with_impacts(options, n_model)
-    mask = np.ones(tu.size, dtype=bool)
-    data = data_for(mask, guess["t1"], v1, y_sign * guess["floor"], scale0, drag)
-    problem = BounceProblem(law, free, nuisance, m, g, data, "trajectory", y_sign, opts)
-    problem = dataclasses.replace(problem, law=tune_damping(problem, guess["e"]))
-    n_theta = len(free) + len(nuisance)
-    # first the nuisance alone (the start can be far in time), then everything
-    nuisance_only = np.arange(n_theta) >= len(free)
-    result = run_stage(problem, nuisance_only, max_iter=20, tol=1e-6, log=log)
-    problem = rebase(problem, result.theta)
-    first = first_stage(problem.law, free, nuisance)
-    active = np.ones(n_theta, dtype=bool)
-    if not first.all():
-        result = run_stage(problem, first, max_iter=max_iter, tol=tol, log=log)
-        problem = rebase(problem, result.theta)
-    result = run_stage(problem, active, max_iter=max_iter, tol=tol, log=log)
-    r = result.residuals[: tu.size]
-    outliers = find_outliers(r, np.ones(tu.size, dtype=bool), outlier_sigma, sigma is not None)
-    if outliers.any():
-        problem = rebase(problem, result.theta)
-        mask = ~outliers
-        data = {**problem.data, "mask": np.pad(mask, (0, n_pad - tu.size))}
-        problem = dataclasses.replace(problem, data=data)
-        result = run_stage(problem, active, max_iter=max_iter, tol=tol, log=log)
-    law, data = problem.law, problem.data
-    theta, r, J, extra = result.theta, result.residuals, result.jacobian, result.extra
-    history, converged = result.history, result.converged
-    iterations = sum(log)
-    predicted = extra[2]["predicted"][: tu.size]
-    dropped = np.concatenate([positions[:keep_from], positions[keep_from:][outliers]]).astype(int)
-    return finish(
-        kind="trajectory",
-        law=law,
-        free=free,
-        nuisance_names=nuisance,
-        theta=theta,
-        r=r[: tu.size],
-        J=J,
-        extra=extra,
-        history=history,
-        converged=converged,
-        iterations=iterations,
-        data={k: float(v) for k, v in data.items() if np.ndim(v) == 0},
-        sigma_used=sigma_used,
-        sigma_given=sigma is not None,
-        n_data=int(mask.sum()),
-        m=m,
-        g=g,
-        separation=separation,
-        y_sign=y_sign,
-        used=mask,
-        t=tu[mask],
-        y=yu[mask],
-        y_fit=predicted[mask],
-        dropped=np.sort(dropped),
-    )
+    if settings.drag is not None:
+        data["drag"] = np.asarray(float(settings.drag))
+    options = with_impacts(problem.options, round_up(min(max(bounces, 2), 64), 8))
+    problem = dataclasses.replace(problem, nuisance=nuisance, data=data, options=options)
+    problem = problem.masked(np.ones(tu.size, dtype=bool))
+    return dataclasses.replace(problem, law=tune_damping(problem, e))
