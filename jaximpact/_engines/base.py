@@ -105,6 +105,11 @@ class AbstractEngine(abc.ABC):
     - `LAW`: the jaximpact law (its contact law family) the engine integrates.
     - `STEPPING`: how it steps, in words (what `stepper` replicates, or that it does not).
     - `CONTINUOUS_PLANT`: a time step of 0 runs a continuous, error-controlled plant.
+    - `NEAREST` (optional, default None: its `LAW` law): how the engine's nearest law to
+      one it lacks (a plastic or adhesive law) is named in an export's warning.
+
+    **Optional method**: `native(law)`, the engine (its own model) that exports `law`
+    where the engine has that law itself (LAMMPS's `jkr`), else None.
     """
 
     NAME: ClassVar[str]
@@ -116,6 +121,12 @@ class AbstractEngine(abc.ABC):
     LAW: ClassVar[str]
     STEPPING: ClassVar[str]
     CONTINUOUS_PLANT: ClassVar[bool]
+    NEAREST: ClassVar[str | None] = None
+
+    def native(self, law) -> "AbstractEngine | None":
+        """The engine's own model for `law` (a law of the table it has beyond its `LAW`
+        family), or None: it exports the family's law."""
+        return None
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)

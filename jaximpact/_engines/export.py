@@ -86,6 +86,8 @@ class Export:
       `T_range`: their extremes over those start phases (None for Drake's continuous plant).
     - `timestep` (s): the recommended (or given) step; `steps_per_contact`.
     - `target_e`, `target_T`: what was asked (the law's e and T at `v0`, or the targets).
+      With `v0=[...]` (a law the engine lacks): `v0` is the speeds' geometric middle,
+      `target_e` the middle of the law's e over them, `speeds` those given.
     - `law`: the engine's law as a jaximpact law, `separation`: its end of contact.
     - `speeds` (m/s), `e_engine`, `T_engine`, `e_target`, `T_target`: e(v) and T(v) that the
       engine realises (its time stepping included where it is replicated, as `e` is; else
@@ -195,6 +197,16 @@ def export(
     at `v0`. MuJoCo from targets alone (`law_or_fit` None) needs none: solref scales the
     contact per unit mass (the `Export`'s `m` is then None, its `law` per kg).
 
+    Laws with a contact state: a `jkr` law goes to LAMMPS's own `jkr` normal model
+    (`lammps_jkr`: its cohesion set so that LAMMPS takes the law's energy per impact, so
+    its e(v) is the law's at every speed, and its E for T at `v0`; a warning says how its
+    neck differs from JKR's). A `thornton` law (any engine), or a `jkr` law to an engine
+    without JKR, goes to the engine's nearest law, with a first warning line that says so
+    and how far that law's e(v) departs from the law's (worst |de|); `v0` may then be a
+    list of speeds (m/s): e is set to the middle of the law's e over them (a speed-free
+    e's best worst case), T to the law's at their geometric middle, and the report covers
+    those speeds.
+
     An export the engine cannot realise at `timestep` is refused: an `UnrealisedExport`
     (a `ValueError`) that names the step that would work (`.working`), or with `strict=False`
     a warning (also in `Export.warnings`) and the export anyway. It cannot realise it when a
@@ -208,8 +220,10 @@ def export(
     chosen = _engine(engine)
     geometry = chosen.geometry(geometry)
     m_given = m is not None
+    chosen, lacked = _native(chosen, None if law_or_fit is None else _law_of(law_or_fit))
+    v0, speeds = _speeds(v0, lacked, chosen)
     m, v0, timestep, poisson = _inputs(chosen, law_or_fit, m, v0, timestep, poisson)
-    source, target_e, target_T = _targets(law_or_fit, e=e, T=T, m=m, v0=v0)
+    source, target_e, target_T = _targets(law_or_fit, e=e, T=T, m=m, v0=v0, speeds=speeds)
     if target_T is not None:
         _check_scales(m, v0, target_T)
     if chosen.TWO_SPHERES:
@@ -239,12 +253,16 @@ def export(
     # mass m/2), or for the sphere on a wall (its own mass)
     engine_law = chosen.law(out.parameters, m)
     response = {}
-    if curves:
+    if curves or lacked:  # the nearest law's report needs its e(v)
         stepping = None if out.stepping is None else chosen.stepper(out.stepping, m=m,
                                                                     radius=radius)  # fmt: skip
         response, note = _responses(engine_law, chosen.effective_mass(m, geometry), out,
-                                    stepping, source, m=m, v0=v0)  # fmt: skip
-        warnings += [note] if note else []
+                                    stepping, source, m=m, v0=v0, speeds=speeds)  # fmt: skip
+        if lacked and (note or speeds is not None):
+            warnings.insert(0, _nearest(chosen, source, response, target_e,
+                                        fitted=speeds is not None, v0=v0))  # fmt: skip
+        else:
+            warnings += [note] if note else []
     return Export(
         engine=engine,
         scene=chosen.SCENES[geometry],
@@ -284,11 +302,13 @@ def _inputs(chosen: AbstractEngine, law_or_fit, m, v0, timestep, poisson):
     return m, v0, timestep, poisson
 
 
-def _targets(law_or_fit, *, e, T, m: float, v0: float):
+def _targets(law_or_fit, *, e, T, m: float, v0: float, speeds=None):
     """`(source, target_e, target_T)`: the law of `law_or_fit` (None with targets) and the e
     and T (s; None where not given) an export aims at: the targets `e` and `T`, checked, or
-    the law's e and T for mass `m` (kg) at `v0` (m/s); a one-line ValueError where neither
-    or both are given, or the law does not separate."""
+    the law's e and T for mass `m` (kg) at `v0` (m/s); with `speeds` (m/s, a law the engine
+    lacks), the middle of the law's e over them (the constant e nearest to it in the worst
+    case) and its T at `v0`. A one-line ValueError where neither or both are given, or the
+    law does not separate."""
     if law_or_fit is None:
         if e is None:
             raise ValueError("export needs a law or fit, or the target e= (and T=)")
@@ -298,19 +318,31 @@ def _targets(law_or_fit, *, e, T, m: float, v0: float):
     source = _law_of(law_or_fit)
     from .._solve.impact import impact
 
+    if speeds is not None:
+        es, _ = _curve(source, m, speeds, "force")
+        if not max(es) > 0:
+            raise ValueError("the law does not separate at any of these speeds: no engine target")
+        return source, 0.5 * (max(es) + min(es)), float(impact(source, m=m, v0=v0).T)
     result = impact(source, m=m, v0=v0)
     if int(result.status) != 0:
-        raise ValueError("the law does not separate at this m and v0 (e = 0): no engine target")
+        below = ""
+        if source.spec is not None and source.spec.captures:  # an adhesive law: jkr
+            below = f", below its sticking speed {float(source.sticking_speed(m)):.4g} m/s"
+        raise ValueError(
+            f"the law does not separate at this m and v0 (e = 0{below}): no engine target"
+        )
     return source, float(result.e), float(result.T)
 
 
-def _responses(engine_law, m_engine: float, out: Design, stepping, source, *, m, v0):
-    """`(fields, note)`: the `Export` fields `speeds` (m/s, `v0` times `_SPEED_FACTORS`),
+def _responses(engine_law, m_engine: float, out: Design, stepping, source, *, m, v0,
+               speeds=None):  # fmt: skip
+    """`(fields, note)`: the `Export` fields `speeds` (m/s, `v0` times `_SPEED_FACTORS`, or
+    the `speeds` given),
     `e_engine`, `T_engine` (what the engine realises: its `stepping`'s mean over first-touch
     phases where it is replicated, else its continuous law `engine_law` on mass `m_engine`,
     kg) and `e_target`, `T_target` (the `source` law's on mass `m`; None from targets), and a
     warning where the two e(v) part by more than 0.02 (else None)."""
-    speeds = tuple(v0 * f for f in _SPEED_FACTORS)
+    speeds = tuple(v0 * f for f in _SPEED_FACTORS) if speeds is None else tuple(speeds)
     if stepping is None:  # the continuous plant, or a stepper not replicated (Chrono)
         e_engine, T_engine = _curve(engine_law, m_engine, speeds, out.separation)
     else:  # what the engine's stepping realises: the mean over first-touch phases
@@ -328,6 +360,64 @@ def _responses(engine_law, m_engine: float, out: Design, stepping, source, *, m,
     return fields, (
         f"the engine's e(v) departs from the law's by up to {spread:.3f} between "
         f"{speeds[0]:.3g} and {speeds[-1]:.3g} m/s: the export is exact at v0 only"
+    )
+
+
+def _native(chosen: AbstractEngine, source):
+    """`(engine, lacked)`: the engine that exports the law `source` (None: targets), its own
+    model for it where it has one (an engine's `native(law)`: LAMMPS's `jkr` for a `jkr`
+    law), and whether it lacks the law, a plastic or adhesive one (`LawSpec.kind`:
+    Thornton's, JKR's), so that the export goes to its nearest law (`_nearest` says so
+    where their e(v) part)."""
+    if source is None:
+        return chosen, False
+    own = chosen.native(source)
+    if own is not None:
+        return own, False
+    kind = "viscoelastic" if source.spec is None else source.spec.kind
+    return chosen, kind != "viscoelastic" and chosen.LAW != source.name
+
+
+def _speeds(v0, lacked, chosen: AbstractEngine):
+    """`(v0, speeds)`: a speed (m/s) as given, with None; or from a sequence of speeds (for
+    a law the engine lacks), their geometric middle and the speeds, sorted. One-line
+    ValueErrors."""
+    if isinstance(v0, str) or np.ndim(v0) == 0:
+        return v0, None
+    if not lacked:
+        raise ValueError(
+            f"v0 must be one speed (m/s) for this law and {chosen.LABEL}; a list of speeds "
+            "is for a law with a contact state the engine lacks (thornton; jkr but for "
+            "LAMMPS), whose nearest engine law is then set over them"
+        )
+    speeds = sorted(check_positive("v0", v, "m/s") for v in np.ravel(v0))
+    if len(speeds) < 2 or speeds[0] == speeds[-1]:
+        raise ValueError("give two or more different speeds in v0=[...] (m/s), or one speed")
+    return float(np.sqrt(speeds[0] * speeds[-1])), tuple(speeds)
+
+
+def _nearest(chosen: AbstractEngine, source, fields: dict, target_e: float, *, fitted: bool,
+             v0: float) -> str:  # fmt: skip
+    """The one line for a law with a contact state (`source`) that engine `chosen` does not
+    have: the nearest law it has (its `NEAREST`, else its `LAW`), how it was set (`fitted`:
+    the middle of the law's e over the speeds given, else e and T at `v0`), and the worst
+    |e_engine - e_law| over `fields`' speeds."""
+    speeds, mine, law = fields["speeds"], fields["e_engine"], fields["e_target"]
+    gaps = [abs(a - b) for a, b in zip(mine, law, strict=True)]
+    worst = int(np.argmax(gaps))
+    nearest = chosen.NEAREST or f"its {chosen.LAW} law"
+    lacked = f"{source.name} law ({source.spec.equation}; e(v) from a contact state)"
+    how = (
+        f"set to e = {target_e:.3g} (the middle of the law's {min(law):.3g} to "
+        f"{max(law):.3g}) and the law's T at {v0:.3g} m/s"
+        if fitted
+        else f"set to the law's e and T at v0 = {v0:.3g} m/s"
+    )
+    tail = "" if fitted else "; pass v0=[...] (m/s) to fit e over the speeds you need"
+    return (
+        f"{chosen.LABEL} has no {lacked}; the nearest is {nearest}, {how}: from "
+        f"{speeds[0]:.3g} to {speeds[-1]:.3g} m/s its e departs from the law's by up to "
+        f"{gaps[worst]:.3g} (|de| at {speeds[worst]:.3g} m/s){tail}"
     )
 
 

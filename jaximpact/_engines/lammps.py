@@ -13,13 +13,16 @@ attractive total force (`separation="force"`): the realised e is then higher tha
 coefficient given, and never below about 0.14 (e(coefficient -> 0)); the export inverts that.
 `fix nve/sphere` is velocity Verlet, the force taking the half-step velocity:
 `_stepping.velocity_verlet` replicates it.
+
+A `jkr` law goes to LAMMPS's `jkr` normal model instead (`native`; `lammps_jkr`), and
+parameters with a `cohesion` are that model's in `response`, `stepper`, `snippet`.
 """
 
 import math
 
 import numpy as np
 
-from . import _stepping
+from . import _stepping, lammps_jkr
 from .base import AbstractEngine, Design, Key, Stepping
 from .materials import check_poisson, check_positive, check_restitution, hertz_stiffness
 
@@ -148,6 +151,12 @@ class Lammps(AbstractEngine):
     )
     LAW = "tsuji"
     STEPPING = "with a timestep, fix nve/sphere's velocity Verlet: replicated"
+    # the law that an export of a law with a contact state LAMMPS lacks (thornton) goes to
+    # (export's `_nearest`)
+    NEAREST = (
+        "hertz/material with damping coeff_restitution (law tsuji, e the same at every "
+        "speed; LAMMPS's mdr normal model is elastic-plastic, but another law, not exported)"
+    )
     CONTINUOUS_PLANT = False
 
     def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
@@ -206,19 +215,38 @@ class Lammps(AbstractEngine):
             stepping=stepping,
         )
 
+    def native(self, law) -> AbstractEngine | None:
+        """The engine for a law LAMMPS has as its own normal model rather than the Hertz
+        design: `lammps_jkr.LammpsJKR` for a `jkr` law, else None."""
+        return _JKR if law.name == _JKR.LAW else None
+
+    def law(self, parameters, m):
+        """`tsuji`, or with a `cohesion` in `parameters` the `jkr` law of `LammpsJKR`."""
+        if "cohesion" in parameters:
+            return _JKR.law(parameters, m)
+        return super().law(parameters, m)
+
     def law_parameters(self, parameters, m):
         """`tsuji`'s `c` = k (N/m^1.5) and `b` (N s/m^1.25) between the two spheres
         (effective mass `m/2`), or of the sphere on the wall."""
+        if "cohesion" in parameters:
+            return _JKR.law_parameters(parameters, m)
         return {"c": parameters["k"], "b": parameters["b"]}
 
     def response(self, parameters, *, m, radius=None):
         """`(law, separation)` that `parameters` (`E`, `coeff_restitution`, `poisson`,
-        `limit_damping`) give two spheres of mass `m` (kg) and radius `radius` (m)."""
+        `limit_damping`) give two spheres of mass `m` (kg) and radius `radius` (m); with a
+        `cohesion` (J/m^2), the `jkr` model's (`lammps_jkr.LammpsJKR.response`)."""
+        if "cohesion" in parameters:
+            return _JKR.response(parameters, m=m, radius=radius)
         clamped = bool(parameters.get("limit_damping", False))
         return tsuji_response(self, parameters, m=m, radius=radius, clamped=clamped)
 
     def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
-        """Velocity Verlet at `parameters["timestep"]` (s), or None without one."""
+        """Velocity Verlet at `parameters["timestep"]` (s), or None without one (with a
+        `cohesion`: the `jkr` model's, `lammps_jkr.replica`)."""
+        if "cohesion" in parameters:
+            return _JKR.stepper(parameters, m=m, radius=radius)
         if parameters.get("timestep") is None:
             return None
         h = check_positive("timestep", parameters["timestep"], "s")
@@ -233,6 +261,8 @@ class Lammps(AbstractEngine):
         return Stepping(h, lambda v: replica(stepping, m, v))
 
     def snippet(self, parameters) -> str:
+        if "cohesion" in parameters:
+            return _JKR.snippet(parameters)
         return "\n".join(
             [
                 "units si",
@@ -245,3 +275,6 @@ class Lammps(AbstractEngine):
                 parameters["timestep"],
             ]
         )
+
+
+_JKR = lammps_jkr.LammpsJKR()

@@ -54,7 +54,9 @@ class LawSpec:
     with a `captured` impact, not an error. `geometry`: parameters that are the bodies'
     geometry (a radius), which the user gives and no fit frees or guesses. `start`: the
     row's own start for a fit, `start(m, v0, e, T) -> params` (SI; `T` may be None), where
-    the family's (an undamped contact time and a damping ratio) does not apply.
+    the family's (an undamped contact time and a damping ratio) does not apply. `kind`:
+    what makes `e` fall, `"viscoelastic"` (damping), `"plastic"` (a yield) or `"adhesive"`
+    (a neck): an engine without the law exports its nearest one, and says so.
     """
 
     name: str
@@ -82,6 +84,7 @@ class LawSpec:
     captures: bool = False
     geometry: tuple[str, ...] = ()
     start: Callable | None = None
+    kind: str = "viscoelastic"
 
     def __post_init__(self):
         if (self.coefficients is None) == (self.state is None):

@@ -310,4 +310,5 @@ JKR = LawSpec(
     captures=True,  # below the sticking speed: e = 0, captured
     geometry=("R",),  # the radius is the user's, never fitted nor guessed
     start=jkr_start,
+    kind="adhesive",
 )

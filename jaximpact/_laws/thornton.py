@@ -253,4 +253,5 @@ THORNTON = LawSpec(
     map_range=(1e-5, 5e-3),
     closed_form=thornton_closed_form,
     start=thornton_start,
+    kind="plastic",
 )

@@ -424,3 +424,74 @@ def run_yade(parameters, *, m, v0, radius, phases=(0.5,), damping=0.0, executabl
         es.append(e)
         Ts.append(T)
     return np.array(es), np.array(Ts)
+
+
+def run_lammps_jkr(parameters, *, m, v0, radius, phases=(0.5,)):
+    """Run LAMMPS on an export to its `jkr` normal model (`parameters` of
+    `export(law("jkr", ...), "lammps", ...)`): two spheres (mass `m` kg, radius `radius` m
+    each, head-on at relative speed `v0` m/s), or with `parameters["geometry"] == "wall"` one
+    such sphere on the exported `fix wall/gran` (the plane z = 0). Returns arrays `(e, T)`:
+    T (s) the number of steps with a non-zero contact force times the step, to the neck's
+    breaking; where the neck holds the body (below the sticking speed, no damping: it would
+    oscillate for ever), `e = 0` and T the steps until it turns back in."""
+    lmp_class = load_lammps()
+    h = parameters["timestep_s"]
+    wall = parameters.get("geometry", "spheres") == "wall"
+    rho = m / (4.0 / 3.0 * math.pi * radius**3)
+    es, Ts = [], []
+    for phase in map(float, phases):
+        lmp = lmp_class(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+        gap = v0 * h * phase
+        box = 10 * radius
+        if wall:  # the sphere above the wall z = 0, first touch `gap` away
+            atoms = f"""create_atoms 1 single 0 0 {radius + gap!r}
+set atom * diameter {2 * radius!r}
+set atom * density {rho!r}
+velocity all set 0 0 0
+set atom 1 vz {-v0!r}"""
+        else:
+            atoms = f"""create_atoms 1 single {-radius - gap / 2!r} 0 0
+create_atoms 1 single {radius + gap / 2!r} 0 0
+set atom * diameter {2 * radius!r}
+set atom * density {rho!r}
+velocity all set 0 0 0
+set atom 1 vx {v0 / 2!r}
+set atom 2 vx {-v0 / 2!r}"""
+        script = f"""units si
+atom_style sphere
+atom_modify map array
+boundary f f f
+comm_modify vel yes
+region box block {-box} {box} {-box} {box} {-box} {box}
+create_box 1 box
+{atoms}
+{parameters["pair_style"]}
+{parameters["pair_coeff"]}
+{parameters.get("fix_wall", "") if wall else ""}
+neighbor {0.5 * radius!r} bin
+neigh_modify every 1 delay 0 check no
+fix 1 all nve/sphere
+{parameters["timestep"]}
+run 0 post no"""
+        for line in script.splitlines():
+            if line.strip():
+                lmp.command(line)
+        axis = 2 if wall else 0
+        steps, started, leaving, captured = 0, False, False, False
+        for _ in range(10_000_000):
+            lmp.command("run 1 pre no post no")
+            v = lmp.numpy.extract_atom("v")
+            approach = -v[0, 2] if wall else v[0, 0] - v[1, 0]
+            if lmp.numpy.extract_atom("f")[0, axis] != 0.0:
+                if leaving and approach > 0.0:  # held by the neck: turned back in
+                    captured = True
+                    break
+                steps += 1
+                started = True
+                leaving |= approach < 0.0
+            elif started:
+                break
+        es.append(0.0 if captured else -approach / v0)
+        Ts.append(steps * h)
+        lmp.close()
+    return np.array(es), np.array(Ts)

