@@ -113,7 +113,7 @@ def test_the_impact_depends_on_v0_over_the_yield_speed_alone():
     )
 
 
-@pytest.mark.parametrize("method", ["auto", "integrate"])
+@pytest.mark.parametrize("method", ["auto", pytest.param("integrate", marks=pytest.mark.slow)])
 @pytest.mark.parametrize("ratio", [1.05, 20.0])  # just above the yield speed, and well above
 def test_gradients_match_central_differences(method, ratio):
     v0 = ratio * V_Y
