@@ -30,6 +30,7 @@ _PUBLIC = {
     "TqdmMeter": "_progress",
     # one impact
     "ImpactResult": "_solve.results",
+    "ImpactOptions": "_solve.options",
     "impact": "_solve.impact",
     "Status": "_status",
     # one drop
@@ -47,11 +48,11 @@ _PUBLIC = {
     "read_recording": "_fit.recordings",
     "starting_law": "_fit.model_choice",
     # many impacts
-    "impact_batch": "_batch",
+    "impact_batch": "_jobs",
     "run_batch": "_batch",
     "write_table": "_batch",
-    "batch_file": "_batch.files",
-    "BatchFile": "_batch.files",
+    "batch_file": "_jobs",
+    "BatchFile": "_jobs",
     # studies
     "bumper_design": "_studies.bumper",
     "drop_design": "_studies.drop",

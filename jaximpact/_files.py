@@ -11,7 +11,7 @@ into place only when the writing finished: a run stopped at any instant (an erro
 Ctrl-C, SIGTERM) leaves the final name as it was, the old file or none.
 
 `read_csv` reads a small CSV file whole (`calibrate --data`, recordings); the tables of
-`batch` stream in chunks through `_batch.readers` instead.
+`batch` stream in chunks through `_jobs.readers` instead.
 """
 
 import contextlib

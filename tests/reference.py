@@ -174,7 +174,8 @@ def _solve(name, params, m, v0, separation, g, rtol):
 
 def reference_impact(name: str, params: dict, *, m: float, v0: float,
                      separation: str = "force", g: float = 0.0, rtol: float = 1e-12) -> dict:
-    """returns dict(e=..., T=..., x_max=..., t_max=..., F_max=..., status="separated"|"stuck"|"captured")"""
+    """returns dict(e=..., T=..., x_max=..., t_max=..., F_max=...,
+    status="separated"|"stuck"|"captured")"""
     return _solve(name, params, m, v0, separation, g, rtol)[0]
 
 

@@ -1,12 +1,17 @@
 """`impact_batch`: many impacts of one law from rows of parameters, masses, speeds and
-gravities, through `run_batch`, on the closed-form, curves or integrated path chosen once
-for the batch; a cost key (the dimensionless groups that fix an impact's step count) orders
-the integrated rows so that each chunk holds members of similar cost.
+gravities, arrays in and arrays out. The rows are checked once (`prepare_rows`), then
+`run_impacts` computes them through `run_batch` with no further check, on the path that
+`choose_path` decides once for the batch (`solve_impact` per row); a cost key (the
+dimensionless groups that fix an impact's step count) orders the integrated rows so that
+each chunk holds members of similar cost. Files of rows are `_jobs`'.
 """
 
 import functools
+import os
+import sys
 import warnings
 from collections.abc import Mapping
+from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
@@ -16,7 +21,17 @@ from .._checks import check_nonnegative, check_positive, invalid_entries
 from .._laws import LAW_NAMES, LAWS, AbstractLaw, CustomLaw, custom_law, law as make_law
 from .._laws.named_law import invalid_parameter_rows, table_law
 from .._progress import AbstractMeter
-from .._solve.impact import CURVES_RTOL, impact, similarity_reason
+from .._solve.impact import check_custom_law, solve_impact
+from .._solve.options import (
+    CUSTOM_RTOL,
+    DEFAULT_RTOL,
+    METHODS,
+    SEPARATIONS,
+    check_options,
+    choose_path,
+    make_options,
+)
+from .._solve.precision import resolvable_tolerances
 from .._status import Status
 from .runner import run_batch
 
@@ -65,15 +80,16 @@ def build_law(skeleton, params):
 
 
 @functools.lru_cache(maxsize=64)
-def _impact_member(skeleton, fields: tuple, options: tuple):
-    """One row -> the requested `ImpactResult` fields; cached per law structure and options,
-    so every batch of the same kind reuses one compiled program per block shape. A row
-    without `g` passes `g=0.0` as a number (so that `impact` may take a closed form)."""
-    keywords = dict(options)
+def _impact_member(skeleton, fields: tuple, options, gravity: bool):
+    """One checked row -> the requested `ImpactResult` fields of `solve_impact` with the
+    batch's `options` (an `ImpactOptions`); cached per law structure and options, so every
+    batch of the same kind reuses one compiled program per block shape. A batch without
+    gravity has no `g` in its rows: `g` is then the constant 0."""
 
     def member(row):
         law = build_law(skeleton, row["params"])
-        result = impact(law, m=row["m"], v0=row["v0"], g=row.get("g", 0.0), **keywords)
+        g = row["g"] if gravity else jnp.asarray(0.0, dtype=float)
+        result = solve_impact(law, row["m"], row["v0"], g, None, options)
         return {name: getattr(result, name) for name in fields if getattr(result, name) is not None}
 
     return member
@@ -110,7 +126,12 @@ def cost_key(skeleton, params, m, v0, g):
 def _fix_shape(skeleton, params):
     """Move a table law's shape parameters (Hunt-Crossley's `n`, the power law's `n` and
     `p`) into the skeleton as numbers when they are the same on every row, so that the
-    rows can be read off the universal curves (which need the shape as numbers)."""
+    rows can be read off the universal curves (which need the shape as numbers).
+
+    `build_law` makes them `jnp` constants, which a trace sees as traced values (JAX
+    0.10): such rows are integrated today, and said to be (`_member_path`); keeping them
+    numpy numbers would read them off the curves, a change of results left to its own
+    issue."""
     if skeleton[0] != "law" or not LAWS[skeleton[1]].shape_parameters:
         return skeleton, params
     shape = LAWS[skeleton[1]].shape_parameters
@@ -120,24 +141,24 @@ def _fix_shape(skeleton, params):
     return (*skeleton, fixed), {k: v for k, v in params.items() if k not in shape}
 
 
-def batch_path(
-    law, separation, *, method="auto", rtol=1e-11, g_is_zero=True, **impact_options
-) -> str:
-    """The path every row of a batch of `law`'s impacts takes: `"closed_form"`,
-    `"similarity"` (the universal curves) or `"integrated"` (the same choice as `impact`'s
-    `method="auto"`, made once for the batch)."""
-    closed = law.closed_form(separation, g_is_zero=g_is_zero)
-    if method != "integrate" and closed is not None:
-        return "closed_form"
-    if (
-        g_is_zero
-        and method in ("auto", "similarity")
-        and rtol >= CURVES_RTOL
-        and "solver" not in impact_options
-        and similarity_reason(law, separation) is None
-    ):
-        return "similarity"
-    return "integrated"
+# a batch's `path` per row: on the gravity table, "integrated" (the batch does not tell the
+# rows the table served from those it integrated)
+_LABELS = {"gravity_table": "integrated"}
+# the keywords of `impact` that a batch passes on (beyond separation, method, rtol, peaks)
+IMPACT_OPTIONS = ("solver", "atol", "max_steps", "tau_max", "rest_tol", "adjoint")
+
+
+def batch_path(law, separation, *, method="auto", rtol=1e-11, g=0.0, **impact_options) -> str:
+    """The `path` that a batch of impacts of `law` (with its parameters, those of one row)
+    reports: `"closed_form"`, `"similarity"` (the universal curves) or `"integrated"`, as
+    `run_impacts` decides it (`choose_path` for the law as the batch's members see it; `g`
+    an array: gravity given per row)."""
+    params = {k: np.atleast_1d(np.asarray(v, dtype=float)) for k, v in law.parameters.items()}
+    skeleton, params = _fix_shape(_law_skeleton(law), params)
+    gravity = not (isinstance(g, (int, float)) and g == 0)
+    path = _member_path(skeleton, params, gravity, separation=separation, method=method,
+                        solver=impact_options.get("solver"), rtol=rtol)  # fmt: skip
+    return _LABELS.get(path.name, path.name)
 
 
 def prepare_rows(law, params, *, m, v0, g=0.0, invalid: str = "raise"):
@@ -148,7 +169,9 @@ def prepare_rows(law, params, *, m, v0, g=0.0, invalid: str = "raise"):
     arrays broadcast), and the rows whose values were refused. `invalid="raise"`: a one-line
     `ValueError` naming the first bad value (`bad` is all False); `"mark"`: bad rows are
     filled with a good row's values (so that the batch runs) and flagged in `bad`; a batch
-    with no good row still raises.
+    with no good row still raises. Every row's values are checked once: by the law's own
+    checks (`"raise"`), or row by row (`"mark"`, the names then by the law built from one
+    row); `run_impacts` checks nothing again.
     """
     if invalid not in ("raise", "mark"):
         raise ValueError(f"invalid must be 'raise' or 'mark', got {invalid!r}")
@@ -178,21 +201,34 @@ def prepare_rows(law, params, *, m, v0, g=0.0, invalid: str = "raise"):
     bad = np.zeros(kinematics["m"].shape, bool)
     if invalid == "mark":
         bad = _invalid_rows(skeleton, arrays, kinematics)
-        if bad.any() and not bad.all():
-            good = int(np.argmin(bad))
-            arrays = {k: np.where(bad, v[good], v) for k, v in arrays.items()}
-            kinematics = {k: np.where(bad, v[good], v) for k, v in kinematics.items()}
+    if invalid == "raise" or bad.all():  # the law's and the kinematics' own one-line errors
+        _check_all(skeleton, arrays, kinematics)
+        return skeleton, arrays, kinematics, bad
+    if bad.any():
+        good = int(np.argmin(bad))
+        arrays = {k: np.where(bad, v[good], v) for k, v in arrays.items()}
+        kinematics = {k: np.where(bad, v[good], v) for k, v in kinematics.items()}
+    _law_of(skeleton, {k: v[:1] for k, v in arrays.items()})  # the names: unknown, missing
+    return skeleton, arrays, kinematics, bad
+
+
+def _law_of(skeleton, params):
+    """The law of `skeleton` built from `params` by the law's own checks (names, values)."""
     if skeleton[0] == "law":
-        make_law(skeleton[1], **arrays)
-    else:
-        custom_law(skeleton[1], **arrays)
+        return make_law(skeleton[1], **params)
+    return custom_law(skeleton[1], **params)
+
+
+def _check_all(skeleton, params, kinematics):
+    """Every value of a batch by the checks of the law and of `impact`: a one-line
+    `ValueError` naming the first bad one."""
+    _law_of(skeleton, params)
     for key, what, unit, positive in (
         ("m", "mass m", "kg", True),
         ("v0", "impact speed v0", "m/s", True),
         ("g", "gravity g", "m/s^2", False),
     ):
         (check_positive if positive else check_nonnegative)(what, kinematics[key], unit)
-    return skeleton, arrays, kinematics, bad
 
 
 def _not_representable(out: dict) -> np.ndarray:
@@ -221,9 +257,129 @@ def _invalid_rows(skeleton, params, kinematics) -> np.ndarray:
     return bad | invalid_entries(kinematics["g"], lambda a: a < 0)
 
 
+class Impacts(NamedTuple):
+    """What `run_impacts` computed: `out` (field -> one value per row), `lost` (the rows
+    whose results float64 cannot hold) and `path`, the way every row went (`batch_path`)."""
+
+    out: dict
+    lost: np.ndarray
+    path: str
+
+
+def run_impacts(
+    skeleton,
+    params: dict,
+    kinematics: dict,
+    *,
+    separation: str = "force",
+    method: str = "auto",
+    rtol: float | None = 1e-11,
+    peaks: bool = True,
+    fields: tuple = IMPACT_FIELDS,
+    order: str = "cost",
+    chunk_size: int | None = None,
+    progress: bool | AbstractMeter = True,
+    devices=None,
+    exact: bool = True,
+    **impact_options,
+) -> Impacts:
+    """The impacts of rows already checked (`prepare_rows`, or a table's row checks): the
+    law's structure `skeleton`, its `params` and `kinematics` (`m`, `v0`, `g`) as 1-D
+    arrays of one length. No value is checked here; the options are (`impact`'s errors),
+    and the path is chosen once for the batch (`choose_path`). Arguments as in
+    `impact_batch`."""
+    unknown = sorted(set(impact_options) - set(IMPACT_OPTIONS))
+    if unknown:
+        raise TypeError(
+            f"impact_batch got an unexpected keyword argument {unknown[0]!r}; its options "
+            f"for each impact are {', '.join(IMPACT_OPTIONS)} (see jaximpact.impact)"
+        )
+    if separation not in SEPARATIONS:
+        raise ValueError(f"separation must be one of {SEPARATIONS}, got {separation!r}")
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    if rtol is None:
+        rtol = DEFAULT_RTOL if skeleton[0] == "law" else CUSTOM_RTOL
+    limits = dict(max_steps=4096, tau_max=1e4, rest_tol=1e-7, atol=None)
+    limits.update({k: v for k, v in impact_options.items() if k in limits})
+    check_options(rtol=rtol, **limits)
+    skeleton, params = _fix_shape(skeleton, params)
+    gravity = not bool(np.all(kinematics["g"] == 0.0))
+    rows = {"params": params, "m": kinematics["m"], "v0": kinematics["v0"]}
+    if gravity:
+        rows["g"] = kinematics["g"]
+    solver = impact_options.get("solver")
+    path = _member_path(skeleton, params, gravity, separation=separation, method=method,
+                        solver=solver, rtol=rtol)  # fmt: skip
+    atol = rtol if limits["atol"] is None else limits["atol"]
+    rtol, atol, rest_tol = resolvable_tolerances(rtol, atol, limits["rest_tol"])
+    options = make_options(
+        path,
+        separation=separation,
+        rtol=rtol,
+        atol=atol,
+        rest_tol=rest_tol,
+        solver=solver,
+        adjoint=impact_options.get("adjoint"),
+        max_steps=limits["max_steps"],
+        tau_max=limits["tau_max"],
+        peaks=peaks,
+    )
+    try:
+        member = _impact_member(skeleton, tuple(fields), options, gravity)
+    except TypeError:  # an option that cannot be hashed (an array): compiled for this call
+        member = _impact_member.__wrapped__(skeleton, tuple(fields), options, gravity)
+    cost = None
+    if order == "cost" and path.integrates:
+        cost = cost_key(skeleton, params, **kinematics)
+    label = skeleton[1] if skeleton[0] == "law" else "custom law"
+    out = run_batch(
+        member,
+        rows,
+        chunk_size=(1024 if path.integrates else 65536) if chunk_size is None else chunk_size,
+        progress=progress,
+        devices=devices,
+        cost=cost,
+        exact=exact,
+        description=f"impacts ({label})",
+    )
+    out = {name: out[name] for name in fields if name in out}
+    return Impacts(out, _not_representable(out), _LABELS.get(path.name, path.name))
+
+
+def _member_path(skeleton, params, gravity: bool, **choice):
+    """`choose_path` for the law as every member of the batch sees it (one row, its
+    parameters traced values, the shape that `_fix_shape` fixed as numbers), and a user's
+    force function tried (`check_custom_law`): once for the batch, with no numbers."""
+    decided = []
+
+    def member(row):
+        law = build_law(skeleton, row["params"])
+        check_custom_law(law, row["v0"])
+        decided.append(choose_path(law, g=row["g"] if gravity else 0.0, **choice))
+        return row["v0"]
+
+    row = {"params": {k: v[0] for k, v in params.items()}, "v0": 1.0, "g": 1.0}
+    jax.eval_shape(member, row)
+    return decided[0]
+
+
+def mark_invalid(out: dict, rows: np.ndarray) -> dict:
+    """`out` with `rows` given status `Status.invalid` and NaN results."""
+    marked = {}
+    for name, values in out.items():
+        if name == "status":
+            marked[name] = np.where(rows, int(Status.invalid), values)
+        elif np.issubdtype(values.dtype, np.floating):
+            marked[name] = np.where(rows, np.nan, values)
+        else:
+            marked[name] = values
+    return marked
+
+
 def impact_batch(
     law,
-    params: dict | None = None,
+    params: Mapping | None = None,
     *,
     m=None,
     v0=None,
@@ -239,53 +395,16 @@ def impact_batch(
     devices=None,
     exact: bool = True,
     invalid: str = "mark",
-    out=None,
     **impact_options,
 ) -> dict[str, np.ndarray]:
-    """Impacts of many bodies at once: `impact` over a batch, in chunks, on all local devices.
-
-    - `law`: a law name of `LAW_NAMES` (then `params` must hold all its parameters), or a
-      law from `jaximpact.law` / `custom_law` whose parameters `params` may replace.
-    - `params`: parameter name -> number or 1-D array (SI units, as in `jaximpact.law`).
-    - `m` (kg), `v0` (m/s), `g` (m/s^2, along the inward normal): numbers or 1-D arrays.
-      Every array is broadcast against the others: `n` rows.
-    - `separation`, `method`, `rtol`, `peaks` and `impact_options` (`solver`, `atol`,
-      `max_steps`, `tau_max`, `rest_tol`): as in `jaximpact.impact`.
-    - `fields`: which `ImpactResult` fields to return (default `e, T, x_max, F_max, status`);
-      with `peaks=False` the peak fields are left out.
-    - `order`: `"cost"` (default) runs the rows sorted by their dimensionless groups (which
-      fix the step count; see `run_batch`) and returns them in the given order; `"given"`
-      runs them as given.
-    - `chunk_size`: rows per device per compiled call (default 1024 for integrated impacts,
-      65536 for closed forms and the universal curves, which cost little per row);
-      `progress`, `devices`, `exact`: as
-      in `run_batch`.
-
-    - `invalid`: what a row with invalid inputs (NaN, infinite, a mass, speed or stiffness
-      <= 0, a negative damping) does: `"mark"` (default) gives it status `Status.invalid`
-      and NaN results, with a warning, while the other rows run; `"raise"` refuses the
-      batch with a `ValueError` naming the first bad value.
-
-    Returns a dict of numpy arrays of length `n` (`status` as integers of `Status`).
-    Inputs are checked once for the whole batch, before any work.
-
-    Streaming, as `jaximpact batch` does: with `params` an iterable of chunks (mappings
-    column -> array, each holding any of the law's parameters and `m`, `v0`, `g`,
-    `separation`; a generator is read once) and `out` a CSV or Parquet path, each chunk is
-    computed and written as it comes, and a `BatchFile` record is returned (see
-    `batch_file`; `resume=True` reuses the chunks an interrupted run finished). `law` must
-    then be a name.
-
-    **Example**:
-    ```python
-    out = impact_batch("hertz_rate", {"c": 2e6, "b1": np.linspace(100, 2000, 10_000)},
-                       m=1.0, v0=2.5)
-    out["e"], out["T"]
-    ```
-    """
-    if out is not None or not (params is None or isinstance(params, Mapping)):
-        return _stream(law, params, out, m=m, v0=v0, g=g, separation=separation,
-                       method=method, rtol=rtol, progress=progress, **impact_options)  # fmt: skip
+    """Impacts of many bodies at once, arrays in and arrays out: the computation behind
+    `jaximpact.impact_batch` (whose docstring has every argument), without its chunks and
+    files (`_jobs`). Returns a dict of numpy arrays, one value per row."""
+    if params is not None and not isinstance(params, Mapping):
+        raise TypeError(
+            "params must be a mapping name -> number or 1-D array; chunks with out= are "
+            "jaximpact.impact_batch's"
+        )
     if m is None or v0 is None:
         raise ValueError("impact_batch needs m= (kg) and v0= (m/s): numbers or 1-D arrays")
     if order not in ("cost", "given"):
@@ -296,37 +415,23 @@ def impact_batch(
     skeleton, law_params, kinematics, bad = prepare_rows(
         law, params, m=m, v0=v0, g=g, invalid=invalid
     )
-    skeleton, law_params = _fix_shape(skeleton, law_params)
-    zero_gravity = bool(np.all(kinematics["g"] == 0.0))
-    rows = {"params": law_params, "m": kinematics["m"], "v0": kinematics["v0"]}
-    if not zero_gravity:
-        rows["g"] = kinematics["g"]
-    options = dict(separation=separation, method=method, rtol=rtol, peaks=peaks, **impact_options)
-    try:
-        member = _impact_member(skeleton, tuple(fields), tuple(sorted(options.items())))
-    except TypeError:  # an option that cannot be hashed (an array): compiled for this call
-        member = _impact_member.__wrapped__(skeleton, tuple(fields), tuple(options.items()))
-    cost = None
-    first = build_law(skeleton, {k: v[:1] for k, v in law_params.items()})
-    path = batch_path(
-        first, separation, method=method, rtol=rtol, g_is_zero=zero_gravity, **impact_options
-    )
-    closed = path != "integrated"
-    if order == "cost" and not closed:
-        cost = cost_key(skeleton, law_params, **kinematics)
-    label = skeleton[1] if skeleton[0] == "law" else "custom law"
-    out = run_batch(
-        member,
-        rows,
-        chunk_size=(65536 if closed else 1024) if chunk_size is None else chunk_size,
+    done = run_impacts(
+        skeleton,
+        law_params,
+        kinematics,
+        separation=separation,
+        method=method,
+        rtol=rtol,
+        peaks=peaks,
+        fields=fields,
+        order=order,
+        chunk_size=chunk_size,
         progress=progress,
         devices=devices,
-        cost=cost,
         exact=exact,
-        description=f"impacts ({label})",
+        **impact_options,
     )
-    out = {name: out[name] for name in fields if name in out}
-    lost = _not_representable(out) & ~bad
+    lost = done.lost & ~bad
     if lost.any():
         first = int(np.argmax(lost))
         message = (
@@ -336,7 +441,8 @@ def impact_batch(
         if invalid == "raise":
             raise ValueError(f"{message}: express the inputs in other units")
         warnings.warn(
-            f"{message}: their status is Status.invalid and their results NaN", stacklevel=2
+            f"{message}: their status is Status.invalid and their results NaN",
+            stacklevel=_callers_level(),
         )
     if bad.any():
         rows = np.flatnonzero(bad)
@@ -344,30 +450,19 @@ def impact_batch(
             f"{rows.size} of {bad.size} rows have invalid inputs (not finite, or out of "
             f"range), the first at row {rows[0]}: their status is Status.invalid and their "
             "results NaN",
-            stacklevel=2,
+            stacklevel=_callers_level(),
         )
-    for name, values in out.items():
-        if name == "status":
-            out[name] = np.where(bad | lost, int(Status.invalid), values)
-        elif np.issubdtype(values.dtype, np.floating):
-            out[name] = np.where(bad | lost, np.nan, values)
-    return out
+    return mark_invalid(done.out, bad | lost)
 
 
-def _stream(law, chunks, out, *, m, v0, g, separation, progress, **options):
-    """`impact_batch` over an iterable of chunks, written to `out` (`batch_file`)."""
-    from .files import batch_file
+_PACKAGE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
-    if not isinstance(law, str):
-        raise ValueError("impact_batch with chunks and out= takes a law name (see LAW_NAMES)")
-    if out is None:
-        raise ValueError("impact_batch over chunks needs out= (a CSV or Parquet path)")
-    if chunks is None:
-        raise ValueError("impact_batch with out= needs the chunks (an iterable of mappings)")
-    # impact_batch's own defaults (g = 0, "force") are not a value given for every row:
-    # a chunk's g or separation column then holds (batch_file refuses a column that
-    # disagrees with a value given)
-    default_g = isinstance(g, (int, float)) and not isinstance(g, bool) and g == 0.0
-    return batch_file(chunks, out, law, m=m, v0=v0, g=None if default_g else g,
-                      separation=None if separation == "force" else separation,
-                      progress=progress, **options)  # fmt: skip
+
+def _callers_level() -> int:
+    """The `stacklevel` of a warning from the function that calls this one, such that it
+    names the first line outside the package (the user's call, through any of its entry
+    points: `jaximpact.impact_batch`, a study)."""
+    frame, level = sys._getframe(1), 1
+    while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE):
+        frame, level = frame.f_back, level + 1
+    return level

@@ -114,7 +114,7 @@ def _start_processes(args):
 
 
 def run_batch_command(args):
-    from .._batch.files import batch_file, check_output_file
+    from .._jobs import batch_file, check_output_file
 
     if args.chunk_rows < 1:
         raise CLIError("--chunk-rows must be at least 1")

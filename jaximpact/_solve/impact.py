@@ -1,5 +1,6 @@
 """One impact: read off the universal curves, taken from a closed form, or integrated
-with diffrax and ended by events (`_integrate`, imported only when needed)."""
+with diffrax and ended by events (`_integrate`, imported only when needed), on the path that
+`options.choose_path` decides."""
 
 import dataclasses
 import math
@@ -11,39 +12,24 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._checks import check_nonnegative, check_positive, check_scale, is_traced
-from .._curves.gravity import WithGravity, gravity_fields, table_for
-from .._curves.shapes import CurveKey, curve_key
-from .._curves.similarity import serves, similarity_fields
-from .._laws import AbstractLaw, shape_of
+from .._curves.gravity import WithGravity, gravity_fields
+from .._curves.similarity import similarity_fields
+from .._laws import AbstractLaw
 from .._status import Status
+from .options import (
+    CURVES_RTOL as CURVES_RTOL,
+    CUSTOM_RTOL,
+    DEFAULT_RTOL,
+    METHODS,
+    SEPARATIONS as SEPARATIONS,
+    ImpactOptions as ImpactOptions,
+    check_options,
+    choose_path,
+    make_options,
+    similarity_reason as similarity_reason,
+)
 from .precision import resolvable_tolerances
 from .results import ImpactResult
-
-SEPARATIONS = ("force", "penetration")
-METHODS = ("auto", "integrate", "closed_form", "similarity")
-# the curves are accurate to about 2e-11 relative (docs/similarity.md): a finer `rtol`
-# asked of `impact` integrates instead
-CURVES_RTOL = 1e-11
-# the default tolerances: a law of the table, a user's law (measured: `c x sqrt(x) + b
-# sqrt(x) v` as written is 1.6e-9 off in e at 1e-11, 2.2e-10 at 1e-12)
-DEFAULT_RTOL = 1e-11
-CUSTOM_RTOL = 1e-12
-
-
-class ImpactOptions(eqx.Module):
-    """Everything static about an impact solve (see `impact` for the meanings)."""
-
-    separation: str = eqx.field(static=True)
-    closed_form: bool = eqx.field(static=True)
-    solver: object = eqx.field(static=True)  # a diffrax solver (None: not integrated)
-    rtol: float = eqx.field(static=True)
-    atol: float = eqx.field(static=True)
-    max_steps: int = eqx.field(static=True)
-    tau_max: float = eqx.field(static=True)
-    rest_tol: float = eqx.field(static=True)
-    adjoint: object = eqx.field(static=True)  # a diffrax adjoint (None: not integrated)
-    peaks: bool = eqx.field(static=True)
-    similarity: CurveKey | WithGravity | None = eqx.field(static=True, default=None)
 
 
 @eqx.filter_jit
@@ -120,7 +106,7 @@ def _check_representable(result, m, v0, g):
     )
 
 
-def _check_custom_law(law, v0):
+def check_custom_law(law, v0):
     """A user's law is tried at first touch before it is integrated: its function must give
     one real force (a `TypeError` or `ValueError` says what it gave instead), finite; one
     that pulls the body in there (`F(0, v0) < 0`) is not a contact force law, and what
@@ -190,23 +176,6 @@ def _warn_if_energy_gained(law, result, m, v0):
         )
 
 
-def _check_options(*, rtol, atol, rest_tol, max_steps, tau_max):
-    """One-line errors for options outside their range (before anything is traced)."""
-    for name, value in (("rtol", rtol), ("atol", atol), ("rest_tol", rest_tol)):
-        if value is None and name == "atol":
-            continue
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 < value < 1:
-            raise ValueError(f"{name} must be a number in (0, 1), got {value!r}")
-    if isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps < 1:
-        raise ValueError(f"max_steps must be a positive integer, got {max_steps!r}")
-    if (
-        isinstance(tau_max, bool)
-        or not isinstance(tau_max, (int, float))
-        or not (tau_max > 0 and math.isfinite(tau_max))
-    ):
-        raise ValueError(f"tau_max must be a finite number > 0 (units of t*), got {tau_max!r}")
-
-
 def gravity_impact(dynamics, m, v0, g, options: ImpactOptions):
     """One contact with gravity from the two-group table (`_curves.gravity`) where
     `(beta, gamma)` lies in it, else integrated with `options` (a `lax.cond`; under `vmap`
@@ -234,48 +203,6 @@ def gravity_impact(dynamics, m, v0, g, options: ImpactOptions):
 
     values, x = jax.lax.cond(in_range, table, integrated, None)
     return ImpactResult(**values, path="similarity"), x
-
-
-def similarity_reason(
-    law, separation: str, *, g_is_zero: bool = True, ts=None, gravity_table: bool = False
-) -> str | None:
-    """Why the universal curves cannot give this impact, or `None` if they can.
-
-    They need a one-group law of the table (`F = c x^n + b x^p v`: no dry force, which adds
-    the group `P/(c x*^n)`; not Maxwell; not a custom law), no gravity (which adds
-    `gamma = g x*/v0^2`) unless `gravity_table` (the caller can read the two-group table
-    of `_curves.gravity` and integrate where it ends: `gravity_impact`) and the shape has
-    one, no time histories, exponents known as numbers, and a shape whose impacts always
-    separate (Hertz viscous under `"penetration"` is captured above a threshold, near which
-    the contact lasts for ever)."""
-    name = law.name
-    if not g_is_zero and not gravity_table:
-        return "gravity adds a second group m g/(c x*^n); pass g=0 (a Python 0) or integrate"
-    if ts is not None:
-        return "time histories (ts=...) need the integration"
-    if not (law.spec and law.spec.one_group):
-        return (
-            f"law {name!r} is not one-group (a dry force, Maxwell's state or a custom law); "
-            "use method='integrate'"
-        )
-    shape = shape_of(law)
-    if shape is None:
-        return (
-            f"law {name!r} has its exponents {', '.join(law.spec.shape_parameters)} as traced "
-            "values; give them as numbers"
-        )
-    key = curve_key(*shape, separation)
-    if not serves(key):
-        return (
-            f"under separation={separation!r} the shape n={shape[0]:g}, p={shape[1]:g} is "
-            "captured above a damping threshold, where the curves end; use method='integrate'"
-        )
-    if not g_is_zero and table_for(key) is None:
-        return (
-            f"gravity adds a second group g x*/v0^2, and the shape n={shape[0]:g}, "
-            f"p={shape[1]:g} under separation={separation!r} has no gravity table; integrate"
-        )
-    return None
 
 
 def impact(
@@ -312,7 +239,7 @@ def impact(
       (Kelvin-Voigt, with `g = 0` and no `ts`), else the universal curves where the impact
       depends on one group `beta` (a one-group law of the table, `g = 0`, no `ts`, no
       `solver` chosen, `rtol >= 1e-11`, and a shape whose impacts always separate; see
-      `similarity_reason`), else integrates. `"integrate"` always integrates,
+      `options.choose_path`), else integrates. `"integrate"` always integrates,
       `"closed_form"` and `"similarity"` insist (a `ValueError` says why they cannot).
     - `solver` (default `diffrax.Tsit5()`), `rtol`, `atol` (default `rtol`): in the
       nondimensional variables, so they are relative to the contact's own scales. The
@@ -350,63 +277,40 @@ def impact(
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     if rtol is None:
         rtol = DEFAULT_RTOL if law.spec is not None else CUSTOM_RTOL
-    _check_options(rtol=rtol, atol=atol, rest_tol=rest_tol, max_steps=max_steps, tau_max=tau_max)
+    check_options(rtol=rtol, atol=atol, rest_tol=rest_tol, max_steps=max_steps, tau_max=tau_max)
     # 1e-300 kg is refused as 1e300 kg is: the contact's scales would under- or overflow
     m = check_scale("mass m", check_positive("mass m", m, "kg"), "kg")
     v0 = check_scale("impact speed v0", check_positive("impact speed v0", v0, "m/s"), "m/s")
     m = jnp.asarray(m, dtype=float)
     v0 = jnp.asarray(v0, dtype=float)
-    g_is_zero = isinstance(g, (int, float)) and g == 0
+    given_g = g  # a number 0 is no gravity, a static fact (choose_path)
     g = jnp.asarray(check_nonnegative("gravity g", g, "m/s^2"), dtype=float)
     if jnp.ndim(m) or jnp.ndim(v0) or jnp.ndim(g):
         raise ValueError("impact takes scalar m, v0 and g; use jax.vmap for a batch")
-
-    closed = None if ts is not None else law.closed_form(separation, g_is_zero=g_is_zero)
-    if method == "closed_form" and closed is None:
-        raise ValueError(
-            f"no closed form for law {law.name!r} with "
-            f"separation={separation!r}, g={float(g)} and ts={'given' if ts is not None else None}"
-        )
-    key, reason = None, None
-    if method == "similarity" or (method == "auto" and closed is None):
-        reason = similarity_reason(law, separation, g_is_zero=g_is_zero, ts=ts, gravity_table=True)
-        if reason is None:
-            key = curve_key(*shape_of(law), separation)
-            # with gravity: the two-group table, integrated where (beta, gamma) leaves it
-            key = key if g_is_zero else WithGravity(key)
-        elif method == "similarity":
-            raise ValueError(f"method='similarity' cannot serve this impact: {reason}")
-    if method == "auto" and key is not None and (solver is not None or rtol < CURVES_RTOL):
-        key = None  # the caller chose how to integrate
-    _check_custom_law(law, v0)
+    path = choose_path(
+        law, separation=separation, method=method, g=given_g, ts=ts, solver=solver, rtol=rtol
+    )
+    check_custom_law(law, v0)
     if ts is not None:
         ts = jnp.asarray(ts, dtype=float)
         if ts.ndim != 1:
             raise ValueError("ts must be a 1-D array of times in seconds")
     rtol, atol, rest_tol = resolvable_tolerances(rtol, rtol if atol is None else atol, rest_tol)
-    closed_form = closed is not None and method != "integrate"
-    if (key is None or isinstance(key, WithGravity)) and not closed_form:
-        import diffrax as dfx
-
-        from .adjoint import auto_adjoint
-
-        solver = dfx.Tsit5() if solver is None else solver
-        adjoint = auto_adjoint(law, m, v0, g, ts) if adjoint is None else adjoint
-    options = ImpactOptions(
+    options = make_options(
+        path,
         separation=separation,
-        closed_form=closed_form,
-        solver=solver,
         rtol=rtol,
         atol=atol,
+        rest_tol=rest_tol,
+        solver=solver,
+        adjoint=adjoint,
         max_steps=max_steps,
         tau_max=tau_max,
-        rest_tol=rest_tol,
-        adjoint=adjoint,
         peaks=peaks,
-        similarity=key,
+        inputs=(law, m, v0, g, ts),
     )
     result = solve_impact(law, m, v0, g, ts, options)
-    if isinstance(key, WithGravity) and not is_traced(result.num_steps):
+    if path.name == "gravity_table" and not is_traced(result.num_steps):
         if int(result.num_steps) > 0:  # outside the table: integrated, and said so
             fields = {f.name: getattr(result, f.name) for f in dataclasses.fields(result)}
             result = ImpactResult(**{**fields, "path": "integrated"})

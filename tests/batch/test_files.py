@@ -16,7 +16,7 @@ import pytest
 from helpers import assert_one_line_error, run_cli
 
 import jaximpact as ji
-from jaximpact._batch import files
+from jaximpact._jobs import job
 
 N, CHUNK = 250, 100
 
@@ -116,7 +116,7 @@ def test_columns_for_separation_and_failing_rows_kept_with_their_status(tmp_path
 
 def _interrupted(tmp_path, monkeypatch, after, **kwargs):
     """A run stopped (KeyboardInterrupt) once `after` chunks were written."""
-    real, done = files._compute, []
+    real, done = job.compute_chunk, []
 
     def compute(*args):
         if len(done) == after:
@@ -124,10 +124,10 @@ def _interrupted(tmp_path, monkeypatch, after, **kwargs):
         done.append(1)
         return real(*args)
 
-    monkeypatch.setattr(files, "_compute", compute)
+    monkeypatch.setattr(job, "compute_chunk", compute)
     with pytest.raises(KeyboardInterrupt):
         _run(tmp_path, **kwargs)
-    monkeypatch.setattr(files, "_compute", real)
+    monkeypatch.setattr(job, "compute_chunk", real)
     assert not (tmp_path / "out.csv").exists()  # nothing half-written where OUT goes
 
 
@@ -320,7 +320,7 @@ def test_impact_batch_streaming_needs_a_name_and_a_path(tmp_path):
 
 
 def test_progress_reports_rows_per_second_and_time_left():
-    assert files._rate(1000, 4000, 2.0) == "1,000 rows, 500 rows/s, 0m06s left"
+    assert job._rate(1000, 4000, 2.0) == "1,000 rows, 500 rows/s, 0m06s left"
 
 
 def test_cli_batch(capsys, tmp_path):

@@ -1,40 +1,44 @@
 """The processes' exchanges (`ProcessGroup`): two groups in threads of this process, through a
-stand-in for the coordination service's key-value store (the real one is exercised by the
-two-process tests in test_files.py)."""
+stand-in for the collective that `jax.experimental.multihost_utils.process_allgather` makes
+over every process's devices (the real one is exercised by the two-process tests in
+test_files.py), and the wait on a shared directory."""
 
-import itertools
 import threading
 
 import pytest
 
-from jaximpact._batch import processes
-from jaximpact._batch.processes import PeerFailed, ProcessGroup
+from jaximpact._jobs import processes
+from jaximpact._jobs.processes import PeerFailed, ProcessGroup
 
 
-class _Store:
-    """`key_value_set` and `blocking_key_value_get` as jax.distributed's client has them."""
+class _Collective:
+    """An all-gather between threads: the k-th call of each member pairs with the k-th call
+    of the others, as the calls of a collective do."""
 
-    def __init__(self):
-        self.values, self.changed = {}, threading.Condition()
+    def __init__(self, count):
+        self.count, self.values, self.changed = count, {}, threading.Condition()
+        self.calls = [0] * count
 
-    def key_value_set(self, key, value):
-        with self.changed:
-            self.values[key] = value
-            self.changed.notify_all()
+    def member(self, index):
+        def allgather(value, count):
+            assert count == self.count
+            with self.changed:
+                call = self.calls[index]
+                self.calls[index] += 1
+                self.values[call, index] = value
+                self.changed.notify_all()
+                every = [(call, k) for k in range(count)]
+                if not self.changed.wait_for(lambda: all(k in self.values for k in every), 20):
+                    raise TimeoutError(call)
+                return [self.values[k] for k in every]
 
-    def blocking_key_value_get(self, key, timeout_ms):
-        with self.changed:
-            if not self.changed.wait_for(lambda: key in self.values, timeout_ms / 1000):
-                raise TimeoutError(key)
-            return self.values[key]
+        return allgather
 
 
 @pytest.fixture
-def pair(monkeypatch):
-    store = _Store()
-    monkeypatch.setattr(processes, "_client", lambda: store)
-    monkeypatch.setattr(processes, "_WAIT_MS", 20_000)
-    return [ProcessGroup(k, 2, calls=itertools.count()) for k in range(2)]
+def pair():
+    collective = _Collective(2)
+    return [ProcessGroup(k, 2, allgather=collective.member(k)) for k in range(2)]
 
 
 def _both(first, second):
@@ -80,3 +84,35 @@ def test_a_process_that_finished_learns_of_a_failure_at_its_report(pair):
 def test_one_process_exchanges_nothing():
     alone = ProcessGroup()
     assert alone.gather(5) == [5] and alone.report(False) is False and alone.report(True)
+
+
+def test_a_process_waits_on_the_shared_directory_for_the_others(pair, tmp_path, monkeypatch):
+    """The first process to finish waits on the disk (no collective pending) until the
+    other arrives; arrivals of an earlier run are cleared first."""
+    monkeypatch.setattr(processes, "_POLL_S", 0.01)
+    a, b = pair
+    (tmp_path / "arrived-000001").touch()  # left by an interrupted run
+    ProcessGroup.clear(tmp_path)
+    waiting = threading.Thread(target=a.wait_for_all, args=(tmp_path,))
+    waiting.start()
+    waiting.join(timeout=0.3)
+    assert waiting.is_alive()  # process 1 has not arrived
+    b.wait_for_all(tmp_path)
+    waiting.join(timeout=10)
+    assert not waiting.is_alive()
+
+
+def test_the_exchange_goes_through_public_jax_only():
+    """No private JAX module under the file jobs or the batches (issue 25)."""
+    from pathlib import Path
+
+    import jaximpact
+
+    root = Path(jaximpact.__file__).parent
+    found = [
+        str(path.relative_to(root))
+        for unit in ("_batch", "_jobs")
+        for path in (root / unit).rglob("*.py")
+        if "jax._src" in path.read_text()
+    ]
+    assert not found

@@ -1,0 +1,224 @@
+"""What is static about an impact solve (`ImpactOptions`), and the one decision of how an
+impact is computed (`choose_path`): the law's exact closed form, the universal curves, the
+two-group gravity table (integrated where it ends), or the integration. `impact` and
+`impact_batch` both ask `choose_path`, once per call (a batch: once for all its rows)."""
+
+import math
+from typing import NamedTuple
+
+import equinox as eqx
+
+from .._checks import is_traced
+from .._curves.gravity import WithGravity, table_for
+from .._curves.shapes import CurveKey, curve_key
+from .._curves.similarity import serves
+from .._laws import shape_of
+
+SEPARATIONS = ("force", "penetration")
+METHODS = ("auto", "integrate", "closed_form", "similarity")
+PATHS = ("closed_form", "similarity", "gravity_table", "integrated")
+# the curves are accurate to about 2e-11 relative (docs/similarity.md): a finer `rtol`
+# asked of `impact` integrates instead
+CURVES_RTOL = 1e-11
+# the default tolerances: a law of the table, a user's law (measured: `c x sqrt(x) + b
+# sqrt(x) v` as written is 1.6e-9 off in e at 1e-11, 2.2e-10 at 1e-12)
+DEFAULT_RTOL = 1e-11
+CUSTOM_RTOL = 1e-12
+
+
+class ImpactOptions(eqx.Module):
+    """Everything static about an impact solve: one compiled program per distinct value.
+
+    `impact` builds it from its keywords (see `impact` for their meanings); a caller that
+    runs `solve_impact` itself (a fit, a batch) builds it with `make_options`.
+
+    - `separation`: `"force"` or `"penetration"`, the end of contact.
+    - `closed_form`: take the law's exact solution (`AbstractLaw.closed_form`).
+    - `solver`, `adjoint`: the diffrax solver and adjoint of an integrated solve (None for
+      a path that does not integrate).
+    - `rtol`, `atol`: tolerances in the contact's own units (`x*`, `t*`); `max_steps`;
+      `tau_max`: the horizon in units of `t*`; `rest_tol`: the speed plus net force
+      (in units of `v0` and `m v0^2/x*`) below which the body is at rest.
+    - `peaks`: find `x_max`, `t_max`, `F_max`.
+    - `similarity`: the universal curves' `CurveKey` to read the impact off, or
+      `WithGravity(key)` for the two-group gravity table; None otherwise.
+
+    **Example**: `jaximpact.ImpactOptions(separation="force", closed_form=True, solver=None,
+    rtol=1e-11, atol=1e-11, max_steps=4096, tau_max=1e4, rest_tol=1e-7, adjoint=None,
+    peaks=True)`, the options of a Kelvin-Voigt impact.
+    """
+
+    separation: str = eqx.field(static=True)
+    closed_form: bool = eqx.field(static=True)
+    solver: object = eqx.field(static=True)  # a diffrax solver (None: not integrated)
+    rtol: float = eqx.field(static=True)
+    atol: float = eqx.field(static=True)
+    max_steps: int = eqx.field(static=True)
+    tau_max: float = eqx.field(static=True)
+    rest_tol: float = eqx.field(static=True)
+    adjoint: object = eqx.field(static=True)  # a diffrax adjoint (None: not integrated)
+    peaks: bool = eqx.field(static=True)
+    similarity: CurveKey | WithGravity | None = eqx.field(static=True, default=None)
+
+
+class Path(NamedTuple):
+    """How an impact is computed: `name`, one of `PATHS`, and for the curves their `key`
+    (a `CurveKey`, or `WithGravity(key)` for the gravity table)."""
+
+    name: str
+    key: CurveKey | WithGravity | None = None
+
+    @property
+    def integrates(self) -> bool:
+        """Whether the solve needs the integrator (the gravity table integrates the impacts
+        that leave it)."""
+        return self.name in ("gravity_table", "integrated")
+
+
+def check_options(*, rtol, atol, rest_tol, max_steps, tau_max):
+    """One-line errors for options outside their range (before anything is traced)."""
+    for name, value in (("rtol", rtol), ("atol", atol), ("rest_tol", rest_tol)):
+        if value is None and name == "atol":
+            continue
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 < value < 1:
+            raise ValueError(f"{name} must be a number in (0, 1), got {value!r}")
+    if isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps < 1:
+        raise ValueError(f"max_steps must be a positive integer, got {max_steps!r}")
+    if (
+        isinstance(tau_max, bool)
+        or not isinstance(tau_max, (int, float))
+        or not (tau_max > 0 and math.isfinite(tau_max))
+    ):
+        raise ValueError(f"tau_max must be a finite number > 0 (units of t*), got {tau_max!r}")
+
+
+def similarity_reason(
+    law, separation: str, *, g_is_zero: bool = True, ts=None, gravity_table: bool = False
+) -> str | None:
+    """Why the universal curves cannot give this impact, or `None` if they can.
+
+    They need a one-group law of the table (`F = c x^n + b x^p v`: no dry force, which adds
+    the group `P/(c x*^n)`; not Maxwell; not a custom law), no gravity (which adds
+    `gamma = g x*/v0^2`) unless `gravity_table` (the caller can read the two-group table
+    of `_curves.gravity` and integrate where it ends: `gravity_impact`) and the shape has
+    one, no time histories, exponents known as numbers, and a shape whose impacts always
+    separate (Hertz viscous under `"penetration"` is captured above a threshold, near which
+    the contact lasts for ever)."""
+    name = law.name
+    if not g_is_zero and not gravity_table:
+        return "gravity adds a second group m g/(c x*^n); pass g=0 (a Python 0) or integrate"
+    if ts is not None:
+        return "time histories (ts=...) need the integration"
+    if not (law.spec and law.spec.one_group):
+        return (
+            f"law {name!r} is not one-group (a dry force, Maxwell's state or a custom law); "
+            "use method='integrate'"
+        )
+    shape = shape_of(law)
+    if shape is None:
+        return (
+            f"law {name!r} has its exponents {', '.join(law.spec.shape_parameters)} as traced "
+            "values; give them as numbers"
+        )
+    key = curve_key(*shape, separation)
+    if not serves(key):
+        return (
+            f"under separation={separation!r} the shape n={shape[0]:g}, p={shape[1]:g} is "
+            "captured above a damping threshold, where the curves end; use method='integrate'"
+        )
+    if not g_is_zero and table_for(key) is None:
+        return (
+            f"gravity adds a second group g x*/v0^2, and the shape n={shape[0]:g}, "
+            f"p={shape[1]:g} under separation={separation!r} has no gravity table; integrate"
+        )
+    return None
+
+
+def choose_path(
+    law,
+    *,
+    separation: str = "force",
+    method: str = "auto",
+    g=0.0,
+    ts=None,
+    solver=None,
+    rtol: float = DEFAULT_RTOL,
+) -> Path:
+    """How `impact` computes the impact of `law` (the only place that decides it).
+
+    `method="auto"`: the law's closed form where one holds for these inputs (every `g`
+    where its row says so, else `g = 0`; no time histories `ts`), else the universal
+    curves (`similarity_reason`; with gravity the two-group table, integrated where it
+    ends) unless a `solver` was chosen or `rtol < CURVES_RTOL`, else the integration.
+    `"integrate"` always integrates; `"closed_form"` and `"similarity"` insist (a
+    `ValueError` says why they cannot serve). Gravity is none only where `g` is a number
+    0 (a static fact); an array or a traced value counts as gravity.
+    """
+    g_is_zero = isinstance(g, (int, float)) and g == 0
+    closed = None if ts is not None else law.closed_form(separation, g_is_zero=g_is_zero)
+    if method == "closed_form" and closed is None:
+        raise ValueError(
+            f"no closed form for law {law.name!r} with separation={separation!r}, "
+            f"g={_shown(g)} and ts={'given' if ts is not None else None}"
+        )
+    if method == "similarity" or (method == "auto" and closed is None):
+        reason = similarity_reason(law, separation, g_is_zero=g_is_zero, ts=ts, gravity_table=True)
+        if reason is not None and method == "similarity":
+            raise ValueError(f"method='similarity' cannot serve this impact: {reason}")
+        # "auto" leaves the curves to a caller who chose how to integrate
+        if reason is None and (method == "similarity" or (solver is None and rtol >= CURVES_RTOL)):
+            key = curve_key(*shape_of(law), separation)
+            return Path("similarity", key) if g_is_zero else Path("gravity_table", WithGravity(key))
+    if closed is not None and method != "integrate":
+        return Path("closed_form")
+    return Path("integrated")
+
+
+def make_options(
+    path: Path,
+    *,
+    separation: str,
+    rtol: float,
+    atol: float,
+    rest_tol: float,
+    solver=None,
+    adjoint=None,
+    max_steps: int = 4096,
+    tau_max: float = 1e4,
+    peaks: bool = True,
+    inputs: tuple = (),
+) -> ImpactOptions:
+    """The `ImpactOptions` of a solve on `path` (tolerances as the working precision can
+    meet them: `precision.resolvable_tolerances`). Where the path integrates, `solver`
+    defaults to `diffrax.Tsit5()` and `adjoint` to the cheapest one for the tracers in
+    `inputs` (`adjoint.auto_adjoint`; no tracers: `RecursiveCheckpointAdjoint`)."""
+    if path.integrates:
+        import diffrax as dfx
+
+        from .adjoint import auto_adjoint
+
+        solver = dfx.Tsit5() if solver is None else solver
+        adjoint = auto_adjoint(*inputs) if adjoint is None else adjoint
+    return ImpactOptions(
+        separation=separation,
+        closed_form=path.name == "closed_form",
+        solver=solver,
+        rtol=rtol,
+        atol=atol,
+        max_steps=max_steps,
+        tau_max=tau_max,
+        rest_tol=rest_tol,
+        adjoint=adjoint,
+        peaks=peaks,
+        similarity=path.key,
+    )
+
+
+def _shown(g) -> str:
+    """`g` as a number for a message (a traced or per-row value as such)."""
+    if is_traced(g):
+        return "a traced value"
+    try:
+        return str(float(g))
+    except (TypeError, ValueError):
+        return "an array"
