@@ -38,7 +38,8 @@ class LawSpec:
     parameter that holds it (`shape_parameters`: those names, which must be known numbers,
     not traced values, for the curves to serve); `()` outside the family. `closed_form`:
     the exact impact for every parameter value without gravity, as a function
-    `closed_form(separation) -> f(law, *, m, v0, g, rest_tol) -> dict` of `ImpactResult`
+    `closed_form(separation) -> f(law, *, m, v0, g, rest_tol, tau_max, with_end) -> dict` of
+    `ImpactResult`
     fields (`closed_forms.py`; `None`: none), which `AbstractLaw.closed_form` hands to
     `impact`; `closed_form_gravity`: that solution holds with gravity too (any `g >= 0`).
     `damping`: the parameter that sets the dissipation (what `restitution_map` varies and a

@@ -4,10 +4,11 @@
 - Maxwell (eqs. 10-11) under the force criterion, under-damped (`4 b^2 > m c`): the
   paper's formulas, kept as an oracle (`impact` uses `closed_forms_linear.maxwell_impact`,
   which holds for every damping and both criteria).
-- The exact impacts the law table's rows hold (`LawSpec.closed_form`, taken by `impact`
-  through `AbstractLaw.closed_form`): `kelvin_voigt_closed_form` (with gravity too),
-  `bingham_closed_form` (eq. 7), `bingham_compression_closed_form` (eq. 9) and
-  `maxwell_closed_form` (eqs. 10-11), the last three through `closed_forms_linear`.
+- The exact impacts the law table's rows hold (`LawSpec.closed_form`, taken by `impact`,
+  `bounce` and `exact_batch` through `AbstractLaw.closed_form`), each for any gravity
+  `g >= 0`: `kelvin_voigt_closed_form`, `bingham_closed_form` (eq. 7),
+  `bingham_compression_closed_form` (eq. 9) and `maxwell_closed_form` (eqs. 10-11), the
+  last three through `closed_forms_linear` (and Kelvin-Voigt's with gravity).
 - The undamped power-law spring `F = c x^n`: `x_max` and `T`.
 - The restitution of the Hunt-Crossley family `F = c x^n (1 + D v)`, a function of
   `D v0` only (through the Lambert W function).
@@ -15,8 +16,10 @@ All in SI units; every function is differentiable and NaN-free, including at cri
 damping (`b^2 = 4 m c`), where the under- and over-damped formulas meet.
 """
 
+import functools
 import math
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -25,44 +28,13 @@ from jax.scipy.special import gammaln
 
 from .._checks import is_traced
 from .._status import Status
-
-
-def _series_near_zero(u, coefficients):
-    return sum(a * u**k for k, a in enumerate(coefficients))
-
-
-def _arctan_ratio(u):
-    """`atan(sqrt(u))/sqrt(u)` for `u > 0`, `atanh(sqrt(-u))/sqrt(-u)` for `-1 < u < 0`."""
-    small = jnp.abs(u) < 1e-2
-    root_pos = jnp.sqrt(jnp.where(u > 1e-2, u, 1.0))
-    root_neg = jnp.sqrt(jnp.where(u < -1e-2, -u, 0.25))
-    exact = jnp.where(u > 0, jnp.arctan(root_pos) / root_pos, jnp.arctanh(root_neg) / root_neg)
-    series = _series_near_zero(u, [(-1) ** k / (2 * k + 1) for k in range(9)])
-    return jnp.where(small, series, exact)
-
-
-def _sin_ratio(r, t):
-    """`sin(sqrt(r) t)/sqrt(r)` continued to `sinh(sqrt(-r) t)/sqrt(-r)` for `r < 0`."""
-    z = r * t**2
-    small = jnp.abs(z) < 1e-2
-    root_pos = jnp.sqrt(jnp.where(small | (r < 0), 1.0, r))
-    root_neg = jnp.sqrt(jnp.where(small | (r > 0), 1.0, -r))
-    exact = jnp.where(r > 0, jnp.sin(root_pos * t) / root_pos, jnp.sinh(root_neg * t) / root_neg)
-    factorials = [1, 6, 120, 5040, 362880, 39916800, 6227020800]
-    series = t * _series_near_zero(-z, [1 / f for f in factorials])
-    return jnp.where(small, series, exact)
-
-
-def _cos_continued(r, t):
-    """`cos(sqrt(r) t)`, continued to `cosh(sqrt(-r) t)` for `r < 0`."""
-    z = r * t**2
-    small = jnp.abs(z) < 1e-2
-    root_pos = jnp.sqrt(jnp.where(small | (r < 0), 1.0, r))
-    root_neg = jnp.sqrt(jnp.where(small | (r > 0), 1.0, -r))
-    exact = jnp.where(r > 0, jnp.cos(root_pos * t), jnp.cosh(root_neg * t))
-    factorials = [1, 2, 24, 720, 40320, 3628800, 479001600]
-    series = _series_near_zero(-z, [1 / f for f in factorials])
-    return jnp.where(small, series, exact)
+from .closed_forms_linear import (
+    linear_impact,
+    maxwell_creep as maxwell_creep,  # where dynamics.py reads it
+    maxwell_gravity_impact,
+    maxwell_impact,
+)
+from .oscillator import _arctan_ratio, _cos_continued, _sin_ratio
 
 
 def kelvin_voigt(c, b, m, v0, separation="force", *, rest_tol=1e-7):
@@ -161,53 +133,6 @@ def maxwell(c, b, m, v0):
         F_max=c * x_star * jnp.exp(-a * tau_peak),
         status=jnp.where(under, Status.separated, Status.captured),
     )
-
-
-def maxwell_creep(mu, rest_tol):
-    """Over-damped Maxwell without gravity (`mu = sqrt(m c)/b >= 2`), nondimensional.
-
-    `V'' + mu V' + V = 0`, `V(0) = 1`, `V'(0) = 0` stays positive for all time when
-    `mu >= 2`: the body never reaches maximum compression, it sinks in while the force
-    relaxes (status captured). With the roots `l2 < l1 < 0` of `l^2 + mu l + 1` and
-    `e_i = exp(l_i tau)`: `Phi = (e1 - e2)/(l1 - l2)`, `V = (l1 e2 - l2 e1)/(l1 - l2)`,
-    `X = Phi + mu (1 - V)` (since `Phi = -V'`). Returns `(tau_rest, X(tau_rest), tau_peak,
-    Phi(tau_peak))`: the instant `V + Phi` falls to `rest_tol` (what `impact` calls at rest;
-    Newton on its logarithm, differentiated implicitly) and the force peak `Phi' = 0`.
-    Call it with `mu >= 2` only (callers substitute a safe value elsewhere); near critical
-    damping the modes are written `exp(-mu tau/2) sinh(q tau)/q` (series in `q`)."""
-    s = 0.5 * mu
-    q2 = s**2 - 1.0
-    near = q2 < 1e-4  # within 1e-2 of critical damping in q: the sinh form, no cancellation
-    q = jnp.sqrt(jnp.where(near, 1.0, q2))
-    fast = -s - q
-    slow = 1.0 / fast  # l1 l2 = 1, without the cancellation of -s + q
-    gap = slow - fast
-    r_near = -jnp.where(near, q2, 0.0)
-
-    def modes(tau):
-        e1, e2 = jnp.exp(slow * tau), jnp.exp(fast * tau)
-        phi_far, v_far = (e1 - e2) / gap, (slow * e2 - fast * e1) / gap
-        decay = jnp.exp(-s * tau)
-        sin_r = _sin_ratio(r_near, tau)
-        phi_near = decay * sin_r
-        v_near = decay * (_cos_continued(r_near, tau) + s * sin_r)
-        return jnp.where(near, phi_near, phi_far), jnp.where(near, v_near, v_far)
-
-    start = jnp.where(near, -jnp.log(rest_tol), jnp.log(rest_tol * gap / (1.0 - fast)) / slow)
-    start = jnp.maximum(start, 1.0)
-
-    def excess(tau, _):
-        phi, v = modes(tau)
-        return jnp.log(phi + v) - jnp.log(rest_tol)
-
-    solution = optx.root_find(
-        excess, optx.Newton(rtol=1e-13, atol=1e-13), start, max_steps=64, throw=False
-    )
-    tau_rest = jnp.where(jnp.isfinite(solution.value), solution.value, start)
-    phi, v = modes(tau_rest)
-    # Phi' = 0 where tanh(q tau) = q/s
-    tau_peak = _arctan_ratio(-q2 / s**2) / s
-    return tau_rest, phi + mu * (1.0 - v), tau_peak, modes(tau_peak)[0]
 
 
 def power_spring(c, n, m, v0):
@@ -333,23 +258,43 @@ def _hunt_crossley_restitution(alpha):
     return jnp.where(valid, e, jnp.where(alpha == jnp.inf, 0.0, jnp.nan))
 
 
-def exact_batch(name: str, params: dict, *, m, v0, separation: str) -> dict | None:
-    """`e`, `T` (s) and `status` of a batch of law `name`'s impacts from an exact solution
-    that holds for every member, or `None`: Maxwell under the force criterion when every
-    member is under-damped (`4 b^2 > m c`); Kelvin-Voigt goes through `impact_batch`'s
-    closed-form path instead."""
-    if name != "maxwell" or separation != "force":
+def exact_batch(law, *, m, v0, separation: str, g=0.0, rest_tol=1e-7) -> dict | None:
+    """`e`, `T` (s) and `status` (numpy arrays) of a batch of impacts of `law`, whose
+    parameters are numbers or 1-D arrays of one length, from the exact solution its row of
+    the law table declares (`LawSpec.closed_form`, read through `AbstractLaw.closed_form`:
+    every parameter value, and every `g >= 0` where the row says `closed_form_gravity`), or
+    `None` where the row has none. `m` (kg), `v0` (m/s), `g` (m/s^2) are numbers. One
+    compiled program per row and criterion (`jit` of `vmap`), whatever the batch's values.
+    """
+    g_is_zero = isinstance(g, (int, float)) and g == 0
+    closed = law.closed_form(separation, g_is_zero=g_is_zero)
+    if closed is None:
         return None
-    c, b = np.asarray(params["c"], float), np.asarray(params["b"], float)
-    if not np.all(4.0 * b**2 > m * c):
-        return None
-    out = maxwell(c, b, m, v0)
-    return {k: np.asarray(out[k]) for k in ("e", "T", "status")}
+    params = law.parameters
+    shape = np.broadcast_shapes(*(np.shape(v) for v in params.values()))
+    batch = law.replace(**{k: jnp.broadcast_to(jnp.asarray(v, float), shape or (1,))
+                           for k, v in params.items()})  # fmt: skip
+    solve = _batch_solve(law.spec.closed_form, separation, rest_tol, float(g))
+    out = solve(batch, jnp.asarray(m, float), jnp.asarray(v0, float))
+    return {k: np.asarray(out[k]).reshape(shape) for k in ("e", "T", "status")}
 
 
-def _finish(fields, m, v0, g=0.0):
+@functools.cache
+def _batch_solve(closed_form, separation, rest_tol, g):
+    """The compiled batch of a row's closed form (`exact_batch`), cached by row builder;
+    `g` (a number) is built in, so that `g = 0` compiles the formulas without gravity only."""
+    closed = closed_form(separation)
+
+    def one(law, m, v0):
+        return closed(law, m=m, v0=v0, g=g, rest_tol=rest_tol)
+
+    return eqx.filter_jit(eqx.filter_vmap(one, in_axes=(eqx.if_array(0), None, None)))
+
+
+def _finish(fields, m, v0, g=0.0, with_end=False):
     """The `ImpactResult` fields of a closed form's dict (`x_end`, m, where contact ended:
-    the work of gravity `m g x_end` is dissipated too, as on the integrated path)."""
+    the work of gravity `m g x_end` is dissipated too, as on the integrated path); with
+    `with_end`, `x_end` is kept (what a bounce needs to start the next flight)."""
     e = fields["e"]
     separated = fields["status"] == Status.separated
     fields = dict(fields)
@@ -358,16 +303,33 @@ def _finish(fields, m, v0, g=0.0):
     fields["dissipated"] = 0.5 * m * v0**2 * (1.0 - e**2) + m * g * x_end
     fields["v_out"] = jnp.where(separated, -e * v0, 0.0)
     fields["num_steps"] = jnp.asarray(0)
+    if with_end:
+        fields["x_end"] = jnp.zeros_like(fields["T"]) + x_end
     return fields
+
+
+# the horizon (units of t*) of a contact that never ends: `impact`'s default `tau_max`
+TAU_MAX = 1e4
+
+
+def _where_no_gravity(g, without_gravity, with_gravity, args):
+    """`without_gravity(args)` where `g = 0`, else `with_gravity(args)`: decided once where
+    `g` is known (a number, or a concrete array), else a `lax.cond` (a select under `vmap`,
+    where both run)."""
+    if not is_traced(g):
+        return (without_gravity if bool(np.all(np.asarray(g) == 0)) else with_gravity)(args)
+    return jax.lax.cond(jnp.all(g == 0), without_gravity, with_gravity, args)
 
 
 def kelvin_voigt_closed_form(separation):
     """Kelvin-Voigt (eq. 1): eq. 5's formulas (`kelvin_voigt`) at `g = 0`, the piecewise
-    oscillator (`closed_forms_linear.linear_impact`) under gravity; any damping."""
+    oscillator (`closed_forms_linear.linear_impact`) under gravity; any damping.
 
-    def impact_fields(law, *, m, v0, g=0.0, rest_tol):
-        from .closed_forms_linear import linear_impact
+    The closed forms built here are `f(law, *, m, v0, g, rest_tol, tau_max, with_end)`:
+    `rest_tol` and `tau_max` as in `impact`, and `with_end=True` keeps `x_end` (m, the
+    penetration where contact ended) among the fields, for `bounce`."""
 
+    def impact_fields(law, *, m, v0, g=0.0, rest_tol, tau_max=TAU_MAX, with_end=False):
         c, b = law.params["c"], law.params["b"]
         g = jnp.asarray(g, dtype=jnp.result_type(float))
 
@@ -388,8 +350,8 @@ def kelvin_voigt_closed_form(separation):
 
         args = jnp.broadcast_arrays(c, b, m, v0, g)
         # eq. 5's formulas where g = 0 (a select under vmap, one branch otherwise)
-        fields = jax.lax.cond(jnp.all(g == 0), without_gravity, with_gravity, args)
-        return _finish(fields, m, v0, g)
+        fields = _where_no_gravity(g, without_gravity, with_gravity, args)
+        return _finish(fields, m, v0, g, with_end)
 
     return impact_fields
 
@@ -398,16 +360,14 @@ def _linear_impact(p_in, p_out, damped, dry):
     """Bingham-type laws: `p_in(P)`, `p_out(P)` the dry force in each phase (N)."""
 
     def build(separation):
-        def impact_fields(law, *, m, v0, g=0.0, rest_tol):
-            from .closed_forms_linear import linear_impact
-
+        def impact_fields(law, *, m, v0, g=0.0, rest_tol, tau_max=TAU_MAX, with_end=False):
             c, pressure = law.params["c"], law.params["P"]
             b = law.params["b"] if damped else jnp.zeros_like(c)
             fields = linear_impact(
                 c, b, p_in(pressure), p_out(pressure), m, v0, g, separation,
                 dry=dry, rest_tol=rest_tol,
             )  # fmt: skip
-            return _finish(fields, m, v0, g)
+            return _finish(fields, m, v0, g, with_end)
 
         return impact_fields
 
@@ -415,14 +375,28 @@ def _linear_impact(p_in, p_out, damped, dry):
 
 
 def maxwell_closed_form(separation):
-    """Maxwell (eqs. 10-11): `closed_forms_linear.maxwell_impact`, every damping, `g = 0`."""
+    """Maxwell (eqs. 10-11), every damping: `closed_forms_linear.maxwell_impact` at
+    `g = 0`, `closed_forms_linear.maxwell_gravity_impact` under gravity (any `g >= 0`)."""
 
-    def impact_fields(law, *, m, v0, g=0.0, rest_tol):
-        from .closed_forms_linear import maxwell_impact
+    def impact_fields(law, *, m, v0, g=0.0, rest_tol, tau_max=TAU_MAX, with_end=False):
+        c, b = law.params["c"], law.params["b"]
+        g = jnp.asarray(g, dtype=jnp.result_type(float))
 
-        fields = maxwell_impact(law.params["c"], law.params["b"], m, v0, separation,
-                                rest_tol=rest_tol)  # fmt: skip
-        return _finish(fields, m, v0, g)
+        def without_gravity(args):
+            c, b, m, v0, g = args
+            fields = maxwell_impact(c, b, m, v0, separation, rest_tol=rest_tol)
+            return dict(fields, status=jnp.asarray(fields["status"]).astype(jnp.int32))
+
+        def with_gravity(args):
+            c, b, m, v0, g = args
+            fields = maxwell_gravity_impact(
+                c, b, m, v0, g, separation, rest_tol=rest_tol, tau_max=tau_max
+            )
+            return dict(fields, status=jnp.asarray(fields["status"]).astype(jnp.int32))
+
+        args = jnp.broadcast_arrays(c, b, m, v0, g)
+        fields = _where_no_gravity(g, without_gravity, with_gravity, args)
+        return _finish(fields, m, v0, g, with_end)
 
     return impact_fields
 

@@ -187,11 +187,11 @@ def jkr_start(*, m, v0, e, T, R):
 def jkr_closed_form(separation):
     """JKR without gravity: `jkr_impact`, either criterion (contact ends at pull-off)."""
 
-    def impact_fields(law, *, m, v0, g=0.0, rest_tol):
+    def impact_fields(law, *, m, v0, g=0.0, rest_tol, tau_max=None, with_end=False):
         from .closed_forms import _finish
 
         p = law.params
-        return _finish(jkr_impact(p["c"], p["R"], p["w"], m, v0), m, v0, g)
+        return _finish(jkr_impact(p["c"], p["R"], p["w"], m, v0), m, v0, g, with_end)
 
     return impact_fields
 

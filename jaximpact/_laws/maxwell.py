@@ -58,5 +58,7 @@ MAXWELL = LawSpec(
     reference="Polukoshko et al. 2007, eqs. 10-11",
     state=MaxwellLaw,
     positive=("c", "b"),
-    closed_form=maxwell_closed_form,  # without gravity: eqs. 10-11 are linear, any damping
+    # eqs. 10-11 are linear with a constant forcing m g: exact for any damping and g >= 0
+    closed_form=maxwell_closed_form,
+    closed_form_gravity=True,
 )

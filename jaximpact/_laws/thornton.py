@@ -96,6 +96,7 @@ def thornton_impact(c, x_y, m, v0, separation="force"):
         F_max=F_m,
         t_max=t_max,
         status=zero.astype(jnp.int32) + Status.separated,
+        x_end=(x_m - depth) if separation == "force" else zero,  # the dent's bottom, or 0
     )
 
 
@@ -122,11 +123,11 @@ def thornton_start(*, m, v0, e, T):
 def thornton_closed_form(separation):
     """Thornton's law without gravity: `thornton_impact` (any `v0 / v_y`)."""
 
-    def impact_fields(law, *, m, v0, g=0.0, rest_tol):
+    def impact_fields(law, *, m, v0, g=0.0, rest_tol, tau_max=None, with_end=False):
         from .closed_forms import _finish
 
         fields = thornton_impact(law.params["c"], law.params["x_y"], m, v0, separation)
-        return _finish(fields, m, v0, g)
+        return _finish(fields, m, v0, g, with_end)
 
     return impact_fields
 

@@ -3,8 +3,10 @@
 The seed paper's system (17) (Polukoshko et al. 2007, section 7) integrates the whole motion,
 flight and contact, with explicit Euler at a fixed step (`_solve.euler`). Here the free flight
 is a parabola (or, with quadratic air drag, its closed form: `_solve.flight`), never
-integrated, and each contact is one event-terminated impact solve with gravity inside it (the
-same solve as `jaximpact.impact(..., g=g)`). The contacts run in a `lax.scan` of static
+integrated, and each contact is one impact solve with gravity inside it (the same solve as
+`jaximpact.impact(..., g=g)`): the law's exact solution where its row has one that holds
+under gravity (Kelvin-Voigt, Bingham 7 and 9, Maxwell), else the gravity table or an
+event-terminated integration. The contacts run in a `lax.scan` of static
 length `max_impacts`; contacts after the end are masked, so the whole drop is one compiled
 program, differentiable in both modes (shared/notes/diffrax-impact-notes.md, section 6).
 """
@@ -31,6 +33,7 @@ from .flight import Flight
 from .impact import CURVES_RTOL, SEPARATIONS, ImpactOptions, gravity_impact, similarity_reason
 from .phases import integrated_contact
 from .precision import resolvable_tolerances
+from .results import ImpactResult
 
 
 class BounceStatus(enum.IntEnum):
@@ -55,6 +58,9 @@ class BounceStatus(enum.IntEnum):
 
 
 _RUNNING = -1
+# "auto": each contact from the law's exact solution with gravity where its row has one,
+# else the gravity table or the integrator; "integrate": every contact integrated
+BOUNCE_METHODS = ("auto", "integrate")
 
 
 class BounceOptions(eqx.Module):
@@ -67,7 +73,9 @@ class BounceOptions(eqx.Module):
 def _gravity_key(law, options: ImpactOptions):
     """The two-group table's key where `impact(..., g=g)` would read it (a one-group law of
     the table with a shipped gravity table, `rtol >= CURVES_RTOL`, the default solver
-    Tsit5), else `None` (static)."""
+    Tsit5, and not `method="integrate"`), else `None` (static)."""
+    if not options.closed_form:
+        return None
     if options.rtol < CURVES_RTOL or type(options.solver) is not dfx.Tsit5:
         return None
     reason = similarity_reason(law, options.separation, g_is_zero=False, gravity_table=True)
@@ -76,12 +84,37 @@ def _gravity_key(law, options: ImpactOptions):
     return WithGravity(curve_key(*shape_of(law), options.separation))
 
 
-def _contact(law, m, v_in, g, ts_local, options: ImpactOptions):
+def _contact(law, m, v_in, g, ts_local, options: ImpactOptions, active=True):
     """One contact at impact speed `v_in` with gravity `g`: the `ImpactResult`, the
     penetration at separation (m; > 0 when the force criterion ends contact inside the
     surface), and, with `ts_local` (s from first touch), the histories on that grid.
-    Without histories a contact whose `(beta, gamma)` the gravity table holds is read off
-    it, as `impact` does (`gravity_impact`; the others are integrated)."""
+    Without histories a law whose exact solution holds under gravity (its row's
+    `closed_form_gravity`: Kelvin-Voigt, Bingham 7 and 9, Maxwell) takes it, as `impact`
+    does, unless `options.closed_form` is off (`bounce(..., method="integrate")`), and
+    only where the contact is `active` (zeros elsewhere: a contact after the end of the
+    drop costs nothing, but under `vmap`); else a contact whose `(beta, gamma)` the
+    gravity table holds is read off it (`gravity_impact`); the others are integrated."""
+    closed = None
+    if ts_local is None and options.closed_form:
+        closed = law.closed_form(options.separation, g_is_zero=False)
+    if closed is not None:
+
+        def exact(v_in):
+            fields = closed(
+                law, m=m, v0=v_in, g=g, rest_tol=options.rest_tol, tau_max=options.tau_max,
+                with_end=True,
+            )  # fmt: skip
+            if not options.peaks:  # as the integrated path under peaks=False
+                fields = {k: v for k, v in fields.items() if k not in ("x_max", "t_max", "F_max")}
+            return fields
+
+        def idle(v_in):
+            shapes = jax.eval_shape(exact, v_in)
+            return jax.tree.map(lambda a: jnp.zeros(a.shape, a.dtype), shapes)
+
+        fields = jax.lax.cond(active, exact, idle, v_in)
+        x_end = fields.pop("x_end")
+        return ImpactResult(**fields, path="closed_form"), x_end
     dynamics = law.dynamics(m=m, v0=v_in, g=g)
     key = None if ts_local is not None else _gravity_key(law, options)
     if key is not None:
@@ -127,7 +160,7 @@ def chain(law, m, g, drag, start, t_end, min_flight, ts, options: BounceOptions)
         hit = active & ~too_late & ~too_short
         v_safe = jnp.where(hit, v_in, 1.0)
         local = None if ts is None else ts - jnp.where(hit, t_land, 0.0)
-        contact, x_end = _contact(law, m, v_safe, g, local, options.impact)
+        contact, x_end = _contact(law, m, v_safe, g, local, options.impact, active=hit)
         separated = contact.status == Status.separated
         t_out = t_land + contact.T
         after = Flight.from_state(t_out, -x_end, -contact.v_out, g=g, drag=drag)
@@ -427,11 +460,14 @@ def bounce_options(
     rest_tol=1e-9,
     adjoint=None,
     peaks=True,
+    method="auto",
 ) -> BounceOptions:
     """The static options of a bounce (see `bounce`); `adjoint` defaults to diffrax's
     `RecursiveCheckpointAdjoint`."""
     if separation not in SEPARATIONS:
         raise ValueError(f"separation must be one of {SEPARATIONS}, got {separation!r}")
+    if method not in BOUNCE_METHODS:
+        raise ValueError(f"method must be one of {BOUNCE_METHODS}, got {method!r}")
     _check_count("max_impacts", max_impacts)
     _check_count("max_steps", max_steps)
     _check_tolerance("rtol", rtol, below_one=True)
@@ -451,7 +487,9 @@ def bounce_options(
     return BounceOptions(
         impact=ImpactOptions(
             separation=separation,
-            closed_form=False,
+            # a bounce takes each contact's exact solution (or the gravity table) where
+            # its law has one, unless told to integrate
+            closed_form=method == "auto",
             solver=dfx.Tsit5() if solver is None else solver,
             rtol=rtol,
             atol=atol,
@@ -485,6 +523,7 @@ def bounce(
     rest_tol: float = 1e-9,
     adjoint: dfx.AbstractAdjoint | None = None,
     peaks: bool = True,
+    method: str = "auto",
     throw: bool = False,
 ) -> BounceResult:
     """A ball of mass `m` (kg) released at height `h0` (m) above a floor at `t = 0`, with
@@ -493,10 +532,10 @@ def bounce(
     The seed paper's system (17) (Polukoshko et al. 2007, section 7): `m y'' = -m g + N`,
     with the contact force `N` of `law` while the ball presses into the floor. Each free
     flight is solved in closed form (a parabola; with `drag`, the closed form of
-    `u' = -g - k u |u|`), each contact by one event-terminated impact solve of
-    `m x'' = -F(x, x') + m g` from first touch to separation (the solve of `jaximpact.impact`
-    with gravity). A contact that ends with the surface still pressed in (force criterion)
-    starts its flight at that depth.
+    `u' = -g - k u |u|`), each contact by one impact solve of `m x'' = -F(x, x') + m g`
+    from first touch to separation (the solve of `jaximpact.impact` with gravity). A
+    contact that ends with the surface still pressed in (force criterion) starts its
+    flight at that depth.
 
     - `separation`: `"force"` (the floor stops pushing) or `"penetration"` (x back to 0),
       as in `impact`.
@@ -512,6 +551,11 @@ def bounce(
       default picks the cheapest diffrax adjoint for the transformation in use
       (`ForwardMode` under `jax.jacfwd`). Tolerances must lie in (0, 1), `tau_max` be > 0,
       `max_steps` and `max_impacts` integers >= 1 (a ValueError otherwise).
+    - `method`: `"auto"` takes each contact from the law's exact solution with gravity where
+      its row has one (Kelvin-Voigt, Bingham 7 and 9, Maxwell: no ODE solve, `num_steps`
+      0; `height`, `velocity` and `force` at given times still integrate them), else from
+      the gravity table where it holds, else integrates; `"integrate"` integrates every
+      contact.
     - `h0 = 0` needs a downward (or upward) `v_drop`: a ball at rest on the floor is refused.
     - `throw`: raise if the sequence failed or ran out of `max_impacts`; by default an
       eager call whose sequence failed (a contact's solve ran out of steps or failed) warns,
@@ -575,6 +619,7 @@ def bounce(
         rest_tol=rest_tol,
         adjoint=adjoint,
         peaks=peaks,
+        method=method,
     )
     start = (jnp.zeros(()), h0, -v_drop)
     result = solve_bounce(law, m, g, drag, start, t_end, min_flight, options)

@@ -45,7 +45,7 @@ def solve_impact(law, m, v0, g, ts, options: ImpactOptions) -> ImpactResult:
     if options.closed_form:
         # gravity reaches here only for a law whose closed form holds for every g
         closed = law.closed_form(options.separation)
-        fields = closed(law, m=m, v0=v0, g=g, rest_tol=options.rest_tol)
+        fields = closed(law, m=m, v0=v0, g=g, rest_tol=options.rest_tol, tau_max=options.tau_max)
         return ImpactResult(**fields, path="closed_form")
     from .phases import integrated_contact
 
@@ -236,7 +236,8 @@ def impact(
     - `ts`: times (s from first touch) at which to return `x`, `v`, `F`; nothing is stored
       otherwise.
     - `method`: `"auto"` uses an exact closed form where one holds for every parameter value
-      (Kelvin-Voigt, with `g = 0` and no `ts`), else the universal curves where the impact
+      and no `ts` is asked (Kelvin-Voigt, Bingham 7 and 9, Maxwell: any `g`; Thornton and
+      JKR: `g = 0`), else the universal curves where the impact
       depends on one group `beta` (a one-group law of the table, `g = 0`, no `ts`, no
       `solver` chosen, `rtol >= 1e-11`, and a shape whose impacts always separate; see
       `options.choose_path`), else integrates. `"integrate"` always integrates,

@@ -121,7 +121,8 @@ def restitution_map(
         params["a"] = np.asarray(factor, dtype=float) / 1.5
         name = "hunt_crossley"
 
-    out = exact_batch(name, params, m=m, v0=v0, separation=separation) if method == "auto" else None
+    made = law(name, **params)
+    out = exact_batch(made, m=m, v0=v0, separation=separation) if method == "auto" else None
     path = "closed_form"
     if out is None:
         out = impact_batch(

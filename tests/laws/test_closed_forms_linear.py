@@ -327,6 +327,7 @@ def test_without_gravity_equals_the_kelvin_voigt_formulas():
         ("bingham", dict(c=2e6, b=200.0, P=400.0), 9.81),
         ("bingham_compression", dict(c=2e6, P=400.0), 9.81),
         ("maxwell", dict(c=2e6, b=2000.0), 0.0),
+        ("maxwell", dict(c=2e6, b=2000.0), 9.81),
     ],
 )
 @pytest.mark.parametrize("separation", SEPARATIONS)
@@ -343,12 +344,13 @@ def test_impact_takes_the_closed_form(law, params, g, separation):
     assert made.closed_form(separation, g_is_zero=g == 0) is not None
 
 
-def test_maxwell_with_gravity_is_integrated():
+def test_maxwell_with_gravity_is_exact_too():
+    """Maxwell's row holds with gravity (`closed_forms_linear.maxwell_gravity_impact`;
+    checked in test_closed_forms_maxwell_gravity.py)."""
     made = ji.law("maxwell", c=2e6, b=2000.0)
-    assert made.closed_form("force", g_is_zero=False) is None
+    assert made.spec.closed_form_gravity
+    assert made.closed_form("force", g_is_zero=False) is not None
     assert made.closed_form("force", g_is_zero=True) is not None
-    with pytest.raises(ValueError, match="no closed form for law 'maxwell'"):
-        ji.impact(made, m=1.0, v0=2.5, g=9.81, method="closed_form")
 
 
 def test_impact_fields_dissipated_energy_and_vmap():
