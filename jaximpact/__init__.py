@@ -77,6 +77,27 @@ _PUBLIC.update(
         "Export": "_engines",
     }
 )
+# oblique impacts: tangential laws, oblique_impact, fit_oblique (issue 27)
+_PUBLIC.update(
+    dict.fromkeys(
+        (
+            "tangential_law",
+            "TANGENTIAL_LAW_NAMES",
+            "TANGENTIAL_LAWS",
+            "AbstractTangentialLaw",
+            "LinearHistoryLaw",
+            "MindlinLaw",
+            "oblique_impact",
+            "ObliqueResult",
+            "rigid_oblique",
+            "incidence",
+            "two_spheres",
+            "fit_oblique",
+            "ObliqueFit",
+        ),
+        "_oblique",
+    )
+)
 _SUBMODULES = ("closed_forms",)
 
 __all__ = sorted([*_PUBLIC, *_SUBMODULES])

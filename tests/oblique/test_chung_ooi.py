@@ -1,0 +1,249 @@
+"""Chung & Ooi (2011)'s particle-impact benchmarks and Kharaz, Gorham & Salman (2001)'s
+oblique impacts, with the inputs and the expected numbers of
+shared/notes/contact-physics.md, sections 1 and 4 (the digitised curves as Kratos
+DEMApplication stores them, `tests/DEM3D_chung_ooi_tests`).
+
+- Tests 1-3 (normal impacts): exact Hertz answers (T) and the restitution a damping set
+  for `e_in` delivers, through `oblique_impact`.
+- Test 4 (Kharaz's alumina sphere, 3.9 m/s, 5-85 degrees): Hertz-Mindlin against the
+  reference curves (e_t, spin, the contact point's rebound angle), and beyond the rigid
+  transition (32.5 degrees) against the rigid-body theory and Kharaz's measurements.
+- Test 5 (gross-sliding plateau) and Test 6 (gross-sliding branch, x < 1): the exact parts.
+  Their stick and micro-slip branches are compared in docs/oblique.md, not asserted: the
+  digitised curves there need a tangential damping this library's Mindlin law lacks (Test
+  6) or disagree with Test 4's own reference at the same psi (Test 5).
+- Test 7 is in test_oblique_impact.py; Test 8 (its partner sphere's size and density
+  are not in the public inputs) is not done.
+"""
+
+import functools
+
+import numpy as np
+import pytest
+
+import jaximpact as ji
+from jaximpact._oblique import incidence, oblique_impact, rigid_oblique, tangential_law, two_spheres
+
+pytestmark = pytest.mark.slow
+
+HERTZ_T = 3.2180654597  # T = 3.218 (m*^2 / (c^2 v))^(1/5) for an undamped Hertz contact
+
+
+def sphere(E, nu, rho, R):
+    """Mass, Hertz stiffness on a rigid plane and shear modulus of a sphere."""
+    m = rho * 4.0 / 3.0 * np.pi * R**3
+    return m, 4.0 / 3.0 * E / (1 - nu**2) * np.sqrt(R), E / (2 * (1 + nu))
+
+
+@functools.cache
+def tsuji_damping(e, c, m, v0):
+    """The damping `b` of `c x^1.5 + b x^0.25 v` whose restitution is `e` (independent of
+    the speed for this law; bisection on `impact`)."""
+    lo, hi = 0.0, 10.0 * np.sqrt(m * c)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        found = float(ji.impact(ji.law("tsuji", c=c, b=mid), m=m, v0=v0).e)
+        lo, hi = (mid, hi) if found > e else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+@pytest.mark.parametrize(
+    "test, E, nu, rho, R, v, T_table",
+    [
+        ("1 glass", 48e9, 0.20, 2800.0, 0.010, 20.0, 40.339e-6),
+        ("1 limestone", 20e9, 0.25, 2500.0, 0.010, 20.0, 54.20e-6),
+        ("2 Al alloy", 70e9, 0.30, 2699.0, 0.10, 0.2, 731.66e-6),
+        ("2 Mg alloy", 40e9, 0.35, 1800.0, 0.10, 0.2, 767.07e-6),
+    ],
+)
+def test_normal_hertz(test, E, nu, rho, R, v, T_table):
+    """Tests 1 (two identical spheres: m* = m/2, R* = R/2) and 2 (a sphere on a rigid
+    plane): e = 1 and the Hertz contact time, with friction on and no tangential motion."""
+    m = rho * 4.0 / 3.0 * np.pi * R**3
+    if test.startswith("1"):
+        eff = two_spheres(m, R, m, R)
+        E_star = E / (2 * (1 - nu**2))
+    else:
+        eff = dict(m=m, R=R, inertia=0.4)
+        E_star = E / (1 - nu**2)
+    c = 4.0 / 3.0 * E_star * np.sqrt(eff["R"])
+    tl = tangential_law("mindlin", G=E / (2 * (1 + nu)), nu=nu, mu=0.35)
+    r = oblique_impact(ji.law("hunt_crossley", c=c, a=0.0), tl, **eff, v_n=v, v_t=0.0)
+    T_hertz = HERTZ_T * (eff["m"] ** 2 / (c**2 * v)) ** 0.2
+    assert float(r.e) == pytest.approx(1.0, abs=1e-9)
+    assert float(r.T) == pytest.approx(T_hertz, rel=1e-9)
+    assert float(r.T) == pytest.approx(T_table, rel=2e-4)  # the notes' 5 digits
+
+
+@pytest.mark.parametrize("material", [(380e9, 0.23, 4000.0), (100e9, 0.25, 7000.0)])
+def test_restitution_delivered(material):
+    """Test 3: a damping set for e_in gives e_out = e_in (the identity line), obliquely too
+    (a rigid plane: the tangential contact does not touch the normal one)."""
+    m, c, G = sphere(*material, 2.5e-3)
+    tl = tangential_law("mindlin", G=G, nu=material[1], mu=0.0)
+    for e_in in (0.2, 0.6, 1.0):
+        b = tsuji_damping(e_in, c, m, 3.9) if e_in < 1 else 0.0
+        law = ji.law("tsuji", c=c, b=b)
+        for v_t in (0.0, 2.0):
+            r = oblique_impact(law, tl, m=m, R=2.5e-3, v_n=3.9, v_t=v_t)
+            assert float(r.e) == pytest.approx(e_in, abs=1e-9)
+            if v_t:  # mu = 0: no tangential force at all
+                assert float(r.v_t_out) == v_t and float(r.omega_out) == 0.0
+
+
+# Test 4, Al oxide on a rigid plane (Kratos Materials4: wall E = 7e20): the reference curves
+# (Kratos `benchmark4_graph1_ref.dat`, graph2 and graph3 as digitised in the notes)
+THETA_4 = [5.17, 10.16, 14.99, 20.06, 25.05, 30.12, 35.03, 40.02, 50.0, 59.98, 69.96, 80.02, 85.01]
+E_T_4 = [0.948, 0.687, 0.624, 0.616, 0.634, 0.684, 0.737, 0.781, 0.845, 0.893, 0.932, 0.966, 0.983]
+OMEGA_4 = [-19, -213, -378, -511, -599, -617, -582, -545, -457, -357, -246, -126, -63]
+ANGLE_4 = [3.8, -1.6, -5.5, -7.5, -7.5, -3.5, 3.4, 11.6, 29.4, 47.8, 64.6, 78.7, 84.5]
+ALUMINA = (380e9, 0.23, 4000.0)
+
+
+@functools.cache
+def sweep_4(name="mindlin", anvil=None):
+    """e, e_t, spin (rad/s, the reference's sign), contact-point rebound angle (degrees)
+    and the centre's, the number of switches, at THETA_4 (or the given anvil's Kharaz
+    angles); `anvil`: (E, nu) of an elastic plane (Kharaz's glass), None: rigid."""
+    R = 2.5e-3
+    m, c, G = sphere(*ALUMINA, R)
+    extra = {}
+    if anvil is not None:
+        E2, nu2 = anvil
+        E_star = 1 / ((1 - ALUMINA[1] ** 2) / ALUMINA[0] + (1 - nu2**2) / E2)
+        c = 4.0 / 3.0 * E_star * np.sqrt(R)
+        extra = dict(G2=E2 / (2 * (1 + nu2)), nu2=nu2)
+    law = ji.law("tsuji", c=c, b=tsuji_damping(0.98, c, m, 3.9))
+    tl = tangential_law(name, G=G, nu=ALUMINA[1], mu=0.092, **extra)
+    rows = []
+    thetas = THETA_4 if anvil is None else KHARAZ_THETA
+    for theta in thetas:
+        v_n, v_t = (float(v) for v in incidence(3.9, np.deg2rad(theta)))
+        r = oblique_impact(law, tl, m=m, R=R, v_n=v_n, v_t=v_t)
+        assert r.status_name == "separated"
+        rows.append((float(r.e), float(r.e_t), -float(r.omega_out),
+                     np.rad2deg(float(r.angle_out_contact)), np.rad2deg(float(r.angle_out)),
+                     int(r.num_switches)))  # fmt: skip
+    return np.array(rows)
+
+
+def test4_against_the_reference_curves():
+    """Hertz-Mindlin (displacement history) reproduces the Test 4 reference: e_t within
+    0.01, the spin within 6 rad/s, the contact point's rebound angle within 1 degree
+    (measured: 0.009, 5 rad/s, 0.9 degrees)."""
+    rows = sweep_4("mindlin")
+    assert np.allclose(rows[:, 0], 0.98, atol=1e-9)
+    assert np.max(np.abs(rows[:, 1] - E_T_4)) < 0.01
+    assert np.max(np.abs(rows[:, 2] - OMEGA_4)) < 6.0
+    assert np.max(np.abs(rows[:, 3] - ANGLE_4)) < 1.0
+    # the micro-slip dip: e_t least near 20 degrees, the contact point reversed (< 0)
+    assert np.argmin(rows[:, 1]) == 3 and np.all(rows[2:5, 3] < -4.0)
+    # force history: the same beyond the rigid transition, 0.06 off at 5 degrees
+    force = sweep_4("mindlin_force")
+    assert np.allclose(force[6:, 1], rows[6:, 1], atol=1e-6)
+    assert np.max(np.abs(force[:, 1] - E_T_4)) < 0.07
+
+
+def test4_gross_sliding_is_rigid():
+    """Beyond tan(theta) = 3.5 mu (1 + e) (32.5 degrees) the contact slides throughout
+    (after a first-touch stick that the damping's x^0.25 gives, 1e-4 of the impulse):
+    e_t and the angles are the rigid-body ones."""
+    rows = sweep_4("mindlin")
+    for k, theta in enumerate(THETA_4):
+        if theta < 33.0:
+            continue
+        v_n, v_t = (float(v) for v in incidence(3.9, np.deg2rad(theta)))
+        rigid = rigid_oblique(mu=0.092, e=rows[k, 0], v_n=v_n, v_t=v_t, R=2.5e-3)
+        assert bool(rigid["sliding"])
+        assert rows[k, 1] == pytest.approx(float(rigid["e_t"]), abs=2e-4)
+        assert rows[k, 3] == pytest.approx(np.rad2deg(float(rigid["angle_out_contact"])), abs=0.02)
+
+
+# Kharaz et al. (2001), alumina on soda-lime glass (E = 70 GPa, nu = 0.25), as Lethe
+# digitised them (notes 4.2): incidence, e_t; incidence, rebound angle of the centre
+KHARAZ_THETA = [39.38, 49.69, 60.02]
+KHARAZ_E_T = [0.771, 0.848, 0.901]
+KHARAZ_ANGLE = [(39.54, 32.61), (49.75, 45.13), (60.21, 57.47)]
+
+
+def test_kharaz_measurements_beyond_the_transition():
+    """Where the rigid theory holds (theta >= 40 degrees, Kharaz's own conclusion), the
+    computed e_t is within 0.01 of the measured one and the centre's rebound angle within
+    1 degree."""
+    rows = sweep_4("mindlin", anvil=(70e9, 0.25))
+    assert np.max(np.abs(rows[:, 1] - KHARAZ_E_T)) < 0.01
+    m, c, _ = sphere(*ALUMINA, 2.5e-3)
+    for theta, measured in KHARAZ_ANGLE:
+        v_n, v_t = (float(v) for v in incidence(3.9, np.deg2rad(theta)))
+        rigid = rigid_oblique(mu=0.092, e=0.98, v_n=v_n, v_t=v_t, R=2.5e-3)
+        assert np.rad2deg(float(rigid["angle_out"])) == pytest.approx(measured, abs=1.0)
+    # and the elastic anvil changes nothing there (gross sliding): the rigid plane's e_t
+    rigid_plane = sweep_4("mindlin")
+    assert rows[0, 1] == pytest.approx(np.interp(39.38, THETA_4, rigid_plane[:, 1]), abs=0.01)
+
+
+def test5_gross_sliding_plateau():
+    """Test 5 (steel and polyethylene, R = 10 um, V_n = 5 m/s, mu = 0.3, e = 1): beyond
+    psi = V_st / (mu V_cn) = 7 the contact slides throughout and R omega' / (mu V_cn) is
+    the rigid -2.5 (1 + e) = -5 (the reference's sign) to 1e-9; the digitised curves
+    (-5.004, -4.991 steel; -4.963, -4.942 polyethylene at psi = 10, 20) within 0.06."""
+    R, v_n, mu = 1e-5, 5.0, 0.3
+    for material, digitised in (((208e9, 0.30, 7850.0), (-5.004, -4.991)),
+                                ((1e9, 0.40, 1400.0), (-4.963, -4.942))):  # fmt: skip
+        m, c, G = sphere(*material, R)
+        tl = tangential_law("mindlin", G=G, nu=material[1], mu=mu)
+        law = ji.law("hunt_crossley", c=c, a=0.0)
+        for psi, expected in zip((10.0, 20.0), digitised, strict=True):
+            r = oblique_impact(law, tl, m=m, R=R, v_n=v_n, v_t=psi * mu * v_n)
+            assert int(r.num_switches) == 0
+            spin = -R * float(r.omega_out) / (mu * v_n)
+            assert spin == pytest.approx(-5.0, rel=1e-9)
+            assert spin == pytest.approx(expected, abs=0.06)
+
+
+# Test 6 (Al alloy, R = 0.1 m, V_n = 0.2 m/s, mu = 0.4, e = 0.5, spin only): beta against
+# x = 3.5 mu (1 + e) V_n / V_st, the first points of Kratos' benchmark8_graph1 "Test 6"
+X_6 = [0.18716577540106982, 0.35828877005347604, 0.550802139037434, 0.764705882352942,
+       0.97860962566845]  # fmt: skip
+BETA_6 = [-0.8152230971128611, -0.6262467191601051, -0.43937007874015754,
+          -0.23779527559055114, -0.017322834645669194]  # fmt: skip
+
+
+def test6_gross_sliding_branch():
+    """For x < 1 the rigid contact slides throughout: beta = x - 1. The Tsuji damping
+    (x^0.25) makes the compliant contact stick for its first instants, which costs up to
+    0.015 in beta (at x = 0.98); the digitised curve within 0.025."""
+    R, v_n, mu, e = 0.1, 0.2, 0.4, 0.5
+    m, c, G = sphere(70e9, 0.33, 2700.0, R)
+    law = ji.law("tsuji", c=c, b=tsuji_damping(e, c, m, v_n))
+    tl = tangential_law("mindlin", G=G, nu=0.33, mu=mu)
+    for x, digitised in zip(X_6, BETA_6, strict=True):
+        u = 3.5 * mu * (1 + e) * v_n / x
+        r = oblique_impact(law, tl, m=m, R=R, v_n=v_n, v_t=0.0, omega=-u / R)
+        beta = -float(r.e_t_contact)
+        assert float(r.e) == pytest.approx(e, abs=1e-9)
+        assert beta == pytest.approx(x - 1.0, abs=0.02)
+        assert beta == pytest.approx(digitised, abs=0.025)
+
+
+def test_coulomb_bound_everywhere():
+    """The tangential impulse never exceeds mu times the normal one (the normal force of
+    these laws never pulls): incidence 1-89 degrees, three tangential laws, the damping
+    (x^0.25) that makes the contact stick at first touch. Before the first `FIRST_TOUCH`
+    of every contact was integrated apart, a change of mode inside the solver's first
+    step went unseen at 85 degrees and e_t came out 0.37 instead of 0.98."""
+    R = 2.5e-3
+    m, c, G = sphere(*ALUMINA, R)
+    law = ji.law("tsuji", c=c, b=tsuji_damping(0.98, c, m, 3.9))
+    for tl in (tangential_law("mindlin", G=G, nu=ALUMINA[1], mu=0.092),
+               tangential_law("mindlin_force", G=G, nu=ALUMINA[1], mu=0.092),
+               tangential_law("linear_history", kt=1e9, mu=0.092)):  # fmt: skip
+        for theta in np.linspace(1.0, 89.0, 23):
+            v_n, v_t = (float(v) for v in incidence(3.9, np.deg2rad(theta)))
+            r = oblique_impact(law, tl, m=m, R=R, v_n=v_n, v_t=v_t)
+            assert r.status_name == "separated", (tl.name, theta)
+            bound = 0.092 * float(r.impulse_n) * (1 + 1e-9)
+            assert abs(float(r.impulse_t)) <= bound, (tl.name, theta)
+            if theta > 35.0:  # gross sliding: the rigid theory
+                rigid = rigid_oblique(mu=0.092, e=float(r.e), v_n=v_n, v_t=v_t, R=R)
+                assert float(r.e_t) == pytest.approx(float(rigid["e_t"]), abs=2e-6)

@@ -1,0 +1,332 @@
+"""`oblique_impact` against the impulse theory (gross sliding, exact), a closed form with
+one stick-slip transition (linear normal and tangential springs), an independent scipy
+solve (DOP853, rtol 1e-12, event-handled Coulomb law), and finite differences.
+
+Each (normal law, tangential law) pair compiles once (about 15 s; 30 s with gradients),
+so the solves are marked slow; the input checks and the rigid theory are fast."""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+from oblique_oracle import oblique_oracle
+from scipy.optimize import brentq
+
+import jaximpact as ji
+from jaximpact._oblique import (
+    incidence,
+    oblique_impact,
+    rigid_oblique,
+    tangential_law,
+    two_spheres,
+)
+
+# Kharaz et al.'s alumina sphere (Chung & Ooi Test 4) on a rigid plane
+E, NU, RHO, R = 380e9, 0.23, 4000.0, 2.5e-3
+M = RHO * 4.0 / 3.0 * np.pi * R**3
+C = 4.0 / 3.0 * E / (1 - NU**2) * np.sqrt(R)
+G_STAR = E / (2 * (1 + NU)) / (2 - NU)
+HERTZ = dict(c=C, a=0.0)
+
+
+def hertz(a=0.0):
+    return ji.law("hunt_crossley", c=C, a=a)
+
+
+# --------------------------------------------------------------------------- fast
+
+
+def test_rigid_theory_limits():
+    """Gross sliding: the slip falls by mu (1 + e) v_n (1 + 1/inertia); rolling from rest
+    keeps 5/7 of v_t (a solid sphere)."""
+    out = rigid_oblique(mu=0.1, e=0.8, v_n=2.0, v_t=3.0, R=0.01, omega=5.0)
+    assert bool(out["sliding"])
+    assert float(out["v_t_out"]) == pytest.approx(3.0 - 0.1 * 1.8 * 2.0)
+    assert float(out["u_out"]) == pytest.approx(3.0 - 0.05 - 0.1 * 1.8 * 2.0 * 3.5)
+    rolling = rigid_oblique(mu=0.5, e=0.8, v_n=2.0, v_t=0.3, R=0.01)
+    assert not bool(rolling["sliding"])
+    assert float(rolling["e_t"]) == pytest.approx(5.0 / 7.0)
+    assert float(rolling["u_out"]) == pytest.approx(0.0, abs=1e-15)
+
+
+def test_two_spheres_effective_values():
+    m1, R1, m2, R2 = 0.0117, 0.01, 0.05, 0.03
+    eff = two_spheres(m1, R1, m2, R2, 0.4, 2.0 / 3.0)
+    m = m1 * m2 / (m1 + m2)
+    assert eff["m"] == pytest.approx(m) and eff["R"] == pytest.approx(R1 * R2 / (R1 + R2))
+    # the contact points' relative slip responds to an impulse J with 1/m1 + 1/m2 + R^2/I
+    slip_compliance = 1 / m1 + 1 / m2 + 1 / (0.4 * m1) + 1 / (2.0 / 3.0 * m2)
+    assert (1 + 1 / eff["inertia"]) / eff["m"] == pytest.approx(slip_compliance)
+    assert two_spheres(0.0117, 0.01, 0.0117, 0.01)["inertia"] == pytest.approx(0.4)
+
+
+def test_incidence_refuses_degrees():
+    v_n, v_t = incidence(3.9, jnp.deg2rad(30.0))
+    assert float(v_n) == pytest.approx(3.9 * np.cos(np.pi / 6))
+    assert float(v_t) == pytest.approx(3.9 * 0.5)
+    with pytest.raises(ValueError, match="not in radians"):
+        incidence(3.9, 30.0)
+    with pytest.raises(ValueError, match="not in radians"):
+        incidence(3.9, np.array([0.1, 45.0]))
+
+
+@pytest.mark.parametrize(
+    "kwargs, error, match",
+    [
+        (dict(m=0.0), ValueError, "mass m must be a finite number > 0"),
+        (dict(R=-1e-3), ValueError, "radius R must be a finite number > 0"),
+        (dict(v_n=-1.0), ValueError, "normal speed v_n"),
+        (dict(v_t=float("nan")), ValueError, "tangential speed v_t must be a finite number"),
+        (dict(inertia=0.0), ValueError, "inertia factor"),
+        (dict(g=-9.81), ValueError, "gravity g must be a finite number >= 0"),
+        (dict(v_t=jnp.ones(3)), ValueError, "use jax.vmap for a batch"),
+        (dict(separation="contact"), ValueError, "separation must be one of"),
+        (dict(rtol=0.0), ValueError, "rtol must be a number in"),
+        (dict(max_segments=0), ValueError, "max_segments must be a whole number"),
+    ],
+)
+def test_bad_input(kwargs, error, match):
+    base = dict(m=M, R=R, v_n=3.0, v_t=1.0)
+    tl = tangential_law("linear_history", kt=1e7, mu=0.1)
+    with pytest.raises(error, match=match) as info:
+        oblique_impact(hertz(), tl, **{**base, **kwargs})
+    assert "\n" not in str(info.value)
+
+
+def test_laws_in_the_wrong_places():
+    tl = tangential_law("linear_history", kt=1e7, mu=0.1)
+    base = dict(m=M, R=R, v_n=3.0, v_t=1.0)
+    with pytest.raises(ValueError, match="takes the normal law first"):
+        oblique_impact(tl, tl, **base)
+    with pytest.raises(ValueError, match="needs a tangential law second.*got nothing"):
+        oblique_impact(hertz(), None, **base)
+    with pytest.raises(ValueError, match="got the normal law 'hunt_crossley'"):
+        oblique_impact(hertz(), hertz(), **base)
+    with pytest.raises(TypeError, match="normal law from jaximpact.law"):
+        oblique_impact("hertz", tl, **base)
+
+
+# --------------------------------------------------------------------------- slow
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("a", [0.0, 0.02])
+@pytest.mark.parametrize("v_t, omega", [(2.5, 0.0), (-2.0, 300.0), (0.5, -900.0)])
+def test_gross_sliding_is_the_impulse_result(a, v_t, omega):
+    """A stiff spring and little friction: the contact slides throughout, and the
+    tangential impulse is mu times the normal one, `mu m (1 + e) v_n`, exactly."""
+    tl = tangential_law("linear_history", kt=1e10, mu=0.05)
+    v_n = 3.0
+    r = oblique_impact(hertz(a), tl, m=M, R=R, v_n=v_n, v_t=v_t, omega=omega)
+    assert r.status_name == "separated" and int(r.num_switches) == 0
+    normal = ji.impact(hertz(a), m=M, v0=v_n, method="integrate", rtol=1e-12)
+    assert float(r.e) == pytest.approx(float(normal.e), rel=2e-9)
+    assert float(r.T) == pytest.approx(float(normal.T), rel=2e-9)
+    theory = rigid_oblique(mu=0.05, e=r.e, v_n=v_n, v_t=v_t, R=R, omega=omega)
+    assert bool(theory["sliding"])
+    for key in ("v_t_out", "omega_out", "u_out"):
+        assert float(getattr(r, key)) == pytest.approx(float(theory[key]), rel=1e-9, abs=1e-12)
+    assert float(r.impulse_t) == pytest.approx(
+        -np.sign(v_t - R * omega) * 0.05 * float(r.impulse_n)
+    )
+
+
+def _linear_closed_form(K, mu, U0, inertia=0.4):
+    """Kelvin-Voigt without damping (`X = sin tau`, contact over [0, pi]) and a constant
+    tangential spring `K` (units of c): the slip `U = U0 cos(w tau)`, `w^2 = K (1 + 1/inertia)`,
+    sticks while `K U0 |sin(w tau)| / w <= mu sin(tau)`; then it slides, the slip falling
+    by `s mu (1 + 1/inertia) (cos tau_s + 1)`. Returns `(U_out, tau_s)`; checks that it
+    does not stick again."""
+    a = 1.0 + 1.0 / inertia
+    w = np.sqrt(K * a)
+
+    def margin(t):
+        return K * U0 * abs(np.sin(w * t)) / w - mu * np.sin(t)
+
+    grid = np.linspace(1e-6, np.pi - 1e-9, 400001)
+    i = int(np.argmax(margin(grid) > 0))
+    tau_s = brentq(margin, grid[i - 1], grid[i], xtol=1e-15)
+    s = np.sign(np.sin(w * tau_s))
+    slip = U0 * np.cos(w * tau_s)
+    later = np.linspace(tau_s, np.pi, 20001)
+    sliding = slip - s * mu * a * (np.cos(tau_s) - np.cos(later))
+    assert np.all(s * K * sliding - mu * np.cos(later) > 0), "it sticks again"
+    return slip - s * mu * a * (np.cos(tau_s) + 1.0), tau_s
+
+
+LINEAR = dict(m=0.1, c=1e6, v_n=1.0, R=0.01)
+
+
+def _linear_impact(kt, mu, v_t, land_events=None):
+    law = ji.law("kelvin_voigt", c=LINEAR["c"], b=0.0)
+    tl = tangential_law("linear_history", kt=kt, mu=mu)
+    return oblique_impact(law, tl, m=LINEAR["m"], R=LINEAR["R"], v_n=LINEAR["v_n"], v_t=v_t,
+                          land_events=land_events)  # fmt: skip
+
+
+@pytest.mark.slow
+def test_one_transition_closed_form():
+    """Stick, then slide: the transition time and the rebound exactly (1e-9)."""
+    c, K, mu, U0 = LINEAR["c"], 2.25 / 3.5, 0.5, 0.5
+    u_out, _ = _linear_closed_form(K, mu, U0)
+    r = _linear_impact(K * c, mu, U0)
+    assert r.status_name == "separated" and int(r.num_switches) == 1
+    assert float(r.u_out) == pytest.approx(u_out, abs=2e-9)
+    assert float(r.v_t_out) == pytest.approx(U0 + (u_out - U0) / 3.5, abs=1e-9)
+    assert float(r.T) == pytest.approx(np.pi * np.sqrt(LINEAR["m"] / c), rel=1e-11)
+    # w = 1 and w = 2 (K U0 <= mu): the spring sticks throughout, and the slip leaves
+    # reversed / intact
+    for w, expected in ((1.0, -U0), (2.0, U0)):
+        r = _linear_impact(w**2 / 3.5 * c, 1.0, U0)
+        assert int(r.num_switches) == 0
+        assert float(r.u_out) == pytest.approx(expected, abs=1e-9)
+
+
+@pytest.mark.slow
+def test_gradient_through_a_transition():
+    """d u_out / d(kt, mu) across the stick-slip transition: against central differences
+    of the closed form (1e-7 relative), and of the solve itself."""
+    c, K, mu, U0 = LINEAR["c"], 2.25 / 3.5, 0.5, 0.5
+    kt = K * c
+    grad = jax.grad(lambda kt, mu: _linear_impact(kt, mu, U0).u_out, argnums=(0, 1))(kt, mu)
+    h = 1e-5
+    fd_kt = (_linear_closed_form(K * (1 + h), mu, U0)[0]
+             - _linear_closed_form(K * (1 - h), mu, U0)[0]) / (2 * h * kt)  # fmt: skip
+    fd_mu = (_linear_closed_form(K, mu * (1 + h), U0)[0]
+             - _linear_closed_form(K, mu * (1 - h), U0)[0]) / (2 * h * mu)  # fmt: skip
+    assert float(grad[0]) == pytest.approx(fd_kt, rel=1e-7)
+    assert float(grad[1]) == pytest.approx(fd_mu, rel=1e-7)
+    # the solve's own values carry 1e-10 of noise: a wider step (the error of the
+    # difference quotient itself is 4e-6 here)
+    h = 1e-3
+    solve_fd = (float(_linear_impact(kt, mu * (1 + h), U0).u_out)
+                - float(_linear_impact(kt, mu * (1 - h), U0).u_out)) / (2 * h * mu)  # fmt: skip
+    assert float(grad[1]) == pytest.approx(solve_fd, rel=2e-5)
+    # without landing the events (diffrax's interpolant), the same gradient is 1e-4 off
+    plain = jax.grad(lambda mu: _linear_impact(kt, mu, U0, land_events=False).u_out)(mu)
+    assert abs(float(plain) / fd_mu - 1) > 1e-5
+
+
+ORACLE_CASES = [
+    ("mindlin", dict(G_star=G_STAR), dict(G_star=G_STAR, history="displacement")),
+    ("mindlin_force", dict(G_star=G_STAR), dict(G_star=G_STAR, history="force")),
+    ("linear_history", dict(kt=2e7), dict(kt=2e7)),
+]
+
+
+@pytest.mark.slow
+@pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")  # scipy's probes
+@pytest.mark.parametrize("a", [0.0, 0.01])
+@pytest.mark.parametrize("name, params, oracle_params", ORACLE_CASES)
+def test_against_scipy(name, params, oracle_params, a):
+    """Incidence 5-45 degrees at 3.9 m/s (sticking, micro-slip reversal, gross sliding):
+    the same switches, and e, v_t_out, omega_out, T within 1e-8 of scipy's DOP853."""
+    tl = tangential_law(name, mu=0.092, **params)
+    for degrees in (5.0, 12.0, 20.0, 30.0, 45.0):
+        v_n, v_t = incidence(3.9, np.deg2rad(degrees))
+        v_n, v_t = float(v_n), float(v_t)
+        r = oblique_impact(hertz(a), tl, m=M, R=R, v_n=v_n, v_t=v_t, rtol=1e-12)
+        o = oblique_oracle(c=C, a=a, m=M, R=R, inertia=0.4, v_n=v_n, v_t=v_t, omega=0.0,
+                           mu=0.092, **oracle_params)  # fmt: skip
+        what = f"{name}, a = {a}, {degrees} degrees"
+        assert int(r.num_switches) == o["switches"], what
+        assert float(r.e) == pytest.approx(o["e"], rel=1e-8), what
+        assert float(r.v_t_out) == pytest.approx(o["v_t_out"], rel=1e-8), what
+        assert float(r.omega_out) == pytest.approx(o["omega_out"], rel=1e-8), what
+        assert float(r.T) == pytest.approx(o["T"], rel=1e-8), what
+
+
+@pytest.mark.slow
+def test_gradient_mindlin_against_central_differences():
+    """e_t in the micro-slip regime (two transitions) as a function of G*, mu and the
+    speed: jax.grad against central differences of the solve."""
+
+    def e_t(g_star, mu, v_t):
+        tl = tangential_law("mindlin", G_star=g_star, mu=mu)
+        return oblique_impact(hertz(0.01), tl, m=M, R=R, v_n=3.6, v_t=v_t).e_t
+
+    x = (G_STAR, 0.092, 1.3)
+    grads = jax.grad(e_t, argnums=(0, 1, 2))(*x)
+    assert int(oblique_impact(hertz(0.01), tangential_law("mindlin", G_star=G_STAR, mu=0.092),
+                              m=M, R=R, v_n=3.6, v_t=1.3).num_switches) == 2  # fmt: skip
+    for k in range(3):
+        h = 1e-5 * x[k]
+        up = list(x)
+        down = list(x)
+        up[k] += h
+        down[k] -= h
+        fd = (float(e_t(*up)) - float(e_t(*down))) / (2 * h)
+        assert float(grads[k]) == pytest.approx(fd, rel=2e-5, abs=1e-9 / x[k]), k
+
+
+@pytest.mark.slow
+def test_vmap_over_angles_and_jit():
+    """A batch over incidence angles equals the single calls; `jit` gives the same."""
+    tl = tangential_law("mindlin", G_star=G_STAR, mu=0.092)
+    angles = jnp.deg2rad(jnp.array([10.0, 25.0, 60.0]))
+
+    def one(theta):
+        v_n, v_t = incidence(3.9, theta)
+        return oblique_impact(hertz(), tl, m=M, R=R, v_n=v_n, v_t=v_t)
+
+    batch = jax.jit(jax.vmap(one))(angles)
+    for k, theta in enumerate(np.asarray(angles)):
+        v_n, v_t = 3.9 * np.cos(theta), 3.9 * np.sin(theta)
+        single = oblique_impact(hertz(), tl, m=M, R=R, v_n=v_n, v_t=v_t)
+        assert float(batch.e_t[k]) == pytest.approx(float(single.e_t), rel=1e-9)
+        assert float(batch.angle_out_contact[k]) == pytest.approx(
+            float(single.angle_out_contact), rel=1e-9, abs=1e-12
+        )
+    assert np.all(np.asarray(batch.status) == 0)
+    assert "separated 3" in batch.summary()
+
+
+@pytest.mark.slow
+def test_head_on_and_rolling():
+    """v_t = 0, omega = 0: the normal impact (e, T of `impact`) and nothing tangential;
+    rolling without slip (omega = v_t / R): nothing slips, nothing changes."""
+    tl = tangential_law("mindlin", G_star=G_STAR, mu=0.3)
+    law = hertz(0.02)
+    normal = ji.impact(law, m=M, v0=2.0, method="integrate", rtol=1e-12)
+    r = oblique_impact(law, tl, m=M, R=R, v_n=2.0, v_t=0.0)
+    assert float(r.e) == pytest.approx(float(normal.e), rel=1e-9)
+    assert float(r.T) == pytest.approx(float(normal.T), rel=1e-9)
+    assert float(r.v_t_out) == 0.0 and float(r.omega_out) == 0.0
+    assert np.isnan(float(r.e_t)) and float(r.angle_out) == 0.0
+    rolling = oblique_impact(law, tl, m=M, R=R, v_n=2.0, v_t=1.5, omega=1.5 / R)
+    assert float(rolling.u_out) == pytest.approx(0.0, abs=1e-12)
+    assert float(rolling.e_t) == pytest.approx(1.0, rel=1e-12)
+    assert float(rolling.dissipated) == pytest.approx(0.5 * M * 4 * (1 - float(r.e) ** 2), rel=1e-6)
+
+
+@pytest.mark.slow
+def test_two_identical_spheres_spinning_together():
+    """Chung & Ooi Test 7: two equal spheres meeting head-on with opposite spins have no
+    relative slip at the contact, so the spins come out as they went in."""
+    Ea, nua, rho, Ra = 70e9, 0.33, 2700.0, 0.1
+    m = rho * 4 / 3 * np.pi * Ra**3
+    eff = two_spheres(m, Ra, m, Ra)
+    c = 4 / 3 * Ea / (2 * (1 - nua**2)) * np.sqrt(eff["R"])
+    tl = tangential_law("mindlin", G=Ea / (2 * (1 + nua)), nu=nua, G2=Ea / (2 * (1 + nua)),
+                        nu2=nua, mu=0.4)  # fmt: skip
+    # relative slip of the contact points: (v1 - R w1) - (v2 + R w2) = 0 for w2 = -w1
+    r = oblique_impact(ji.law("hunt_crossley", c=c, a=0.0), tl, **eff, v_n=0.4, v_t=0.0)
+    assert float(r.impulse_t) == 0.0
+    assert float(r.e) == pytest.approx(1.0, rel=1e-9)
+
+
+@pytest.mark.slow
+@pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")  # scipy's probes
+def test_soft_spring_restick_in_the_first_step():
+    """A soft spring (5e6 N/m) slides at first touch and sticks again within the solver's
+    first step, where the condition grows like a square root: plain Newton left the step
+    for t = 0 and the solve failed; the bracketed root finder places it (scipy agrees)."""
+    tl = tangential_law("linear_history", kt=5e6, mu=0.15)
+    v_n, v_t = (float(v) for v in incidence(3.9, np.deg2rad(5.0)))
+    r = oblique_impact(hertz(0.01), tl, m=M, R=R, v_n=v_n, v_t=v_t, rtol=1e-12)
+    assert r.status_name == "separated" and int(r.num_switches) == 2
+    o = oblique_oracle(c=C, a=0.01, m=M, R=R, inertia=0.4, v_n=v_n, v_t=v_t, omega=0.0,
+                       mu=0.15, kt=5e6)  # fmt: skip
+    assert o["switches"] == 2
+    assert float(r.v_t_out) == pytest.approx(o["v_t_out"], rel=1e-8)
+    assert float(r.omega_out) == pytest.approx(o["omega_out"], rel=1e-8)
