@@ -15,7 +15,6 @@ unless the body is held, restitution until separation (`Phi = 0` or `X = 0`), `V
 import functools
 import itertools
 import math
-import timeit
 
 import jax
 import jax.numpy as jnp
@@ -256,6 +255,7 @@ def test_matches_scipy(separation):
 
 
 @pytest.mark.slow
+@pytest.mark.very_slow  # 486 scipy integrations per criterion: about 100 s each
 @pytest.mark.parametrize("separation", SEPARATIONS)
 def test_matches_scipy_wide_grid(separation):
     """486 impacts per criterion: every ending (separated, back, rest, horizon) occurs."""
@@ -486,28 +486,3 @@ def test_bounce_closed_form_gradients():
     got = float(jax.grad(last_apex)(b))
     want = (float(last_apex(b * (1 + h))) - float(last_apex(b * (1 - h)))) / (2 * h * b)
     np.testing.assert_allclose(got, want, rtol=1e-5)
-
-
-@pytest.mark.slow
-def test_bounce_speed_up():
-    """A warm jitted drop with closed-form contacts against the same drop integrated (the
-    only way before the closed forms), printed (`pytest -s`)."""
-    for name, params in DROPS[:3]:
-        law = ji.law(name, **params)
-        times = {}
-        for method in ("auto", "integrate"):
-
-            @jax.jit
-            def run(law, method=method):
-                r = ji.bounce(law, m=1.0, h0=0.6, t_end=3.0, max_impacts=16, method=method)
-                return r.e, r.T
-
-            jax.block_until_ready(run(law))
-            times[method] = min(
-                timeit.repeat(lambda run=run, law=law: jax.block_until_ready(run(law)),
-                              number=5, repeat=3)
-            ) / 5  # fmt: skip
-        ratio = times["integrate"] / times["auto"]
-        print(f"{name}: closed form {times['auto'] * 1e3:.2f} ms, integrated "
-              f"{times['integrate'] * 1e3:.2f} ms, {ratio:.0f}x")  # fmt: skip
-        assert ratio > 1.0
