@@ -3,8 +3,8 @@
 import equinox as eqx
 from jaxtyping import Array
 
-from .._checks import is_traced
 from .._format import format_fields, format_value, jsonable
+from .._solve.results import status_text
 from .._status import Status
 
 # the fields as `summary()` shows them: name, unit ("" a pure number, None a count)
@@ -73,17 +73,7 @@ class ObliqueResult(eqx.Module):
         return Status(int(self.status)).name
 
     def _status_text(self) -> str:
-        if is_traced(self.status):
-            return format_value(self.status)
-        import numpy as np
-
-        codes = np.asarray(self.status).ravel()
-        names = {int(s): s.name for s in Status}
-        if np.ndim(self.status) == 0:
-            return names.get(int(codes[0]), str(int(codes[0])))
-        found, counts = np.unique(codes, return_counts=True)
-        return ", ".join(f"{names.get(int(c), str(int(c)))} {n}" for c, n in
-                         zip(found, counts, strict=True))  # fmt: skip
+        return status_text(self.status)
 
     def summary(self) -> str:
         """The impact as text, every number with its unit; a batch by the range of each

@@ -64,17 +64,7 @@ class ImpactResult(eqx.Module):
 
     def _status_text(self) -> str:
         """`separated`, or for a batch the count of each status (`separated 9, stuck 1`)."""
-        if is_traced(self.status):
-            return format_value(self.status)
-        import numpy as np
-
-        codes = np.asarray(self.status).ravel()
-        names = {int(s): s.name for s in Status}
-        if np.ndim(self.status) == 0:
-            return names.get(int(codes[0]), str(int(codes[0])))
-        found, counts = np.unique(codes, return_counts=True)
-        return ", ".join(f"{names.get(int(c), str(int(c)))} {n}" for c, n in
-                         zip(found, counts, strict=True))  # fmt: skip
+        return status_text(self.status)
 
     def summary(self) -> str:
         """The impact as text, every number with its unit (`T = 7.845 ms`); a batch of
@@ -106,3 +96,19 @@ class ImpactResult(eqx.Module):
 
     def __repr__(self) -> str:
         return self.summary()
+
+
+def status_text(status) -> str:
+    """A status array as words: `separated`, or for a batch the count of each status
+    (`separated 9, stuck 1`); inside `jit` its shape."""
+    if is_traced(status):
+        return format_value(status)
+    import numpy as np
+
+    codes = np.asarray(status).ravel()
+    names = {int(s): s.name for s in Status}
+    if np.ndim(status) == 0:
+        return names.get(int(codes[0]), str(int(codes[0])))
+    found, counts = np.unique(codes, return_counts=True)
+    return ", ".join(f"{names.get(int(c), str(int(c)))} {n}" for c, n in
+                     zip(found, counts, strict=True))  # fmt: skip
