@@ -23,10 +23,7 @@ from .._laws.named_law import invalid_parameter_rows, table_law
 from .._progress import AbstractMeter
 from .._solve.impact import check_custom_law, solve_impact
 from .._solve.options import (
-    CUSTOM_RTOL,
-    DEFAULT_RTOL,
-    METHODS,
-    SEPARATIONS,
+    check_choices,
     check_options,
     choose_path,
     make_options,
@@ -294,12 +291,7 @@ def run_impacts(
             f"impact_batch got an unexpected keyword argument {unknown[0]!r}; its options "
             f"for each impact are {', '.join(IMPACT_OPTIONS)} (see jaximpact.impact)"
         )
-    if separation not in SEPARATIONS:
-        raise ValueError(f"separation must be one of {SEPARATIONS}, got {separation!r}")
-    if method not in METHODS:
-        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-    if rtol is None:
-        rtol = DEFAULT_RTOL if skeleton[0] == "law" else CUSTOM_RTOL
+    rtol = check_choices(separation, method, rtol, table_law=skeleton[0] == "law")
     limits = dict(max_steps=4096, tau_max=1e4, rest_tol=1e-7, atol=None)
     limits.update({k: v for k, v in impact_options.items() if k in limits})
     check_options(rtol=rtol, **limits)

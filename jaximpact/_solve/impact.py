@@ -18,11 +18,9 @@ from .._laws import AbstractLaw
 from .._status import Status
 from .options import (
     CURVES_RTOL as CURVES_RTOL,
-    CUSTOM_RTOL,
-    DEFAULT_RTOL,
-    METHODS,
     SEPARATIONS as SEPARATIONS,
     ImpactOptions as ImpactOptions,
+    check_choices,
     check_options,
     choose_path,
     make_options,
@@ -272,12 +270,7 @@ def impact(
             f"impact needs a law from jaximpact.law(...) or jaximpact.custom_law(...), "
             f"got {type(law).__name__}"
         )
-    if separation not in SEPARATIONS:
-        raise ValueError(f"separation must be one of {SEPARATIONS}, got {separation!r}")
-    if method not in METHODS:
-        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-    if rtol is None:
-        rtol = DEFAULT_RTOL if law.spec is not None else CUSTOM_RTOL
+    rtol = check_choices(separation, method, rtol, table_law=law.spec is not None)
     check_options(rtol=rtol, atol=atol, rest_tol=rest_tol, max_steps=max_steps, tau_max=tau_max)
     # 1e-300 kg is refused as 1e300 kg is: the contact's scales would under- or overflow
     m = check_scale("mass m", check_positive("mass m", m, "kg"), "kg")

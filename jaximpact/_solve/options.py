@@ -75,6 +75,18 @@ class Path(NamedTuple):
         return self.name in ("gravity_table", "integrated")
 
 
+def check_choices(separation: str, method: str, rtol, *, table_law: bool):
+    """One-line ValueErrors for an unknown `separation` or `method`; the `rtol` to use (its
+    default: 1e-11 for a law of the table, 1e-12 for a user's law)."""
+    if separation not in SEPARATIONS:
+        raise ValueError(f"separation must be one of {SEPARATIONS}, got {separation!r}")
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    if rtol is None:
+        return DEFAULT_RTOL if table_law else CUSTOM_RTOL
+    return rtol
+
+
 def check_options(*, rtol, atol, rest_tol, max_steps, tau_max):
     """One-line errors for options outside their range (before anything is traced)."""
     for name, value in (("rtol", rtol), ("atol", atol), ("rest_tol", rest_tol)):
