@@ -310,18 +310,25 @@ def test_an_interrupted_batch_stops_says_what_it_kept_and_resume_completes_it(
 
 
 @pytest.mark.slow
-def test_an_interrupted_calibrate_all_stops_with_one_line():
+@pytest.mark.parametrize(
+    "signum, after, fitting",
+    [(signal.SIGINT, 1.0, False), (signal.SIGINT, 4.0, True), (signal.SIGTERM, 5.0, True)],
+)
+def test_an_interrupted_calibrate_all_stops_with_one_line(signum, after, fitting):
+    """At several moments (importing JAX; the fits under way) and for both signals."""
     child = _cli("calibrate", "--law", "all", "--v0", "2.5", "--e", "0.8", "--T", "7.8e-3")
-    time.sleep(4.0)  # JAX loaded, the fits under way
+    time.sleep(after)
     assert child.poll() is None
     start = time.perf_counter()
-    child.send_signal(signal.SIGINT)
+    child.send_signal(signum)
     stdout, err = child.communicate(timeout=60)
     assert time.perf_counter() - start < 5
-    assert child.returncode == 130 and stdout == ""
+    assert child.returncode == 128 + signum and stdout == ""
     lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("jaximpact: error: interrupted by SIGINT")
-    assert "laws fitted" in lines[0]
+    name = signal.Signals(signum).name
+    assert len(lines) == 1 and lines[0].startswith(f"jaximpact: error: interrupted by {name}")
+    if fitting:
+        assert "laws fitted" in lines[0]
 
 
 # ------------------------------------------------- 4. sizes float64 cannot carry, refused alike
@@ -360,6 +367,15 @@ def test_cli_refuses_contact_scales_float64_cannot_carry(capsys):
 def test_calibrate_refuses_a_mass_float64_cannot_carry(m):
     with pytest.raises(ValueError, match="1e-150 to 1e150"):
         ji.calibrate(ji.law("hertz_rate", c=1e6, b1=100.0), m=m, v0=2.5, e=0.85, T=7.8e-3)
+
+
+@pytest.mark.parametrize("m", [1e-300, 1e300, 1e-151, 1e151])
+@pytest.mark.parametrize("engine", ["mujoco", "lammps"])
+def test_export_refuses_a_mass_float64_cannot_carry(engine, m):
+    """`ji.export` as the rest of the library: the same window, the same one line."""
+    with pytest.raises(ValueError, match="1e-150 to 1e150") as error:
+        ji.export(ji.law("hertz_rate", c=2e6, b1=800.0), engine, m=m, v0=2.5, radius=0.01)
+    assert "\n" not in str(error.value)
 
 
 # ------------------------------------------------------- 5. results print as numbers with units

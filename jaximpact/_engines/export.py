@@ -7,6 +7,7 @@ import warnings as _warnings
 
 import numpy as np
 
+from .._checks import check_scale
 from . import _stepping, chrono, drake, lammps, liggghts, mujoco, yade
 from .base import AbstractEngine, Design
 from .materials import check_poisson, check_positive, check_restitution
@@ -293,8 +294,8 @@ def _inputs(chosen: AbstractEngine, law_or_fit, m, v0, timestep, poisson):
         if law_or_fit is not None or chosen.MASS_DEPENDS is not None:
             raise ValueError(missing_mass(chosen.NAME, law_or_fit is not None, "pass m= (kg)"))
         m = 1.0  # MuJoCo from targets: per unit mass (the export does not depend on it)
-    m = check_positive("m", m, "kg")
-    v0 = check_positive("v0", v0, "m/s")
+    m = check_scale("m", check_positive("m", m, "kg"), "kg")
+    v0 = check_scale("v0", check_positive("v0", v0, "m/s"), "m/s")
     if timestep is not None:
         timestep = check_positive("timestep", timestep, "s")
     if poisson is not None:

@@ -3,7 +3,9 @@ values): `oblique_impact`, integrated with diffrax in segments of one tangential
 (sticking or sliding), each ended by an event with a root finder, so that the
 stick-slip transitions are placed to the solver's tolerance and differentiable."""
 
+import functools
 import math
+from typing import NamedTuple
 
 import diffrax as dfx
 import equinox as eqx
@@ -169,11 +171,139 @@ def _first_mode(dyn: ObliqueDynamics, y0, compressing):
     return jnp.where(slides, SLIP, STICK).astype(jnp.int32), sense
 
 
+class _Setup(NamedTuple):
+    """What every segment of one oblique solve shares (`_segments`)."""
+
+    dyn: ObliqueDynamics
+    options: ObliqueOptions
+    conditions: tuple
+    event: dfx.Event
+    term: dfx.ODETerm
+    controller: dfx.PIDController
+    held_status: int
+    has_surface: bool
+    tau_max: jax.Array
+
+
+def _segment(setup: _Setup, carry, _):
+    """One segment of `_segments`' scan: solve in the current tangential mode until an
+    event, then decide the status and the next mode (the carry of `_segments`)."""
+    dyn, options, conditions, event = setup.dyn, setup.options, setup.conditions, setup.event
+    term, controller, has_surface = setup.term, setup.controller, setup.has_surface
+    normal, size = dyn.normal, dyn.size
+    y, tau, mode, sense, compressing, mute, t_stop, alive, status, switches, steps = carry
+    args = (mode, sense, compressing, mute)
+    t1 = jnp.where(alive, t_stop, tau)
+    sol = dfx.diffeqsolve(
+        term,
+        options.solver,
+        tau,
+        t1,
+        None,
+        y,
+        args=args,
+        stepsize_controller=controller,
+        event=event,
+        saveat=dfx.SaveAt(t1=True),
+        adjoint=options.adjoint,
+        max_steps=options.max_steps,
+        throw=False,
+    )
+    y1, tau1 = sol.ys[-1], sol.ts[-1]
+    masks = sol.event_mask
+    if options.land:
+        y1, tau1 = _land(dyn, conditions, masks, term, tau, y, tau1, args, options, controller)
+    ended = (masks[0] & ~compressing) | (masks[3] if has_surface else False)
+    at_max = masks[0] & compressing
+    switched = masks[-1]
+    fired = jnp.any(jnp.stack(list(masks)))
+    out_of_steps = sol.result == dfx.RESULTS.max_steps_reached
+    broke = (
+        (sol.result == dfx.RESULTS.dt_min_reached)
+        | (sol.result == dfx.RESULTS.max_steps_rejected)
+        | (sol.result == dfx.RESULTS.internal_error)
+    )
+    # the tangential limit crossed before the segment's end: within its last step,
+    # before a normal event that diffrax, taking conditions in order, put first (the
+    # segment is solved again from its start to that event's time, the normal
+    # conditions muted: its last step then ends where the limit's condition is < 0,
+    # and its own event is found; near the end of contact the limit |F_n| dips to 0
+    # and rises again past it, so a solve beyond that time would step over the
+    # crossing), or within its first step, which began with the limit's condition at 0
+    # (the mode changes at once, where the segment began)
+    # (judged with the normal force's sign at the segment's start: |F_n| has a kink
+    # where the contact ends, and the sliding condition, a rate, jumps there)
+    sign = jnp.where(normal.force(y[:size], compressing) < 0, -1.0, 1.0)
+    overtaken = (
+        alive
+        & ~switched
+        & ~broke
+        & (dyn.switch(y1, mode, sense, compressing, sign) < -OVERTAKEN)
+        & jnp.all(jnp.isfinite(y1))
+    )
+    armed = dyn.switch(y, mode, sense, compressing) > 0
+    redo = overtaken & armed & ~mute
+    at_once = overtaken & ~redo
+    # a sticking segment that still ended beyond Coulomb's limit: a failure, never a
+    # silent force beyond mu |F_n|
+    beyond = (mode == STICK) & (
+        jnp.abs(dyn.trial(y1)) > (1.0 + 1e-6) * dyn.cap(y1, compressing) + OVERTAKEN
+    )
+    failed = ~overtaken & ~out_of_steps & (broke | ~jnp.all(jnp.isfinite(y1)) | beyond)
+    y1_n = y1[:size]
+    leaving = normal.velocity(y1_n) < 0
+    stuck = at_max & (normal.force(y1_n, False) - normal.gamma <= 0)
+    # a redo that found no crossing before its stop: nothing to trust
+    failed = failed | (mute & ~switched & ~overtaken & alive)
+    horizon = ~fired & ~out_of_steps & ~failed
+    captured = (ended & ~leaving) | masks[1] | horizon
+    status_now = jnp.where(
+        out_of_steps,
+        Status.out_of_steps,
+        jnp.where(
+            failed,
+            Status.failed,
+            jnp.where(
+                ended & leaving,
+                Status.separated,
+                jnp.where(
+                    stuck | masks[2], setup.held_status, jnp.where(captured, Status.captured, -1)
+                ),
+            ),
+        ),
+    )
+    done = (status_now >= 0) & ~overtaken
+    # the tangential mode changes: sticking -> sliding against the trial force;
+    # sliding -> sticking with the spring at the limit it was held at
+    change = alive & ~done & ((switched & ~redo) | at_once)
+    y_at = jnp.where(at_once, y, y1)
+    tau_at = jnp.where(at_once, tau, tau1)
+    to_slip = change & (mode == STICK)
+    to_stick = change & (mode == SLIP)
+    y_next = jnp.where(to_stick, dyn.held(y_at, sense, compressing), y_at)
+    y_next = jnp.where(redo, y, y_next)
+    sense_next = jnp.where(to_slip, -jnp.sign(dyn.trial(y_at)), sense)
+    carry = (
+        jnp.where(alive, y_next, y),
+        jnp.where(alive & ~redo, tau_at, tau),
+        jnp.where(change, 1 - mode, mode),
+        sense_next,
+        compressing & ~(alive & at_max & ~overtaken),
+        alive & redo,
+        jnp.where(alive & redo, jax.lax.stop_gradient(tau1), setup.tau_max),
+        alive & ~done,
+        jnp.where(alive & done, status_now, status).astype(jnp.int32),
+        switches + change.astype(jnp.int32),
+        steps + jnp.where(alive, sol.stats["num_steps"], 0),
+    )
+    return carry, None
+
+
 def _segments(dyn: ObliqueDynamics, y0, options: ObliqueOptions):
     """Integrate the contact segment by segment (a `lax.scan` of `max_segments` solves,
     those after the end skipped); return the final state, time, status, switch and step
     counts (nondimensional)."""
-    normal, size = dyn.normal, dyn.size
+    normal = dyn.normal
     conditions = _conditions(dyn, options.separation, options.rest_tol)
     event = dfx.Event(
         conditions,
@@ -183,117 +313,17 @@ def _segments(dyn: ObliqueDynamics, y0, options: ObliqueOptions):
     term = dfx.ODETerm(lambda t, y, args: dyn.rhs(y, *args[:3]))
     controller = dfx.PIDController(rtol=options.rtol, atol=options.atol)
     tau_max = jnp.asarray(options.tau_max, dtype=float)
-    held_status = Status.stuck if normal.has_dry else Status.captured
-    has_surface = len(conditions) == 5
-
-    def segment(carry, _):
-        y, tau, mode, sense, compressing, mute, t_stop, alive, status, switches, steps = carry
-        args = (mode, sense, compressing, mute)
-        t1 = jnp.where(alive, t_stop, tau)
-        sol = dfx.diffeqsolve(
-            term,
-            options.solver,
-            tau,
-            t1,
-            None,
-            y,
-            args=args,
-            stepsize_controller=controller,
-            event=event,
-            saveat=dfx.SaveAt(t1=True),
-            adjoint=options.adjoint,
-            max_steps=options.max_steps,
-            throw=False,
-        )
-        y1, tau1 = sol.ys[-1], sol.ts[-1]
-        masks = sol.event_mask
-        if options.land:
-            y1, tau1 = _land(dyn, conditions, masks, term, tau, y, tau1, args, options,
-                             controller)  # fmt: skip
-        ended = (masks[0] & ~compressing) | (masks[3] if has_surface else False)
-        at_max = masks[0] & compressing
-        switched = masks[-1]
-        fired = jnp.any(jnp.stack(list(masks)))
-        out_of_steps = sol.result == dfx.RESULTS.max_steps_reached
-        broke = (
-            (sol.result == dfx.RESULTS.dt_min_reached)
-            | (sol.result == dfx.RESULTS.max_steps_rejected)
-            | (sol.result == dfx.RESULTS.internal_error)
-        )
-        # the tangential limit crossed before the segment's end: within its last step,
-        # before a normal event that diffrax, taking conditions in order, put first (the
-        # segment is solved again from its start to that event's time, the normal
-        # conditions muted: its last step then ends where the limit's condition is < 0,
-        # and its own event is found; near the end of contact the limit |F_n| dips to 0
-        # and rises again past it, so a solve beyond that time would step over the
-        # crossing), or within its first step, which began with the limit's condition at 0
-        # (the mode changes at once, where the segment began)
-        # (judged with the normal force's sign at the segment's start: |F_n| has a kink
-        # where the contact ends, and the sliding condition, a rate, jumps there)
-        sign = jnp.where(normal.force(y[:size], compressing) < 0, -1.0, 1.0)
-        overtaken = (
-            alive
-            & ~switched
-            & ~broke
-            & (dyn.switch(y1, mode, sense, compressing, sign) < -OVERTAKEN)
-            & jnp.all(jnp.isfinite(y1))
-        )
-        armed = dyn.switch(y, mode, sense, compressing) > 0
-        redo = overtaken & armed & ~mute
-        at_once = overtaken & ~redo
-        # a sticking segment that still ended beyond Coulomb's limit: a failure, never a
-        # silent force beyond mu |F_n|
-        beyond = (mode == STICK) & (
-            jnp.abs(dyn.trial(y1)) > (1.0 + 1e-6) * dyn.cap(y1, compressing) + OVERTAKEN
-        )
-        failed = ~overtaken & ~out_of_steps & (broke | ~jnp.all(jnp.isfinite(y1)) | beyond)
-        y1_n = y1[:size]
-        leaving = normal.velocity(y1_n) < 0
-        stuck = at_max & (normal.force(y1_n, False) - normal.gamma <= 0)
-        # a redo that found no crossing before its stop: nothing to trust
-        failed = failed | (mute & ~switched & ~overtaken & alive)
-        horizon = ~fired & ~out_of_steps & ~failed
-        captured = (ended & ~leaving) | masks[1] | horizon
-        status_now = jnp.where(
-            out_of_steps,
-            Status.out_of_steps,
-            jnp.where(
-                failed,
-                Status.failed,
-                jnp.where(
-                    ended & leaving,
-                    Status.separated,
-                    jnp.where(
-                        stuck | masks[2], held_status, jnp.where(captured, Status.captured, -1)
-                    ),
-                ),
-            ),
-        )
-        done = (status_now >= 0) & ~overtaken
-        # the tangential mode changes: sticking -> sliding against the trial force;
-        # sliding -> sticking with the spring at the limit it was held at
-        change = alive & ~done & ((switched & ~redo) | at_once)
-        y_at = jnp.where(at_once, y, y1)
-        tau_at = jnp.where(at_once, tau, tau1)
-        to_slip = change & (mode == STICK)
-        to_stick = change & (mode == SLIP)
-        y_next = jnp.where(to_stick, dyn.held(y_at, sense, compressing), y_at)
-        y_next = jnp.where(redo, y, y_next)
-        sense_next = jnp.where(to_slip, -jnp.sign(dyn.trial(y_at)), sense)
-        carry = (
-            jnp.where(alive, y_next, y),
-            jnp.where(alive & ~redo, tau_at, tau),
-            jnp.where(change, 1 - mode, mode),
-            sense_next,
-            compressing & ~(alive & at_max & ~overtaken),
-            alive & redo,
-            jnp.where(alive & redo, jax.lax.stop_gradient(tau1), tau_max),
-            alive & ~done,
-            jnp.where(alive & done, status_now, status).astype(jnp.int32),
-            switches + change.astype(jnp.int32),
-            steps + jnp.where(alive, sol.stats["num_steps"], 0),
-        )
-        return carry, None
+    setup = _Setup(
+        dyn=dyn,
+        options=options,
+        conditions=conditions,
+        event=event,
+        term=term,
+        controller=controller,
+        held_status=Status.stuck if normal.has_dry else Status.captured,
+        has_surface=len(conditions) == 5,
+        tau_max=tau_max,
+    )
 
     compressing = jnp.asarray(normal.split)
     mode, sense = _first_mode(dyn, y0, compressing)
@@ -320,7 +350,9 @@ def _segments(dyn: ObliqueDynamics, y0, options: ObliqueOptions):
     no = jnp.asarray(False)
     carry = (y_in, tau0, mode, sense, compressing, no, tau_max, jnp.asarray(True), zero - 1,
              zero, zero)  # fmt: skip
-    carry, _ = jax.lax.scan(segment, carry, None, length=options.max_segments)
+    carry, _ = jax.lax.scan(
+        functools.partial(_segment, setup), carry, None, length=options.max_segments
+    )
     y, tau, _, _, _, _, _, alive, status, switches, steps = carry
     # still going after max_segments solves: counted as out of steps
     status = jnp.where(alive, Status.out_of_steps, status).astype(jnp.int32)

@@ -39,7 +39,8 @@ def _no_persistent_cache(monkeypatch):
 # ------------------------------------------------------------------------------ laws
 
 
-def test_laws_table(capsys):
+def test_laws_table(capsys, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "200")  # the content, not its wrapping (test_assumptions)
     status, out, err = run_cli(capsys, ["laws"])
     assert status == 0 and err == ""
     for name in ji.LAW_NAMES:
