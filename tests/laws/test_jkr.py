@@ -24,8 +24,8 @@ LAW = ji.law("jkr", c=C, R=R, w=W)
 V_S = float(LAW.sticking_speed(M))
 
 
-def scipy_jkr(c, R, w, m, v0, g=0.0):
-    """The JKR relations integrated by scipy's DOP853 at rtol 1e-13: the contact radius
+def scipy_jkr(c, R, w, m, v0, g=0.0, rtol=1e-13):
+    """The JKR relations integrated by scipy's DOP853 at `rtol` (1e-13): the contact radius
     `a(x)` on the attached branch by brentq, `x'' = -F(a(x))/m + g` from x = 0 (snap-in)
     to v = 0, then to pull-off (least x) or to v = 0 again (captured). In units
     x_s = (m v0^2/c)^0.4, t_s = x_s/v0."""
@@ -61,7 +61,7 @@ def scipy_jkr(c, R, w, m, v0, g=0.0):
         return y[1]
 
     turn.terminal, turn.direction = True, -1
-    first = solve_ivp(rhs, (0, 100), [0, 1], method="DOP853", rtol=1e-13, atol=1e-15, events=turn)
+    first = solve_ivp(rhs, (0, 100), [0, 1], method="DOP853", rtol=rtol, atol=1e-15, events=turn)
     t_m, (X_m, _) = first.t_events[0][0], first.y_events[0][0]
 
     def pull_off(t, y):
@@ -72,7 +72,7 @@ def scipy_jkr(c, R, w, m, v0, g=0.0):
 
     pull_off.terminal, pull_off.direction = True, -1
     back.terminal, back.direction = True, 1
-    second = solve_ivp(rhs, (t_m, t_m + 100), [X_m, 0.0], method="DOP853", rtol=1e-13,
+    second = solve_ivp(rhs, (t_m, t_m + 100), [X_m, 0.0], method="DOP853", rtol=rtol,
                        atol=1e-15, events=[pull_off, back])  # fmt: skip
     if second.t_events[0].size:
         t_end, e = second.t_events[0][0], -second.y_events[0][0][1]

@@ -23,8 +23,8 @@ LAW = ji.law("thornton", c=C, x_y=X_Y)
 V_Y = float(LAW.yield_speed(M))
 
 
-def scipy_thornton(c, x_y, m, v0, g=0.0, separation="force"):
-    """The model integrated by scipy's DOP853 at rtol 1e-13, in units x_s = (m v0^2/c)^0.4,
+def scipy_thornton(c, x_y, m, v0, g=0.0, separation="force", rtol=1e-13):
+    """The model integrated by scipy's DOP853 at `rtol` (1e-13), in units x_s = (m v0^2/c)^0.4,
     t_s = x_s / v0: loading to v = 0, then Hertzian unloading about x_p to x = x_p (force
     criterion) or x = 0 (penetration). Returns e, T, x_max, F_max, t_max (SI)."""
     xs = (m * v0**2 / c) ** 0.4
@@ -39,7 +39,7 @@ def scipy_thornton(c, x_y, m, v0, g=0.0, separation="force"):
 
     stop.terminal, stop.direction = True, -1
     first = solve_ivp(lambda t, y: [y[1], -loading(max(y[0], 0.0)) + gam], (0, 100), [0, 1],
-                      method="DOP853", rtol=1e-13, atol=1e-15, events=stop)  # fmt: skip
+                      method="DOP853", rtol=rtol, atol=1e-15, events=stop)  # fmt: skip
     t_m, (X_m, _) = first.t_events[0][0], first.y_events[0][0]
     F_m = loading(X_m)
     c_p = math.sqrt(X_m**1.5 / F_m)
@@ -52,7 +52,7 @@ def scipy_thornton(c, x_y, m, v0, g=0.0, separation="force"):
         return y[0] - (X_p if separation == "force" else 0.0)
 
     leave.terminal, leave.direction = True, -1
-    second = solve_ivp(unloading, (t_m, t_m + 100), [X_m, 0.0], method="DOP853", rtol=1e-13,
+    second = solve_ivp(unloading, (t_m, t_m + 100), [X_m, 0.0], method="DOP853", rtol=rtol,
                        atol=1e-15, events=leave)  # fmt: skip
     t_end, (_, V_end) = second.t_events[0][0], second.y_events[0][0]
     return dict(e=-V_end, T=t_end * ts, x_max=X_m * xs, F_max=F_m * fs, t_max=t_m * ts)
