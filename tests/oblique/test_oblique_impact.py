@@ -300,22 +300,6 @@ def test_head_on_and_rolling():
 
 
 @pytest.mark.slow
-def test_two_identical_spheres_spinning_together():
-    """Chung & Ooi Test 7: two equal spheres meeting head-on with opposite spins have no
-    relative slip at the contact, so the spins come out as they went in."""
-    Ea, nua, rho, Ra = 70e9, 0.33, 2700.0, 0.1
-    m = rho * 4 / 3 * np.pi * Ra**3
-    eff = two_spheres(m, Ra, m, Ra)
-    c = 4 / 3 * Ea / (2 * (1 - nua**2)) * np.sqrt(eff["R"])
-    tl = tangential_law("mindlin", G=Ea / (2 * (1 + nua)), nu=nua, G2=Ea / (2 * (1 + nua)),
-                        nu2=nua, mu=0.4)  # fmt: skip
-    # relative slip of the contact points: (v1 - R w1) - (v2 + R w2) = 0 for w2 = -w1
-    r = oblique_impact(ji.law("hunt_crossley", c=c, a=0.0), tl, **eff, v_n=0.4, v_t=0.0)
-    assert float(r.impulse_t) == 0.0
-    assert float(r.e) == pytest.approx(1.0, rel=1e-9)
-
-
-@pytest.mark.slow
 @pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")  # scipy's probes
 def test_soft_spring_restick_in_the_first_step():
     """A soft spring (5e6 N/m) slides at first touch and sticks again within the solver's
