@@ -37,6 +37,7 @@ from .common import (
 from .export import add_engine_e, add_export
 from .fit import add_fit
 from .laws import add_laws
+from .oblique import add_fit_oblique
 from .paper import add_paper
 from .simulate import add_simulate
 
@@ -44,6 +45,7 @@ COMMANDS = [
     ("laws", add_laws),
     ("simulate", add_simulate),
     ("fit", add_fit),
+    ("fit-oblique", add_fit_oblique),
     ("calibrate", add_calibrate),
     ("paper", add_paper),
     ("bench", add_bench),

@@ -122,8 +122,9 @@ def add_output_arguments(parser, *, plot: bool = True):
         )
 
 
-def parse_params(items: Iterable[str]) -> dict[str, float]:
-    """`["c=2e6", "b1=800"]` -> `{"c": 2e6, "b1": 800.0}`; a `CLIError` for anything else."""
+def parse_params(items: Iterable[str], flag: str = "--param") -> dict[str, float]:
+    """`["c=2e6", "b1=800"]` -> `{"c": 2e6, "b1": 800.0}`; a `CLIError` (naming `flag`) for
+    anything else."""
     from .._checks import check_scale
 
     params = {}
@@ -131,16 +132,16 @@ def parse_params(items: Iterable[str]) -> dict[str, float]:
         name, sep, value = item.partition("=")
         name, value = name.strip(), value.strip()
         if not sep or not name or not value:
-            raise CLIError(f"--param {item!r} must be NAME=VALUE, e.g. --param c=2e6")
+            raise CLIError(f"{flag} {item!r} must be NAME=VALUE, e.g. {flag} c=2e6")
         if not name.isidentifier():
-            raise CLIError(f"--param {item!r}: {name!r} is not a parameter name")
+            raise CLIError(f"{flag} {item!r}: {name!r} is not a parameter name")
         try:
             number = float(value)
         except ValueError:
-            raise CLIError(f"--param {item!r}: {value!r} is not a number") from None
+            raise CLIError(f"{flag} {item!r}: {value!r} is not a number") from None
         if name in params:
-            raise CLIError(f"--param {name} is given twice")
-        check_scale(f"--param {name}", number)
+            raise CLIError(f"{flag} {name} is given twice")
+        check_scale(f"{flag} {name}", number)
         params[name] = number
     return params
 

@@ -1,0 +1,236 @@
+"""`jaximpact fit-oblique`: fit a tangential law (friction, tangential stiffness) to measured
+oblique rebounds, the tangential restitution and/or the spin after impact, read from a CSV.
+
+Columns (a header names them; an empty cell is a value not measured):
+- the incidence: `theta_deg` (from the normal, degrees; with `--speed`) or `v_n,v_t` (m/s);
+- optionally `omega` (spin before impact, rad/s; default 0);
+- what was measured: `e_t` (the centre's tangential restitution) and/or `omega_out` (rad/s).
+"""
+
+import math
+from pathlib import Path
+
+from .common import (
+    CLIError,
+    add_law_arguments,
+    add_output_arguments,
+    check_plot_path,
+    command_parser,
+    emit,
+    free_names,
+    law_from_args,
+    parse_params,
+)
+
+INCIDENCE = ("theta_deg", "v_n", "v_t", "omega")
+MEASURED = ("e_t", "omega_out")
+COLUMNS = INCIDENCE + MEASURED
+
+
+def add_fit_oblique(subparsers):
+    parser = command_parser(
+        subparsers,
+        "fit-oblique",
+        help="fit friction and tangential stiffness to oblique rebounds (e_t, spin)",
+        description="Fit the tangential law --tangential (mindlin: G_star, mu; "
+        "linear_history: kt, mu, ct) of a sphere of mass --mass (kg) and radius --radius "
+        "(m) to rebounds measured at several incidences, read from FILE.csv: columns "
+        "theta_deg (with --speed) or v_n,v_t, optionally omega (spin before, rad/s), and "
+        "e_t and/or omega_out (an empty cell: not measured). The normal law --law with "
+        "--param is held fixed (fit it first with 'jaximpact calibrate'). Each impact is "
+        "integrated with stick and slip as segments ended by events, so the fit's "
+        "derivatives are exact through the transitions. Prints the parameters with "
+        "standard errors and the goodness of fit (rms of e_t and of the spin).",
+        example="jaximpact fit-oblique rebounds.csv --speed 3.9 --mass 2.6e-4 --radius 2.5e-3 "
+        "--law tsuji --param c=1.1e9 b=0.5 --tangential mindlin --tparam G_star=1.35e10 "
+        "mu=0.092\n"
+        "jaximpact fit-oblique rebounds.csv --mass 2.6e-4 --radius 2.5e-3 --law hunt_crossley "
+        "--param c=1.1e9 a=0 --tangential linear_history --tparam kt=1e6 mu=0.1 --json",
+    )
+    parser.add_argument("file", type=Path, metavar="FILE.csv", help="the measured rebounds")
+    add_law_arguments(parser)
+    parser.add_argument(
+        "--tangential",
+        required=True,
+        choices=("mindlin", "mindlin_force", "linear_history"),
+        help="the tangential law to fit",
+    )
+    parser.add_argument(
+        "--tparam",
+        action="extend",
+        nargs="+",
+        default=[],
+        metavar="NAME=VALUE",
+        help="the tangential law's start values in SI units, e.g. --tparam G_star=1.35e10 "
+        "mu=0.092 (mindlin also takes G=... nu=...)",
+    )
+    parser.add_argument("--mass", type=float, required=True, metavar="KG", help="mass, kg (> 0)")
+    parser.add_argument(
+        "--radius", type=float, required=True, metavar="M", help="sphere radius, m (> 0)"
+    )
+    parser.add_argument(
+        "--speed",
+        type=float,
+        metavar="M/S",
+        help="impact speed, m/s, for a file that gives the incidence as theta_deg",
+    )
+    parser.add_argument(
+        "--inertia",
+        type=float,
+        default=0.4,
+        metavar="K",
+        help="moment of inertia over m R^2 (default 0.4, a solid sphere)",
+    )
+    parser.add_argument(
+        "--free",
+        action="extend",
+        nargs="+",
+        metavar="NAME",
+        help="tangential parameters to fit (default: the stiffness and mu)",
+    )
+    add_output_arguments(parser)
+    parser.set_defaults(handler=run_fit_oblique)
+
+
+def read_rebounds(path: Path, speed: float | None) -> dict:
+    """`{v_n, v_t, omega, e_t, omega_out, theta}` (lists; NaN where not measured) from the
+    CSV at `path`; one-line `CLIError`s for what is missing or not a number."""
+    from .._files import read_csv
+
+    try:
+        text = path.read_text()
+    except OSError as error:
+        raise CLIError(f"cannot read {path}: {error.strerror or error}") from None
+    except UnicodeDecodeError:
+        raise CLIError(f"{path} is not a text file (a CSV with columns theta_deg,e_t)") from None
+    header, rows = read_csv(text, comments=True)
+    header = [name.strip() for name in header]
+    unknown = [name for name in header if name not in COLUMNS]
+    if unknown:
+        raise CLIError(
+            f"{path}: unknown column {', '.join(map(repr, unknown))}; the columns are "
+            f"{', '.join(COLUMNS)}"
+        )
+    if len(set(header)) != len(header):
+        raise CLIError(f"{path}: a column is named twice in the header")
+    by_angle = "theta_deg" in header
+    if by_angle == ("v_n" in header or "v_t" in header) or (
+        not by_angle and not {"v_n", "v_t"} <= set(header)
+    ):
+        raise CLIError(f"{path}: give the incidence as theta_deg or as v_n,v_t (not both)")
+    if by_angle and speed is None:
+        raise CLIError(f"{path} gives theta_deg: pass the impact speed --speed (m/s)")
+    if not by_angle and speed is not None:
+        raise CLIError(f"{path} gives v_n,v_t: --speed is not used; leave it out")
+    if not set(MEASURED) & set(header):
+        raise CLIError(f"{path}: no measured column (e_t and/or omega_out)")
+    columns = {name: [] for name in COLUMNS}
+    for number, cells in rows:
+        if len(cells) != len(header):
+            raise CLIError(f"{path}, line {number}: {len(cells)} cells for {len(header)} columns")
+        values = dict.fromkeys(COLUMNS, math.nan) | {"omega": 0.0}
+        for name, cell in zip(header, cells, strict=True):
+            values[name] = _number(cell, path, number, name)
+        if by_angle:
+            theta = values["theta_deg"]
+            if not 0.0 <= theta < 90.0:
+                raise CLIError(
+                    f"{path}, line {number}: theta_deg = {theta:g} must lie in [0, 90) degrees "
+                    "from the normal"
+                )
+            values["v_n"] = speed * math.cos(math.radians(theta))
+            values["v_t"] = speed * math.sin(math.radians(theta))
+        for name in ("v_n", "v_t", "omega"):
+            if math.isnan(values[name]):
+                raise CLIError(f"{path}, line {number}: no {name}; every row needs its incidence")
+        if all(math.isnan(values[name]) for name in MEASURED):
+            raise CLIError(f"{path}, line {number}: neither e_t nor omega_out is given")
+        values["theta"] = math.degrees(math.atan2(values["v_t"], values["v_n"]))
+        for name in (*COLUMNS, "theta"):
+            columns.setdefault(name, []).append(values[name])
+    if not columns["v_n"]:
+        raise CLIError(f"{path} has no rows")
+    return columns
+
+
+def _number(cell: str, path: Path, line: int, column: str) -> float:
+    if not cell.strip():
+        return math.nan
+    try:
+        return float(cell)
+    except ValueError:
+        raise CLIError(f"{path}, line {line}, column {column}: {cell!r} is not a number") from None
+
+
+def run_fit_oblique(args):
+    import numpy as np
+
+    from .._oblique import fit_oblique, tangential_law
+
+    check_plot_path(args.plot, inputs=(args.file,))
+    if args.speed is not None and not args.speed > 0:
+        raise CLIError(f"--speed must be > 0 (m/s), got {args.speed:g}")
+    data = read_rebounds(args.file, args.speed)
+    law = law_from_args(args)
+    tangential = tangential_law(args.tangential, **parse_params(args.tparam, "--tparam"))
+    free = free_names(args.free)
+    if free is None:
+        stiffness = "G_star" if "G_star" in tangential.params else "kt"
+        free = (stiffness, "mu")
+    rows = {k: np.asarray(data[k], dtype=float) for k in (*COLUMNS, "theta")}
+    measured = {k: rows[k] if np.any(np.isfinite(rows[k])) else None for k in MEASURED}
+    fit = fit_oblique(
+        law,
+        tangential,
+        m=args.mass,
+        R=args.radius,
+        v_n=rows["v_n"],
+        v_t=rows["v_t"],
+        omega=rows["omega"],
+        e_t=measured["e_t"],
+        omega_out=measured["omega_out"],
+        free=free,
+        inertia=args.inertia,
+    )
+    if args.plot is not None:
+        _plot(args.plot, rows, fit)
+    emit(args, fit.to_dict(), lambda: _report(fit, rows))
+    return 0
+
+
+def _report(fit, rows) -> str:
+    import numpy as np
+
+    lines = [fit.summary(), "", "  theta [deg]   e_t meas   e_t fit   omega_out meas   fit [rad/s]"]
+    for i, theta in enumerate(rows["theta"]):
+        e_m, w_m = rows["e_t"][i], rows["omega_out"][i]
+        e_f, w_f = float(np.asarray(fit.e_t)[i]), float(np.asarray(fit.omega_out)[i])
+        lines.append(
+            f"  {theta:11.2f}   {_cell(e_m, '.3f'):>8}   {e_f:7.3f}   {_cell(w_m, '.1f'):>14}"
+            f"   {w_f:11.1f}"
+        )
+    if not bool(fit.converged):
+        lines.append("the optimiser did not converge: try other start values (--tparam)")
+    return "\n".join(lines)
+
+
+def _cell(value: float, spec: str) -> str:
+    return "-" if math.isnan(value) else format(value, spec)
+
+
+def _plot(path: Path, rows, fit):
+    """e_t and the spin after impact against the incidence: measured points, fitted law."""
+    import numpy as np
+
+    from .._plotting import new_figure, save_figure
+
+    fig = new_figure(figsize=(9, 3.6))
+    order = np.argsort(rows["theta"])
+    for k, (name, label) in enumerate((("e_t", "e_t"), ("omega_out", "spin after [rad/s]"))):
+        ax = fig.add_subplot(1, 2, k + 1)
+        ax.plot(rows["theta"][order], np.asarray(getattr(fit, name))[order], "-", label="fit")
+        ax.plot(rows["theta"], rows[name], "o", label="measured")
+        ax.set_xlabel("incidence from the normal [deg]")
+        ax.set_ylabel(label)
+        ax.legend()
+    save_figure(fig, path)

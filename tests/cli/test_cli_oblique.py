@@ -1,0 +1,84 @@
+"""`jaximpact fit-oblique`: bad files and options get one line before any solve; a real
+fit (slow) prints the parameters, the goodness of fit and the table of rebounds."""
+
+import json
+
+import pytest
+from helpers import assert_one_line_error, run_cli
+
+BASE = ["--mass", "2.618e-4", "--radius", "2.5e-3", "--law", "tsuji", "--param", "c=4.1968e9",
+        "b=15.134", "--tangential", "linear_history", "--tparam", "kt=1e6", "mu=0.1"]  # fmt: skip
+
+
+@pytest.fixture(autouse=True)
+def _no_persistent_cache(monkeypatch):
+    monkeypatch.setenv("JAXIMPACT_CACHE_DIR", "")
+
+
+def _write(tmp_path, text, name="rebounds.csv"):
+    path = tmp_path / name
+    path.write_text(text)
+    return str(path)
+
+
+@pytest.mark.parametrize(
+    "text, extra, message",
+    [
+        ("theta_deg,e_t\n20,0.6\n", [], "pass the impact speed --speed"),
+        ("v_n,v_t,e_t\n3,1,0.6\n", ["--speed", "3.9"], "--speed is not used"),
+        ("theta_deg,v_n,e_t\n20,3,0.6\n", ["--speed", "3.9"], "theta_deg or as v_n,v_t"),
+        ("v_n,e_t\n3,0.6\n", [], "theta_deg or as v_n,v_t"),
+        ("theta,e_t\n20,0.6\n", ["--speed", "3.9"], "unknown column 'theta'"),
+        ("theta_deg\n20\n", ["--speed", "3.9"], "no measured column"),
+        ("theta_deg,e_t\n20,0.6,1\n", ["--speed", "3.9"], "line 2: 3 cells for 2 columns"),
+        ("theta_deg,e_t\n20,abc\n", ["--speed", "3.9"], "column e_t: 'abc' is not a number"),
+        ("theta_deg,e_t\n95,0.6\n", ["--speed", "3.9"], "must lie in [0, 90) degrees"),
+        ("theta_deg,e_t,omega_out\n20,,\n", ["--speed", "3.9"], "neither e_t nor omega_out"),
+        ("theta_deg,e_t\n", ["--speed", "3.9"], "has no rows"),
+        ("theta_deg,e_t\n20,0.6\n", ["--speed", "-1"], "--speed must be > 0"),
+        ("theta_deg,e_t\n20,0.6\n", ["--speed", "3.9", "--tparam", "kt"], "--tparam 'kt' must"),
+        ("theta_deg,e_t\n20,0.6\n", ["--speed", "3.9", "--free", "G_star"], "free must name"),
+    ],
+)
+def test_bad_input_is_one_line(capsys, tmp_path, text, extra, message):
+    status, out, err = run_cli(capsys, ["fit-oblique", _write(tmp_path, text), *BASE, *extra])
+    assert_one_line_error(status, out, err, contains=message)
+
+
+def test_a_missing_file_and_a_plot_that_is_the_input(capsys, tmp_path):
+    status, out, err = run_cli(capsys, ["fit-oblique", str(tmp_path / "none.csv"), *BASE])
+    assert_one_line_error(status, out, err, contains="cannot read")
+    data = _write(tmp_path, "theta_deg,e_t\n20,0.6\n")
+    status, out, err = run_cli(capsys, ["fit-oblique", data, *BASE, "--speed", "3.9",
+                                        "--plot", data])  # fmt: skip
+    assert_one_line_error(status, out, err, contains="input")
+
+
+@pytest.mark.slow
+def test_fits_rebounds_made_by_the_library(capsys, tmp_path):
+    """e_t and spin made by `oblique_impact` with kt = 5e6 N/m, mu = 0.12 at five angles,
+    fitted from kt = 1e6, mu = 0.1 through the command: the parameters back to 1e-6, the
+    table and the figure written, and --json one object with the goodness of fit."""
+    import numpy as np
+
+    import jaximpact as ji
+
+    law = ji.law("tsuji", c=4.1968e9, b=15.134)
+    truth = ji.tangential_law("linear_history", kt=5e6, mu=0.12)
+    rows = ["theta_deg,e_t,omega_out"]
+    for theta in (5.0, 15.0, 25.0, 40.0, 60.0):
+        v_n, v_t = (float(v) for v in ji.incidence(3.9, np.deg2rad(theta)))
+        r = ji.oblique_impact(law, truth, m=2.618e-4, R=2.5e-3, v_n=v_n, v_t=v_t)
+        rows.append(f"{theta},{float(r.e_t)!r},{float(r.omega_out)!r}")
+    data = _write(tmp_path, "\n".join(rows) + "\n")
+    plot = tmp_path / "fit.png"
+    argv = ["fit-oblique", data, *BASE, "--speed", "3.9"]
+    status, out, err = run_cli(capsys, [*argv, "--plot", str(plot)])
+    assert status == 0, err
+    assert "kt" in out and "rms e_t" in out and "theta [deg]" in out and plot.stat().st_size > 0
+    status, out, err = run_cli(capsys, [*argv, "--json"])
+    assert status == 0, err
+    fit = json.loads(out)
+    assert fit["converged"] is True and fit["n_data"] == 10 and fit["dof"] == 8
+    assert fit["params"]["kt"] == pytest.approx(5e6, rel=1e-6)
+    assert fit["params"]["mu"] == pytest.approx(0.12, rel=1e-6)
