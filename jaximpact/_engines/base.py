@@ -108,8 +108,13 @@ class AbstractEngine(abc.ABC):
     - `NEAREST` (optional, default None: its `LAW` law): how the engine's nearest law to
       one it lacks (a plastic or adhesive law) is named in an export's warning.
 
-    **Optional method**: `native(law)`, the engine (its own model) that exports `law`
-    where the engine has that law itself (LAMMPS's `jkr`), else None.
+    - `TANGENTIAL` (optional, default none): the tangential laws (`tangential_law` names)
+      the engine takes exactly, with `with_tangential`.
+
+    **Optional methods**: `native(law)`, the engine (its own model) that exports `law`
+    where the engine has that law itself (LAMMPS's `jkr`), else None;
+    `with_tangential(parameters, tangential)`, the design's parameters with the tangential
+    law set (for the laws of `TANGENTIAL`).
     """
 
     NAME: ClassVar[str]
@@ -122,6 +127,15 @@ class AbstractEngine(abc.ABC):
     STEPPING: ClassVar[str]
     CONTINUOUS_PLANT: ClassVar[bool]
     NEAREST: ClassVar[str | None] = None
+    TANGENTIAL: ClassVar[tuple[str, ...]] = ()
+
+    def with_tangential(self, parameters: dict, tangential) -> dict:
+        """`parameters` with the tangential law `tangential` (a law of `TANGENTIAL`); a
+        one-line ValueError for a law the engine does not take."""
+        raise ValueError(
+            f"{self.LABEL} has no tangential export yet (the normal law is exported alone); "
+            "export tangential laws to lammps"
+        )
 
     def native(self, law) -> "AbstractEngine | None":
         """The engine's own model for `law` (a law of the table it has beyond its `LAW`

@@ -24,6 +24,7 @@ import numpy as np
 
 from . import _stepping, lammps_jkr
 from .base import AbstractEngine, Design, Key, Stepping
+from .lammps_tangential import NO_TANGENTIAL, TANGENTIAL_MODELS, with_tangential
 from .materials import check_poisson, check_positive, check_restitution, hertz_stiffness
 
 
@@ -122,7 +123,7 @@ def _model(E: float, coefficient: float, poisson: float, limit_damping: bool) ->
     extra = " limit_damping" if limit_damping else ""
     return (
         f"hertz/material {E:.10g} {coefficient:.10g} {poisson:.10g} "
-        f"damping coeff_restitution tangential linear_nohistory 0 0{extra}"
+        f"damping coeff_restitution {NO_TANGENTIAL}{extra}"
     )
 
 
@@ -158,6 +159,10 @@ class Lammps(AbstractEngine):
         "speed; LAMMPS's mdr normal model is elastic-plastic, but another law, not exported)"
     )
     CONTINUOUS_PLANT = False
+    TANGENTIAL = tuple(TANGENTIAL_MODELS)
+
+    def with_tangential(self, parameters, tangential):
+        return with_tangential(parameters, tangential)
 
     def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
                limit_damping=False, geometry=None) -> Design:  # fmt: skip

@@ -50,6 +50,7 @@ import numpy as np
 
 from . import _stepping
 from .base import AbstractEngine, Design, Key, Stepping
+from .lammps_tangential import NO_TANGENTIAL, TANGENTIAL_MODELS, with_tangential
 from .materials import check_poisson, check_positive
 
 # src/GRANULAR/gran_sub_mod_normal.cpp (22Jul2025): the constants of the contact radius
@@ -220,10 +221,7 @@ def model(E: float, cohesion: float, poisson: float) -> str:
     """The `jkr` model of `pair_coeff` (and of `fix wall/gran granular`): Young's modulus `E`
     (Pa), no damping (`damping velocity` with `damp = 0`), Poisson's ratio, `cohesion`
     (J/m^2, the surface energy: half the work of adhesion), no tangential force."""
-    return (
-        f"jkr {E:.10g} 0.0 {poisson:.10g} {cohesion:.10g} damping velocity "
-        "tangential linear_nohistory 0 0"
-    )
+    return f"jkr {E:.10g} 0.0 {poisson:.10g} {cohesion:.10g} damping velocity {NO_TANGENTIAL}"
 
 
 class LammpsJKR(AbstractEngine):
@@ -256,6 +254,10 @@ class LammpsJKR(AbstractEngine):
         "zero overlap, break at the least force): replicated"
     )
     CONTINUOUS_PLANT = False
+    TANGENTIAL = tuple(TANGENTIAL_MODELS)
+
+    def with_tangential(self, parameters, tangential):
+        return with_tangential(parameters, tangential)
 
     def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
                limit_damping=False, geometry=None) -> Design:  # fmt: skip

