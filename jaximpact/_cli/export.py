@@ -118,6 +118,16 @@ def add_export(subparsers):
         "two spheres",
     )  # fmt: skip
     parser.add_argument(
+        "--tangential", metavar="NAME",
+        help=f"{_labels(lambda e: bool(e.TANGENTIAL))}: also export the tangential law NAME "
+        "(linear_history, mindlin, mindlin_force) with --tparam, and print the e_t and spin "
+        "it promises from 5 to 75 degrees",
+    )  # fmt: skip
+    parser.add_argument(
+        "--tparam", action="extend", nargs="+", default=[], metavar="NAME=VALUE",
+        help="the tangential law's parameters, SI units, e.g. --tparam G_star=1.35e10 mu=0.092",
+    )  # fmt: skip
+    parser.add_argument(
         "--no-strict", dest="strict", action="store_false",
         help="export what the engine cannot realise at --timestep anyway, with a warning",
     )  # fmt: skip
@@ -187,6 +197,13 @@ def _run_export(args):
         from .._laws import law
 
         source = law(name, **params)
+    tangential = None
+    if args.tangential is not None:
+        from .._oblique import tangential_law
+
+        tangential = tangential_law(args.tangential, **parse_params(args.tparam, "--tparam"))
+    elif args.tparam:
+        raise CLIError("--tparam needs --tangential NAME")
     try:  # with --no-strict, the refusal comes as a warning (one line on stderr)
         x = export(
             source,
@@ -201,6 +218,7 @@ def _run_export(args):
             limit_damping=args.limit_damping,
             **({"geometry": "wall"} if args.wall else {}),
             strict=args.strict,
+            tangential=tangential,
         )
     except UnrealisedExport as refusal:
         raise CLIError(refusal.message("--no-strict to export it anyway")) from None
@@ -232,6 +250,12 @@ def _run_export(args):
             for i, v in enumerate(x.speeds):
                 law_e = f"   {x.e_target[i]:.5g}" if with_law else ""
                 lines.append(f"  {format_number(v):>9}   {x.e_engine[i]:.5g}{law_e}")
+        if x.tangential is not None:
+            lines.append(f"tangential {x.tangential.name}: what its laws promise at v0 "
+                         "(continuous, no spin before)")  # fmt: skip
+            lines.append("  angle (deg)   e_t       spin after (rad/s)")
+            for angle, e_t, omega in zip(x.angles, x.e_t_engine, x.omega_engine, strict=True):
+                lines.append(f"  {angle:11g}   {e_t:.5f}   {omega:.4g}")
         lines += [f"warning: {w}" for w in data["warnings"]]
         return "\n".join(lines)
 

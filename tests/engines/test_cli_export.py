@@ -205,3 +205,47 @@ def test_cli_export_wall(capsys):
         main(["export", "lammps", "--e", "0.5", "--T", "5e-4", "--mass", "0.004", "--v0", "1",
               "--wall"])  # fmt: skip
     assert "radius (m) of the sphere" in capsys.readouterr().err
+
+
+TANGENTIAL_ARGV = ["--law", "tsuji", "--param", "c=4.2e9", "b=15", "--mass", "2.618e-4",
+                   "--v0", "3.9"]  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "extra, message",
+    [
+        (["mujoco", "--tangential", "mindlin", "--tparam", "G_star=1e10", "mu=0.1"],
+         "MuJoCo has no tangential export yet"),
+        (["lammps", "--radius", "2.5e-3", "--tparam", "mu=0.1"], "--tparam needs --tangential"),
+        (["lammps", "--radius", "2.5e-3", "--tangential", "mindlin", "--tparam", "mu"],
+         "--tparam 'mu' must be NAME=VALUE"),
+    ],
+)  # fmt: skip
+def test_cli_export_tangential_bad_input(capsys, extra, message):
+    with pytest.raises(SystemExit) as stop:
+        main(["export", *extra, *TANGENTIAL_ARGV])
+    out, err = capsys.readouterr()
+    assert stop.value.code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert message in err
+
+
+@pytest.mark.slow
+def test_cli_export_tangential_to_lammps(capsys):
+    """The clause in pair_coeff and fix wall/gran, and the promise from 5 to 75 degrees,
+    as text and as JSON (the Python export's numbers)."""
+    import jaximpact as ji
+
+    argv = ["export", "lammps", *TANGENTIAL_ARGV, "--radius", "2.5e-3", "--wall",
+            "--tangential", "mindlin", "--tparam", "G_star=1.35e10", "mu=0.092"]  # fmt: skip
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "tangential mindlin 1.35e+11 0 0.092" not in out  # k is 8 G*, not G*
+    assert out.count("tangential mindlin 1.08e+11 0 0.092") >= 2 and "spin after" in out
+    assert main([*argv, "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    tl = ji.tangential_law("mindlin", G_star=1.35e10, mu=0.092)
+    x = ji.export(ji.law("tsuji", c=4.2e9, b=15.0), "lammps", m=2.618e-4, v0=3.9,
+                  radius=2.5e-3, geometry="wall", tangential=tl, curves=False)  # fmt: skip
+    assert data["e_t_engine"] == pytest.approx(list(x.e_t_engine), rel=1e-12)
+    assert data["tangential"] == {"name": "mindlin", "parameters": {"G_star": 1.35e10,
+                                                                     "mu": 0.092}}  # fmt: skip
