@@ -11,7 +11,6 @@ import math
 import sys
 from pathlib import Path
 
-from .._files import read_csv
 from .._format import format_number, format_quantity
 from .._interrupt import check_interrupt, set_note
 from .._plotting import new_figure, save_figure
@@ -25,6 +24,7 @@ from .common import (
     emit,
     free_names,
     parse_params,
+    read_table,
 )
 from .laws import concrete_units
 
@@ -138,24 +138,9 @@ def _cell(text, line, column):
 def read_data(path: Path) -> dict:
     """`{column: [float, ...]}` from a CSV with a header naming some of `COLUMNS`; empty
     cells are NaN; blank lines and lines starting with `#` are skipped."""
-    try:
-        text = path.read_text()
-    except OSError as error:
-        raise CLIError(f"cannot read --data {path}: {error.strerror or error}") from None
-    except UnicodeDecodeError:
-        raise CLIError(f"--data {path} is not a text file (a CSV with columns v0,e)") from None
-    header, rows = read_csv(text, comments=True)
-    if not header:
-        raise CLIError(f"--data {path} is empty")
-    header = [name.strip() for name in header]
-    unknown = [name for name in header if name not in COLUMNS]
-    if unknown:
-        raise CLIError(
-            f"--data {path}: unknown column {', '.join(map(repr, unknown))}; "
-            f"the columns are v0,e[,T,sigma_e,sigma_T]"
-        )
-    if len(set(header)) != len(header):
-        raise CLIError(f"--data {path}: a column is named twice in the header")
+    header, rows = read_table(
+        path, COLUMNS, label=f"--data {path}", hint="v0,e[,T,sigma_e,sigma_T]"
+    )
     for needed in ("v0", "e"):
         if needed not in header:
             raise CLIError(f"--data {path}: no column {needed!r} (need v0,e[,T,sigma_e,sigma_T])")

