@@ -134,6 +134,11 @@ def read_rebounds(path: Path, speed: float | None) -> dict:
             columns.setdefault(name, []).append(values[name])
     if not columns["v_n"]:
         raise CLIError(f"{path} has no rows")
+    if by_angle and len(columns["v_n"]) > 1 and max(columns["theta_deg"]) <= math.pi / 2:
+        raise CLIError(
+            f"{path}: every theta_deg is at most {math.pi / 2:.4f}: radians? the column "
+            "takes degrees from the normal"
+        )
     return columns
 
 

@@ -35,6 +35,7 @@ def _write(tmp_path, text, name="rebounds.csv"):
         ("theta_deg,e_t\n95,0.6\n", ["--speed", "3.9"], "must lie in [0, 90) degrees"),
         ("theta_deg,e_t,omega_out\n20,,\n", ["--speed", "3.9"], "neither e_t nor omega_out"),
         ("theta_deg,e_t\n", ["--speed", "3.9"], "has no rows"),
+        ("theta_deg,e_t\n0.35,0.6\n0.7,0.7\n", ["--speed", "3.9"], "radians?"),
         ("theta_deg,e_t\n20,0.6\n", ["--speed", "-1"], "--speed must be > 0"),
         ("theta_deg,e_t\n20,0.6\n", ["--speed", "3.9", "--tparam", "kt"], "--tparam 'kt' must"),
         ("theta_deg,e_t\n20,0.6\n", ["--speed", "3.9", "--free", "G_star"], "free must name"),
