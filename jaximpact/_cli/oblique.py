@@ -183,14 +183,35 @@ def run_fit_oblique(args):
     )
     if args.plot is not None:
         _plot(args.plot, rows, fit)
-    emit(args, fit.to_dict(), lambda: _report(fit, rows))
+    check = _sanity(law, args.mass, float(np.max(rows["v_n"])))
+    emit(args, {**fit.to_dict(), "check": check}, lambda: _report(fit, rows, check))
     return 0
 
 
-def _report(fit, rows) -> str:
+def _sanity(law, m: float, v_n: float) -> dict:
+    """What the normal law implies for mass `m` (kg) at the largest normal speed `v_n`
+    (m/s): contact time, penetration and peak force, so that a mass in the wrong unit shows
+    (e_t and the spin do not depend on it: both springs scale alike)."""
+    from .._solve.impact import impact
+
+    r = impact(law, m=m, v0=v_n)
+    return {"v_n": v_n, "T": float(r.T), "x_max": float(r.x_max), "F_max": float(r.F_max)}
+
+
+def _report(fit, rows, check) -> str:
     import numpy as np
 
-    lines = [fit.summary(), "", "  theta [deg]   e_t meas   e_t fit   omega_out meas   fit [rad/s]"]
+    from .._format import format_quantity
+
+    lines = [
+        fit.summary(),
+        f"check: at v_n = {check['v_n']:.4g} m/s the normal law with this mass gives a contact "
+        f"time of {format_quantity(check['T'], 's')}, x_max {format_quantity(check['x_max'], 'm')}"
+        f", F_max {format_quantity(check['F_max'], 'N')}: if these look wrong, check the units "
+        "(--mass in kg; e_t and the spin do not depend on the mass)",
+        "",
+        "  theta [deg]   e_t meas   e_t fit   omega_out meas   fit [rad/s]",
+    ]
     for i, theta in enumerate(rows["theta"]):
         e_m, w_m = rows["e_t"][i], rows["omega_out"][i]
         e_f, w_f = float(np.asarray(fit.e_t)[i]), float(np.asarray(fit.omega_out)[i])
