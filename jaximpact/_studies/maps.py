@@ -107,6 +107,13 @@ def restitution_map(
         )
     if {"c", damping_name} & set(fixed):
         raise ValueError("fixed must not hold c or the damping parameter: they are the grid")
+    missing = [k for k in spec.geometry if k not in fixed]
+    if missing:  # a radius is the user's, never guessed
+        raise ValueError(
+            f"law {law_name!r} needs its geometry held fixed: pass fixed={{"
+            + ", ".join(f"{k!r}: ... (m)" for k in missing)
+            + "}"
+        )
     c = axis(c, C_RANGE, num, log=True)
     damping = axis(damping, spec.map_range, num, log=False)
     m, v0 = float(m), float(v0)

@@ -108,6 +108,13 @@ def test_maxwell_map_integrated_equals_the_closed_form():
     [n for n in ji.LAW_NAMES if n not in ("kelvin_voigt", "maxwell", "hertz_rate")],
 )
 def test_every_law_maps_without_failures(name):
-    rmap = restitution_map(name, num=5)
+    geometry = {k: 0.01 for k in ji.LAWS[name].geometry}  # a radius of 1 cm (JKR)
+    fixed = {**ji.LAWS[name].map_fixed, **geometry} if geometry else None
+    rmap = restitution_map(name, num=5, fixed=fixed)
     assert np.all(np.isfinite(rmap.e)) and np.all(np.isfinite(rmap.T))
     assert np.all((rmap.e >= 0) & (rmap.e <= 1)) and np.all(rmap.T > 0)
+
+
+def test_a_law_with_geometry_needs_it_given():
+    with pytest.raises(ValueError, match=r"needs its geometry held fixed: pass fixed=\{'R'"):
+        restitution_map("jkr", num=3)
