@@ -270,18 +270,20 @@ def compute(job: Job) -> Job:
     waits for a dead one's parts. Returns the job with what this process `computed` and
     `reused` (and the `rows` and `chunks` of a table read once)."""
     group, parts, table = job.group, job.parts, job.table
+    own = [i for i in range(job.chunks) if group.owns(i)]
+    # said before the parts directory exists: a stop once it does is resumable (a signal
+    # between the two printed "nothing computed yet" without --resume; measured under load)
+    _note_kept(parts, job.out, 0, len(own))
     if group.index == 0:
         if not job.resume:
             parts.remove()
         parts.dir.mkdir(parents=True, exist_ok=True)
         group.clear(parts.dir)
     group.gather(None)  # the others wait for the parts directory
-    own = [i for i in range(job.chunks) if group.owns(i)]
     together = job.mesh == "global" and group.count > 1  # one program over every process
     digests, rows, chunks = dict(job.digests), job.rows, job.chunks
     computed = reused = done_rows = 0
     own_rows, start, failed = _own_rows(job, own), time.perf_counter(), True
-    _note_kept(parts, job.out, 0, len(own))
     try:
         with metered(job.progress, max(len(own), 1), f"batch {job.law}{job.tag}") as bar:
             for round_ in _rounds(enumerate(table.chunks(job.chunk_rows)), group.count):
