@@ -70,6 +70,7 @@ _PUBLIC.update(
     {
         "hertz_stiffness": "_engines",
         "yield_overlap": "_engines.materials",
+        "yield_pressure": "_engines.materials",
         "work_of_adhesion": "_engines.materials",
         "effective_mass": "_engines",
         "effective_radius": "_engines",

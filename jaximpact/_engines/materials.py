@@ -144,6 +144,24 @@ def yield_overlap(E, nu, R, *, p_y=None, Y=None, E2=None, nu2=None, R2=None) -> 
     return _representable("x_y", R_star * (math.pi * p_y / (2.0 * E_star)) ** 2, "m")
 
 
+def yield_pressure(x_y, E, nu, R, *, E2=None, nu2=None, R2=None) -> float:
+    """The limiting contact pressure `p_y` (Pa) that a yield overlap `x_y` (m) means, the
+    inverse of `yield_overlap`: `p_y = (2 E* / pi) (x_y / R*)^0.5`; the yield stress is
+    `Y = p_y / 1.6`. For a fitted `x_y` with standard error `s`, `p_y`'s is
+    `p_y s / (2 x_y)`.
+
+    `E` (Pa), `nu`, `R` (m), and `E2`, `nu2`, `R2` for the second body as in
+    `hertz_stiffness` (default: the same material, a flat).
+
+    **Example**: `yield_pressure(fit.params["x_y"], E=2.1e11, nu=0.3, R=5e-3, E2=math.inf)`.
+    """
+    x_y = _positive("x_y", x_y, "m")
+    R = _positive("R", R, "m")
+    R_star = R if R2 is None else effective_radius(R, R2)
+    E_star = effective_modulus(E, nu, E2, nu2)
+    return _representable("p_y", 2.0 * E_star / math.pi * math.sqrt(x_y / R_star), "Pa")
+
+
 def work_of_adhesion(gamma, gamma2=None, gamma12=0.0) -> float:
     """The work of adhesion `w` (J/m^2) of `law("jkr", ..., w=...)` from surface energies
     (J/m^2) by Dupre's rule, `w = gamma + gamma2 - gamma12`: twice the surface energy for

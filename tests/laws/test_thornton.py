@@ -8,6 +8,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from hypothesis import given, settings, strategies as st
 from scipy.integrate import solve_ivp
 
 import jaximpact as ji
@@ -138,6 +139,32 @@ def test_calibrate_recovers_the_yield_overlap_from_e_at_several_speeds():
     fit = ji.calibrate(ji.law("thornton", c=C, x_y=5 * X_Y), m=M, v0=v0, e=e, free=("x_y",))
     assert fit.converged and fit.reproduces
     assert float(fit.params["x_y"]) == pytest.approx(X_Y, rel=1e-8)
+
+
+def test_a_fitted_yield_overlap_gives_the_yield_stress_back():
+    """The overlap fitted from e(v) gives back the limiting pressure it was made from
+    (`yield_pressure`, the inverse of `yield_overlap`), hence Y = p_y / 1.6."""
+    v0 = jnp.array([0.05, 0.3, 1.0])
+    e = jax.vmap(lambda v: ji.impact(LAW, m=M, v0=v).e)(v0)
+    fit = ji.calibrate(ji.law("thornton", c=C, x_y=3 * X_Y), m=M, v0=v0, e=e, free=("x_y",))
+    p_y = ji.yield_pressure(float(fit.params["x_y"]), E=2.1e11, nu=0.3, R=R, E2=math.inf)
+    assert p_y == pytest.approx(P_Y, rel=1e-8)
+
+
+@settings(max_examples=50, deadline=None)
+@given(
+    x_y=st.floats(1e-12, 1e-3),
+    E=st.floats(1e6, 1e12),
+    nu=st.floats(0.0, 0.49),
+    R=st.floats(1e-6, 1.0),
+    flat=st.booleans(),
+)
+def test_yield_pressure_inverts_yield_overlap(x_y, E, nu, R, flat):
+    bodies = dict(E2=math.inf) if flat else dict(E2=2 * E, nu2=nu, R2=3 * R)
+    p_y = ji.yield_pressure(x_y, E=E, nu=nu, R=R, **bodies)
+    assert ji.yield_overlap(E, nu, R, p_y=p_y, **bodies) == pytest.approx(x_y, rel=1e-12)
+    with pytest.raises(ValueError, match="x_y"):
+        ji.yield_pressure(-x_y, E=E, nu=nu, R=R)
 
 
 def test_the_force_remembers_the_largest_overlap():
