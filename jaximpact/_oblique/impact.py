@@ -18,6 +18,7 @@ from .._laws import AbstractLaw
 from .._solve.adjoint import _tracer_kinds, auto_adjoint
 from .._solve.impact import check_custom_law
 from .._solve.options import CUSTOM_RTOL, DEFAULT_RTOL
+from .._solve.phases import solve_broke
 from .._status import Status
 from .dynamics import SLIP, STICK, ObliqueDynamics
 from .results import _NOT_RESULTS, ObliqueResult
@@ -218,11 +219,7 @@ def _segment(setup: _Setup, carry, _):
     switched = masks[-1]
     fired = jnp.any(jnp.stack(list(masks)))
     out_of_steps = sol.result == dfx.RESULTS.max_steps_reached
-    broke = (
-        (sol.result == dfx.RESULTS.dt_min_reached)
-        | (sol.result == dfx.RESULTS.max_steps_rejected)
-        | (sol.result == dfx.RESULTS.internal_error)
-    )
+    broke = solve_broke(sol.result)
     # the tangential limit crossed before the segment's end: within its last step,
     # before a normal event that diffrax, taking conditions in order, put first (the
     # segment is solved again from its start to that event's time, the normal

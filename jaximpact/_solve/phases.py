@@ -75,6 +75,17 @@ def _event_conditions(dynamics, separation, plan, rest_tol):
     return conditions
 
 
+def solve_broke(result):
+    """Whether a diffrax solve itself failed (`result`: its `RESULTS`): the step size fell
+    below its minimum, too many steps were rejected, or an internal error; running out of
+    steps (`max_steps_reached`) is reported apart."""
+    return (
+        (result == dfx.RESULTS.dt_min_reached)
+        | (result == dfx.RESULTS.max_steps_rejected)
+        | (result == dfx.RESULTS.internal_error)
+    )
+
+
 def integrate_phases(
     dynamics,
     *,
@@ -141,11 +152,7 @@ def integrate_phases(
         # the solve itself failed, or its state is not a number; a root finder that did
         # not meet its 1e-13 (an ill-conditioned event, e.g. heavy Kelvin-Voigt damping
         # where F crosses zero with slope c v_out ~ 0) still placed the event: not a failure
-        broke = (
-            (sol.result == dfx.RESULTS.dt_min_reached)
-            | (sol.result == dfx.RESULTS.max_steps_rejected)
-            | (sol.result == dfx.RESULTS.internal_error)
-        )
+        broke = solve_broke(sol.result)
         failed = ~skip & ~out_of_steps & (broke | ~jnp.all(jnp.isfinite(y_end)))
         record = dict(
             y=y_end,
