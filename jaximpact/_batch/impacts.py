@@ -316,6 +316,7 @@ def run_impacts(
         max_steps=limits["max_steps"],
         tau_max=limits["tau_max"],
         peaks=peaks,
+        gravity=gravity,
     )
     try:
         member = _impact_member(skeleton, tuple(fields), options, gravity)

@@ -25,6 +25,7 @@ from .._format import (
 )
 from .._laws import AbstractLaw, damping_parameter, shape_of
 from .._solve.impact import CURVES_RTOL, ImpactOptions, similarity_reason, solve_impact
+from .._solve.options import is_no_gravity
 from .._status import Status
 from .forward_jacobian import value_and_jacobian, with_forward_jacobian
 from .parameters import default_free, law_with, to_unbounded
@@ -472,6 +473,7 @@ def _residual_function(
         adjoint=dfx.ForwardMode(),
         peaks=peaks,
         similarity=curves,
+        gravity=not is_no_gravity(g),
     )
 
     def residuals(theta, data):
@@ -634,7 +636,7 @@ def calibrate(
         )
     if not free:
         raise ValueError("free names no parameter to fit")
-    g_is_zero = isinstance(g, (int, float)) and g == 0
+    g_is_zero = is_no_gravity(g)
     undetermined, undetermined_why = _undetermined(law, free, e=e, T=T, g_is_zero=g_is_zero)
     curves = None
     if method in ("auto", "similarity"):
@@ -675,7 +677,9 @@ def calibrate(
         and method == "auto"
         and law.closed_form(separation, g_is_zero=g_is_zero) is not None,
     )
-    fit = _fit(law, data, m, np.float64(g) if g_is_zero else jnp.asarray(g, dtype=float),
+    # g = 0 as a Python number is static to filter_jit (a numpy scalar would be traced):
+    # the formulas without gravity are compiled alone
+    fit = _fit(law, data, m, 0.0 if g_is_zero else jnp.asarray(g, dtype=float),
                np.float64(target_tol), options)  # fmt: skip
     e_only = T is None and g_is_zero and shape_of(law) is not None
     return _reported(fit, undetermined, undetermined_why, e_only)

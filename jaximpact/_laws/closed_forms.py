@@ -314,8 +314,9 @@ TAU_MAX = 1e4
 
 def _where_no_gravity(g, without_gravity, with_gravity, args):
     """`without_gravity(args)` where `g = 0`, else `with_gravity(args)`: decided once where
-    `g` is known (a number, or a concrete array), else a `lax.cond` (a select under `vmap`,
-    where both run)."""
+    `g` is known (a number, or a concrete array, as given: `jnp.asarray` of a number
+    inside a trace is a tracer), else a `lax.cond` (a select under `vmap`, where both
+    run)."""
     if not is_traced(g):
         return (without_gravity if bool(np.all(np.asarray(g) == 0)) else with_gravity)(args)
     return jax.lax.cond(jnp.all(g == 0), without_gravity, with_gravity, args)
@@ -331,7 +332,7 @@ def kelvin_voigt_closed_form(separation):
 
     def impact_fields(law, *, m, v0, g=0.0, rest_tol, tau_max=TAU_MAX, with_end=False):
         c, b = law.params["c"], law.params["b"]
-        g = jnp.asarray(g, dtype=jnp.result_type(float))
+        given_g, g = g, jnp.asarray(g, dtype=jnp.result_type(float))
 
         def without_gravity(args):
             c, b, m, v0, g = args
@@ -350,7 +351,7 @@ def kelvin_voigt_closed_form(separation):
 
         args = jnp.broadcast_arrays(c, b, m, v0, g)
         # eq. 5's formulas where g = 0 (a select under vmap, one branch otherwise)
-        fields = _where_no_gravity(g, without_gravity, with_gravity, args)
+        fields = _where_no_gravity(given_g, without_gravity, with_gravity, args)
         return _finish(fields, m, v0, g, with_end)
 
     return impact_fields
@@ -380,7 +381,7 @@ def maxwell_closed_form(separation):
 
     def impact_fields(law, *, m, v0, g=0.0, rest_tol, tau_max=TAU_MAX, with_end=False):
         c, b = law.params["c"], law.params["b"]
-        g = jnp.asarray(g, dtype=jnp.result_type(float))
+        given_g, g = g, jnp.asarray(g, dtype=jnp.result_type(float))
 
         def without_gravity(args):
             c, b, m, v0, g = args
@@ -395,7 +396,7 @@ def maxwell_closed_form(separation):
             return dict(fields, status=jnp.asarray(fields["status"]).astype(jnp.int32))
 
         args = jnp.broadcast_arrays(c, b, m, v0, g)
-        fields = _where_no_gravity(g, without_gravity, with_gravity, args)
+        fields = _where_no_gravity(given_g, without_gravity, with_gravity, args)
         return _finish(fields, m, v0, g, with_end)
 
     return impact_fields

@@ -23,6 +23,7 @@ from .options import (
     check_choices,
     check_options,
     choose_path,
+    is_no_gravity,
     make_options,
     similarity_reason as similarity_reason,
 )
@@ -34,6 +35,8 @@ from .results import ImpactResult
 def solve_impact(law, m, v0, g, ts, options: ImpactOptions) -> ImpactResult:
     """The compiled part of `impact`, cached per law structure and options; no input
     checks (callers inside the library that have validated their inputs use it)."""
+    if not options.gravity:  # g is 0, a static fact: no gravity's branches are compiled
+        g = 0.0
     dynamics = law.dynamics(m=m, v0=v0, g=g)
     if isinstance(options.similarity, WithGravity):
         return gravity_impact(dynamics, m, v0, g, options)[0]
@@ -302,6 +305,7 @@ def impact(
         tau_max=tau_max,
         peaks=peaks,
         inputs=(law, m, v0, g, ts),
+        gravity=not is_no_gravity(given_g),
     )
     result = solve_impact(law, m, v0, g, ts, options)
     if path.name == "gravity_table" and not is_traced(result.num_steps):

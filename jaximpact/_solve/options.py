@@ -42,6 +42,8 @@ class ImpactOptions(eqx.Module):
     - `peaks`: find `x_max`, `t_max`, `F_max`.
     - `similarity`: the universal curves' `CurveKey` to read the impact off, or
       `WithGravity(key)` for the two-group gravity table; None otherwise.
+    - `gravity`: False where `g` is known to be 0 (a number 0 given): the solve then
+      compiles without gravity's branches (a traced `g` would compile both).
 
     **Example**: `jaximpact.ImpactOptions(separation="force", closed_form=True, solver=None,
     rtol=1e-11, atol=1e-11, max_steps=4096, tau_max=1e4, rest_tol=1e-7, adjoint=None,
@@ -59,6 +61,7 @@ class ImpactOptions(eqx.Module):
     adjoint: object = eqx.field(static=True)  # a diffrax adjoint (None: not integrated)
     peaks: bool = eqx.field(static=True)
     similarity: CurveKey | WithGravity | None = eqx.field(static=True, default=None)
+    gravity: bool = eqx.field(static=True, default=True)
 
 
 class Path(NamedTuple):
@@ -166,7 +169,7 @@ def choose_path(
     `ValueError` says why they cannot serve). Gravity is none only where `g` is a number
     0 (a static fact); an array or a traced value counts as gravity.
     """
-    g_is_zero = isinstance(g, (int, float)) and g == 0
+    g_is_zero = is_no_gravity(g)
     closed = None if ts is not None else law.closed_form(separation, g_is_zero=g_is_zero)
     if method == "closed_form" and closed is None:
         raise ValueError(
@@ -199,11 +202,13 @@ def make_options(
     tau_max: float = 1e4,
     peaks: bool = True,
     inputs: tuple = (),
+    gravity: bool = True,
 ) -> ImpactOptions:
     """The `ImpactOptions` of a solve on `path` (tolerances as the working precision can
     meet them: `precision.resolvable_tolerances`). Where the path integrates, `solver`
     defaults to `diffrax.Tsit5()` and `adjoint` to the cheapest one for the tracers in
-    `inputs` (`adjoint.auto_adjoint`; no tracers: `RecursiveCheckpointAdjoint`)."""
+    `inputs` (`adjoint.auto_adjoint`; no tracers: `RecursiveCheckpointAdjoint`);
+    `gravity=False` where `g` is a number 0 (`is_no_gravity`)."""
     if path.integrates:
         import diffrax as dfx
 
@@ -223,7 +228,14 @@ def make_options(
         adjoint=adjoint,
         peaks=peaks,
         similarity=path.key,
+        gravity=gravity,
     )
+
+
+def is_no_gravity(g) -> bool:
+    """Whether `g` is a number 0 (a Python or numpy scalar, not an array or a tracer):
+    the one static fact that lets a solve compile without gravity."""
+    return isinstance(g, (int, float)) and not isinstance(g, bool) and g == 0
 
 
 def _shown(g) -> str:
