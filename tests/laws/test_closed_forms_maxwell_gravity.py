@@ -506,9 +506,11 @@ def test_no_gravity_compiles_without_gravitys_formulas(where, monkeypatch):
     monkeypatch.setattr(closed_forms, "maxwell_gravity_impact", refuse)
     law = ji.law("maxwell", c=2.7e4, b=200.0)
     if where == "impact":
-        options = ji.ImpactOptions(separation="force", closed_form=True, solver=None,
-                                   rtol=1e-11, atol=1e-11, max_steps=4096, tau_max=1e4,
-                                   rest_tol=1e-7, adjoint=None, peaks=True, gravity=False)  # fmt: skip
+        options = ji.ImpactOptions(
+            separation="force", closed_form=True, solver=None, rtol=1e-11, atol=1e-11,
+            max_steps=4096, tau_max=1e4, rest_tol=1e-7, adjoint=None, peaks=True,
+            gravity=False,
+        )  # fmt: skip
         from jaximpact._solve.impact import solve_impact
 
         jax.eval_shape(lambda v: solve_impact(law, 0.0027, v, 0.0, None, options).e, 1.0)
