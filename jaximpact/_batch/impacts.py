@@ -140,7 +140,7 @@ def _fix_shape(skeleton, params):
 
 # a batch's `path` per row: on the gravity table, "integrated" (the batch does not tell the
 # rows the table served from those it integrated)
-_LABELS = {"gravity_table": "integrated"}
+_LABELS = {"gravity_table": "integrated", "dry_table": "integrated"}
 # the keywords of `impact` that a batch passes on (beyond separation, method, rtol, peaks)
 IMPACT_OPTIONS = ("solver", "atol", "max_steps", "tau_max", "rest_tol", "adjoint")
 

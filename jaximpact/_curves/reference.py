@@ -31,9 +31,13 @@ def _force(y, beta, n, p):
     return _pow(y[0], n) + beta * _pow(y[0], p) * y[1]
 
 
-def _separation_gap(y, beta, n, p, separation):
-    """Positive in contact, crossing zero at separation (a transversal crossing)."""
+def _separation_gap(y, beta, n, p, separation, dry=None):
+    """Positive in contact, crossing zero at separation (a transversal crossing); with a
+    dry force (restitution: `F = X^n + beta X^p V - dry`), the force itself under
+    `"force"` (it crosses zero inside the surface, before `X` does)."""
     x, v = y[0], y[1]
+    if dry is not None and separation == "force":
+        return jnp.minimum(x, _force(y, beta, n, p) - dry)
     if separation == "penetration" or n == p:
         return x
     k = n - p  # F = x^p (x^k + beta v); with the smaller of it and x, whose slope below 0
@@ -98,17 +102,21 @@ def reference_impact(
     tau_max=1e7,
     max_steps=400_000,
     gamma=None,
+    dry=None,
 ):
     """`dict` of the five `curve.OUTPUTS` (nondimensional), `separated` (bool) at `beta`.
 
     `gamma` (`g x*/v0^2`, gravity pushing in: `X'' = -X^n - beta X^p X' + gamma`): `None`
     for none; with it, a restitution in which `V` comes back up to 0 before separation
     (the body held in the surface: a second solve, up to the separation) is not
-    `separated`."""
+    `separated`. `dry` (`P/(c x*^n)`, `None` for none): a dry force against the motion; a
+    body that comes to rest with `X^n <= dry` is held (stuck), not `separated`; `F_max`
+    includes it."""
     y0 = jnp.stack([jnp.zeros_like(beta), jnp.ones_like(beta)])
     options = dict(rtol=rtol, max_steps=max_steps)
-    if gamma is not None:
-        options["gamma"] = gamma
+    constant = (0.0 if gamma is None else gamma) - (0.0 if dry is None else dry)
+    if gamma is not None or dry is not None:
+        options["gamma"] = constant  # compression: gravity in, the dry force out
     y_max, t_max, _ = _solve(y0, 0.0, tau_max, lambda y: y[1], beta, n, p, **options)
     y_peak, _, peaked = _solve(
         y0,
@@ -120,14 +128,18 @@ def reference_impact(
         p,
         **options,
     )
-    at_touch = _force(y0, beta, n, p)
-    later = jnp.maximum(
-        _force(y_max, beta, n, p), jnp.where(peaked, _force(y_peak, beta, n, p), 0.0)
+    in_dry = 0.0 if dry is None else dry
+    at_touch = _force(y0, beta, n, p) + in_dry
+    later = (
+        jnp.maximum(_force(y_max, beta, n, p), jnp.where(peaked, _force(y_peak, beta, n, p), 0.0))
+        + in_dry
     )
     f_max = jnp.maximum(at_touch, later)
     restitution = y_max.at[1].set(0.0)
     end = tau_max
-    if gamma is not None:
+    if dry is not None:  # restitution: gravity in, the dry force in (against V < 0)
+        options["gamma"] = (0.0 if gamma is None else gamma) + dry
+    if gamma is not None or dry is not None:
         # where V comes back up to 0 (upwards only): gravity holding the body, or, after
         # a separation, its fall back; the separation must come before it. (V - 1e-14:
         # negative at the start, where V = 0, so that the bracket is never [0, +])
@@ -139,7 +151,7 @@ def reference_impact(
         restitution,
         t_max,
         end,
-        lambda y: _separation_gap(y, beta, n, p, separation),
+        lambda y: _separation_gap(y, beta, n, p, separation, dry),
         beta,
         n,
         p,
@@ -151,7 +163,8 @@ def reference_impact(
         x_max=y_max[0],
         t_max=t_max,
         F_max=f_max,
-        separated=ended & (y_end[1] < 0),
+        # a dry force holds a body at rest at maximum compression where X^n <= dry
+        separated=ended & (y_end[1] < 0) & (_pow(y_max[0], n) > in_dry),
         # where this flips, F_max switches from a later peak to the force at first touch
         # (p = 0: beta): a kink that no Chebyshev piece may straddle
         peak_at_touch=at_touch >= later,

@@ -34,6 +34,9 @@ class LawSpec:
     `one_group`: without gravity the impact depends on the one group `beta` alone (the
     family without a dry force), so `impact` can read it off the universal curves, whose
     shipped shapes are those of these rows (`table.SHIPPED_SHAPES`);
+    `dry_table`: the dry force acts in both phases of a family law with numbers for
+    exponents (Bingham-modified), so without gravity the impact depends on `beta` and
+    `P/(c x*^n)` and `impact` reads it off the two-group dry table (`_curves.gravity`).
     `shape`: the exponents `(n, p)` of a family law, each a number or the name of the
     parameter that holds it (`shape_parameters`: those names, which must be known numbers,
     not traced values, for the curves to serve); `()` outside the family. `closed_form`:
@@ -73,6 +76,7 @@ class LawSpec:
     dry: bool = False
     defaults: dict[str, float] = dataclasses.field(default_factory=dict)
     one_group: bool = False
+    dry_table: bool = False
     closed_form: Callable | None = None
     closed_form_gravity: bool = False
     shape: tuple = ()

@@ -100,6 +100,7 @@ _SPECS = [
         coefficients=lambda q, v0: _family(q["c"], 1, q["b1"], 1, q["P"], -q["P"]),
         split=True,
         dry=True,
+        dry_table=True,  # (beta, P/(c x*)) without gravity: the two-group dry table
     ),
     LawSpec(
         name="bingham_compression",

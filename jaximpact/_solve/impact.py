@@ -178,16 +178,17 @@ def _warn_if_energy_gained(law, result, m, v0):
 
 
 def gravity_impact(dynamics, m, v0, g, options: ImpactOptions):
-    """One contact with gravity from the two-group table (`_curves.gravity`) where
-    `(beta, gamma)` lies in it, else integrated with `options` (a `lax.cond`; under `vmap`
-    both run, and the integration skips the members the table serves, so a batch pays for
-    the solver only where some member is outside). Returns the `ImpactResult` (path
-    `"similarity"`) and the penetration at separation (m)."""
+    """One contact from a two-group table (`_curves.gravity`: gravity, or a dry force in
+    both phases) where `(beta, gamma)` (or `(beta, pi)`) lies in it, else integrated with
+    `options` (a `lax.cond`; under `vmap` both run, and the integration skips the members
+    the table serves, so a batch pays for the solver only where some member is outside).
+    Returns the `ImpactResult` (path `"similarity"`) and the penetration at separation (m)."""
     from .phases import integrated_contact
 
     fields, x_end, in_range = gravity_fields(
-        dynamics, options.similarity.key, m=m, v0=v0, g=g, peaks=options.peaks
-    )
+        dynamics, options.similarity.key, m=m, v0=v0, g=g, peaks=options.peaks,
+        group=options.similarity.group,
+    )  # fmt: skip
 
     def same_types(values):
         return {
@@ -308,7 +309,7 @@ def impact(
         gravity=not is_no_gravity(given_g),
     )
     result = solve_impact(law, m, v0, g, ts, options)
-    if path.name == "gravity_table" and not is_traced(result.num_steps):
+    if path.name in ("gravity_table", "dry_table") and not is_traced(result.num_steps):
         if int(result.num_steps) > 0:  # outside the table: integrated, and said so
             fields = {f.name: getattr(result, f.name) for f in dataclasses.fields(result)}
             result = ImpactResult(**{**fields, "path": "integrated"})

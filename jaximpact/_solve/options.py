@@ -9,14 +9,14 @@ from typing import NamedTuple
 import equinox as eqx
 
 from .._checks import is_traced
-from .._curves.gravity import WithGravity, table_for
+from .._curves.gravity import WithDryForce, WithGravity, table_for
 from .._curves.shapes import CurveKey, curve_key
 from .._curves.similarity import serves
 from .._laws import shape_of
 
 SEPARATIONS = ("force", "penetration")
 METHODS = ("auto", "integrate", "closed_form", "similarity")
-PATHS = ("closed_form", "similarity", "gravity_table", "integrated")
+PATHS = ("closed_form", "similarity", "gravity_table", "dry_table", "integrated")
 # the curves are accurate to about 2e-11 relative (docs/similarity.md): a finer `rtol`
 # asked of `impact` integrates instead
 CURVES_RTOL = 1e-11
@@ -41,7 +41,8 @@ class ImpactOptions(eqx.Module):
       (in units of `v0` and `m v0^2/x*`) below which the body is at rest.
     - `peaks`: find `x_max`, `t_max`, `F_max`.
     - `similarity`: the universal curves' `CurveKey` to read the impact off, or
-      `WithGravity(key)` for the two-group gravity table; None otherwise.
+      `WithGravity(key)` for the two-group gravity table, `WithDryForce(key)` for the
+      dry force's (Bingham-modified); None otherwise.
     - `gravity`: False where `g` is known to be 0 (a number 0 given): the solve then
       compiles without gravity's branches (a traced `g` would compile both).
 
@@ -66,7 +67,7 @@ class ImpactOptions(eqx.Module):
 
 class Path(NamedTuple):
     """How an impact is computed: `name`, one of `PATHS`, and for the curves their `key`
-    (a `CurveKey`, or `WithGravity(key)` for the gravity table)."""
+    (a `CurveKey`, or `WithGravity(key)` / `WithDryForce(key)` for a two-group table)."""
 
     name: str
     key: CurveKey | WithGravity | None = None
@@ -75,7 +76,7 @@ class Path(NamedTuple):
     def integrates(self) -> bool:
         """Whether the solve needs the integrator (the gravity table integrates the impacts
         that leave it)."""
-        return self.name in ("gravity_table", "integrated")
+        return self.name in ("gravity_table", "dry_table", "integrated")
 
 
 def check_choices(separation: str, method: str, rtol, *, table_law: bool):
@@ -186,7 +187,23 @@ def choose_path(
             return Path("similarity", key) if g_is_zero else Path("gravity_table", WithGravity(key))
     if closed is not None and method != "integrate":
         return Path("closed_form")
+    if method in ("auto", "similarity") and solver is None and rtol >= CURVES_RTOL:
+        dry = dry_table_key(law, separation, g_is_zero=g_is_zero, ts=ts)
+        if dry is not None:
+            return Path("dry_table", dry)
     return Path("integrated")
+
+
+def dry_table_key(law, separation: str, *, g_is_zero: bool, ts=None) -> WithDryForce | None:
+    """The two-group table of a law whose dry force acts in both phases (its row's
+    `dry_table`: Bingham-modified, eq. 8), where it serves: no gravity (a third group), no
+    time histories, a shipped table for the law's shape under `separation`; else `None`.
+    Impacts outside the table (a dry force near the one that holds the body) are
+    integrated."""
+    if not (law.spec and law.spec.dry_table) or not g_is_zero or ts is not None:
+        return None
+    key = CurveKey(*(float(q) for q in law.spec.shape), separation)
+    return WithDryForce(key) if table_for(key, "dry") is not None else None
 
 
 def make_options(

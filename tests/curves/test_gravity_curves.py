@@ -24,6 +24,7 @@ LAWS = {
     ("hunt_crossley", "force"): ("a", 1.5),
     ("hertz_modified", "force"): ("b", 1.0),
     ("hertz_rate", "penetration"): ("b1", 1.0),
+    ("hertz_viscous", "force"): ("b", 1.0),
 }
 # the fast suite checks law 14 under the force criterion; the slow group every shipped shape
 FAST = []  # one gravity impact against the integration is in the fast suite (below)

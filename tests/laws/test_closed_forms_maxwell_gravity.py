@@ -495,32 +495,35 @@ def test_bounce_closed_form_gradients():
 @pytest.mark.parametrize("where", ["impact", "calibrate"])
 def test_no_gravity_compiles_without_gravitys_formulas(where, monkeypatch):
     """With g a number 0, neither `impact` nor `calibrate` traces the formulas with gravity
-    (a traced g compiled both branches: calibrate's compile was 20 s instead of 3 s)."""
+    (a traced g compiled both branches: calibrate's compile was 20 s instead of 3 s). The
+    solve is traced afresh (its jit wrapper's cache would skip the trace)."""
+    import jaximpact._fit.calibrate as calibrate
     import jaximpact._laws.closed_forms as closed_forms
-    from jaximpact._fit.calibrate import _residual_function
     from jaximpact._fit.forward_jacobian import value_and_jacobian
+    from jaximpact._solve.impact import solve_impact
 
     def refuse(*args, **kwargs):
         raise AssertionError("the formulas with gravity were traced for g = 0")
 
     monkeypatch.setattr(closed_forms, "maxwell_gravity_impact", refuse)
+    monkeypatch.setattr(calibrate, "solve_impact", solve_impact.__wrapped__)
     law = ji.law("maxwell", c=2.7e4, b=200.0)
+    options = dict(
+        separation="force", closed_form=True, solver=None, rtol=1e-11, atol=1e-11,
+        max_steps=4096, tau_max=1e4, rest_tol=1e-7, adjoint=None, peaks=True,
+    )  # fmt: skip
+    solve = solve_impact.__wrapped__
     if where == "impact":
-        options = ji.ImpactOptions(
-            separation="force", closed_form=True, solver=None, rtol=1e-11, atol=1e-11,
-            max_steps=4096, tau_max=1e4, rest_tol=1e-7, adjoint=None, peaks=True,
-            gravity=False,
-        )  # fmt: skip
-        from jaximpact._solve.impact import solve_impact
-
-        jax.eval_shape(lambda v: solve_impact(law, 0.0027, v, 0.0, None, options).e, 1.0)
-        # and through impact itself, jitted over v0 (a fresh trace: a new function)
-        jax.eval_shape(lambda v: ji.impact(law, m=0.0027, v0=v).e, 1.0)
+        no_gravity = ji.ImpactOptions(**options, gravity=False)
+        jax.eval_shape(lambda v, g: solve(law, 0.0027, v, g, None, no_gravity).e, 1.0, 0.0)
     else:
-        raw = _residual_function(law, ("b", "c"), m=0.0027, separation="force", g=0.0,
-                                 rtol=1e-10, has_e=True, has_T=False, closed_form=True)  # fmt: skip
+        raw = calibrate._residual_function(
+            law, ("b", "c"), m=0.0027, separation="force", g=0.0, rtol=1e-10, has_e=True,
+            has_T=False, closed_form=True,
+        )  # fmt: skip
         data = (jnp.ones(2), jnp.ones(2), jnp.full(2, jnp.nan), jnp.ones(2), jnp.ones(2))
         jax.eval_shape(lambda t: value_and_jacobian(raw, t, data), jnp.zeros(2))
     # with gravity the formulas are traced (the check above can fail)
+    gravity = ji.ImpactOptions(**options, gravity=True)
     with pytest.raises(AssertionError, match="traced for g = 0"):
-        jax.eval_shape(lambda v: ji.impact(law, m=0.0027, v0=v, g=9.81).e, 1.0)
+        jax.eval_shape(lambda v, g: solve(law, 0.0027, v, g, None, gravity).e, 1.0, 0.0)
