@@ -81,10 +81,10 @@ def test_law_takes_numbers_or_arrays_of_good_numbers_only(value):
 def _refused(name: str, key: str, value: float) -> bool:
     """DESIGN.md's rule: stiffness and exponent > 0, a nominal restitution in (0, 1], the
     rest >= 0; Maxwell's dashpot > 0 (b = 0 carries no force: the body never stops),
-    Thornton's yield overlap and JKR's radius > 0."""
+    Thornton's yield overlap and the adhesive laws' radius > 0."""
     if not math.isfinite(value):
         return True
-    positive = {"maxwell": ("b",), "thornton": ("x_y",), "jkr": ("R",)}.get(name, ())
+    positive = {"maxwell": ("b",), "thornton": ("x_y",), "jkr": ("R",), "dmt": ("R",)}.get(name, ())
     if key in ("c", "n") or key in positive:
         return value <= 0
     if key == "e_nominal":

@@ -421,10 +421,14 @@ def gravity_fields(
 
     outputs = (0, 1, 2, 3, 4) if peaks else (0, 1)
     beta = dynamics.beta
-    second = dynamics.gamma if group == "gravity" else dynamics.dry_in
+    # a constant force alike in both phases (DMT's adhesion, dry_in = dry_out < 0) pulls
+    # in as gravity does
+    second = dynamics.gamma - dynamics.dry_in if group == "gravity" else dynamics.dry_in
     in_range, q = gravity_correction(table_for(key, group), beta, second, outputs)
     base = curve_values(curves_for(curve_key(key.n, key.p, key.separation)), beta, outputs)
     values = base * jnp.exp(jnp.where(in_range, second, 0.0) * q)
+    if peaks and group == "gravity":  # the table's F_max is that of X^n + beta X^p V
+        values = values.at[4].add(dynamics.dry_in)
     e = values[0]
     if key.separation == "force" and group == "dry":
         # x^n (1 + beta V) = pi where the force criterion ends contact (n = p, V = -e)

@@ -25,7 +25,7 @@ from .._format import (
 )
 from .._laws import AbstractLaw, damping_parameter, shape_of
 from .._solve.impact import CURVES_RTOL, ImpactOptions, similarity_reason, solve_impact
-from .._solve.options import dry_table_key, is_no_gravity
+from .._solve.options import is_no_gravity, table_key
 from .._status import Status
 from .forward_jacobian import value_and_jacobian, with_forward_jacobian
 from .parameters import default_free, law_with, to_unbounded
@@ -649,11 +649,11 @@ def calibrate(
         raise ValueError(f"method must be 'auto', 'similarity' or 'integrate', got {method!r}")
     if init == "auto" and curves is None:
         law = _initial_law(law, free, m=m, v0=v0, e=e, T=T, separation=separation)
-    # a dry force in both phases (Bingham-modified): its two-group table, integrated where
-    # a speed falls outside it
+    # a dry force in both phases (Bingham-modified), an adhesion in contact (DMT): a
+    # two-group table, integrated where a speed falls outside it
     table = None
     if curves is None and method == "auto" and rtol >= CURVES_RTOL:
-        table = dry_table_key(law, separation, g_is_zero=g_is_zero)
+        table = table_key(law, separation, g_is_zero=g_is_zero)
 
     ones = np.ones(rows)
     s_e = ones if sigma_e is None else sigma_e

@@ -79,6 +79,9 @@ def starting_law(name: str, *, m: float, v0: float, e: float, T: float | None, *
             params[key] = energy / (e * x_star) / (2.0 if _dry_both_ways(spec, v0) else 1.0)
         elif key == "e_nominal":
             params[key] = min(max(e, 0.05), 0.999)
+        elif key == "w":  # DMT: a pull-off 2 pi w R of 1 % of the contact's force scale
+            params[key] = 0.01 * m * v0**2 / x_star / (2.0 * math.pi * geometry["R"])
+    params.update(geometry)
     return law(name, **{k: v for k, v in params.items() if k in spec.parameters})
 
 

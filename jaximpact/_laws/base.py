@@ -37,6 +37,10 @@ class LawSpec:
     `dry_table`: the dry force acts in both phases of a family law with numbers for
     exponents (Bingham-modified), so without gravity the impact depends on `beta` and
     `P/(c x*^n)` and `impact` reads it off the two-group dry table (`_curves.gravity`).
+    `constant_force`: the family's `P` acts alike in both phases while in contact (DMT's
+    adhesion, `P = -2 pi w R`), so it enters the impact as gravity does (`gamma - P/(c
+    x*^n)`) and `impact` reads it off the gravity table of its shape under the penetration
+    criterion (`gap="x"`: contact ends at `x = 0`).
     `shape`: the exponents `(n, p)` of a family law, each a number or the name of the
     parameter that holds it (`shape_parameters`: those names, which must be known numbers,
     not traced values, for the curves to serve); `()` outside the family. `closed_form`:
@@ -77,6 +81,7 @@ class LawSpec:
     defaults: dict[str, float] = dataclasses.field(default_factory=dict)
     one_group: bool = False
     dry_table: bool = False
+    constant_force: bool = False
     closed_form: Callable | None = None
     closed_form_gravity: bool = False
     shape: tuple = ()

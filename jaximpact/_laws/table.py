@@ -36,6 +36,11 @@ def _family(c, n, b, p, p_in=0.0, p_out=0.0):
     return c, n, b + zero, p, p_in + zero, p_out + zero
 
 
+def _dmt_adhesion(q):
+    """DMT's pull-off force `2 pi w R` (N), acting while in contact."""
+    return 2.0 * jnp.pi * q["w"] * q["R"]
+
+
 _SPECS = [
     LawSpec(
         name="kelvin_voigt",
@@ -238,6 +243,27 @@ def _log_damping(e):
 
 
 _SPECS += [
+    LawSpec(
+        name="dmt",
+        damping="b",
+        map_range=(200.0, 2000.0),
+        equation="DMT 1975",
+        formula="c x^1.5 + b x^0.5 v - 2 pi w R while x > 0 (contact ends at x = 0)",
+        parameters=("c", "b", "R", "w"),
+        units={"c": "N/m^1.5", "b": "N s/m^1.5", "R": "m", "w": "J/m^2"},
+        reference="Derjaguin, Muller & Toporov, J. Colloid Interface Sci. 53 (1975) 314; "
+        "LAMMPS pair granular dmt (pull-off 4 pi cohesion R = 2 pi w R), damping viscoelastic",
+        coefficients=lambda q, v0: _family(
+            q["c"], 1.5, q["b"], 0.5, -_dmt_adhesion(q), -_dmt_adhesion(q)
+        ),
+        gap="x",  # the adhesion holds the contact until x = 0 under either criterion
+        shape=(1.5, 0.5),
+        constant_force=True,  # read off law 14's gravity table (penetration)
+        positive=("c", "R"),
+        captures=True,  # below the sticking speed: e = 0, captured
+        geometry=("R",),
+        kind="adhesive",
+    ),
     LawSpec(
         name="tsuji",
         damping="b",

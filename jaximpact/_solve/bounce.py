@@ -31,6 +31,7 @@ from .._status import Status
 from .adjoint import auto_adjoint
 from .flight import Flight
 from .impact import CURVES_RTOL, SEPARATIONS, ImpactOptions, gravity_impact, similarity_reason
+from .options import adhesion_table_key
 from .phases import integrated_contact
 from .precision import resolvable_tolerances
 from .results import ImpactResult
@@ -78,6 +79,9 @@ def _gravity_key(law, options: ImpactOptions):
         return None
     if options.rtol < CURVES_RTOL or type(options.solver) is not dfx.Tsit5:
         return None
+    adhesion = adhesion_table_key(law)  # DMT: its adhesion pulls in as gravity does
+    if adhesion is not None:
+        return adhesion
     reason = similarity_reason(law, options.separation, g_is_zero=False, gravity_table=True)
     if reason is not None:
         return None

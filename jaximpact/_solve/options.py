@@ -188,10 +188,28 @@ def choose_path(
     if closed is not None and method != "integrate":
         return Path("closed_form")
     if method in ("auto", "similarity") and solver is None and rtol >= CURVES_RTOL:
-        dry = dry_table_key(law, separation, g_is_zero=g_is_zero, ts=ts)
-        if dry is not None:
-            return Path("dry_table", dry)
+        table = table_key(law, separation, g_is_zero=g_is_zero, ts=ts)
+        if table is not None:
+            return Path(f"{table.group}_table", table)
     return Path("integrated")
+
+
+def adhesion_table_key(law, *, ts=None) -> WithGravity | None:
+    """The gravity table that reads a law whose constant force acts alike in both phases
+    (its row's `constant_force`: DMT's adhesion pulls in as gravity does, `gamma - P/(c
+    x*^n)`, any `g`), under the penetration criterion (its contact ends at `x = 0`); else
+    `None`. Impacts outside the table (near capture) are integrated."""
+    if not (law.spec and law.spec.constant_force) or ts is not None:
+        return None
+    key = curve_key(*(float(q) for q in law.spec.shape), "penetration")
+    return WithGravity(key) if table_for(key) is not None else None
+
+
+def table_key(law, separation: str, *, g_is_zero: bool, ts=None):
+    """The two-group table that serves a law the curves do not (`dry_table_key`,
+    `adhesion_table_key`), or `None`."""
+    dry = dry_table_key(law, separation, g_is_zero=g_is_zero, ts=ts)
+    return dry if dry is not None else adhesion_table_key(law, ts=ts)
 
 
 def dry_table_key(law, separation: str, *, g_is_zero: bool, ts=None) -> WithDryForce | None:
