@@ -381,7 +381,8 @@ def _targets(law_or_fit, *, e, T, m: float, v0: float, speeds=None):
     result = impact(source, m=m, v0=v0)
     if int(result.status) != 0:
         below = ""
-        if source.spec is not None and source.spec.captures:  # an adhesive law: jkr
+        # an adhesive law with a closed-form sticking speed (jkr; dmt's has none)
+        if source.spec is not None and source.spec.captures and source.spec.state is not None:
             below = f", below its sticking speed {float(source.sticking_speed(m)):.4g} m/s"
         raise ValueError(
             f"the law does not separate at this m and v0 (e = 0{below}): no engine target"

@@ -14,15 +14,17 @@ coefficient given, and never below about 0.14 (e(coefficient -> 0)); the export 
 `fix nve/sphere` is velocity Verlet, the force taking the half-step velocity:
 `_stepping.velocity_verlet` replicates it.
 
-A `jkr` law goes to LAMMPS's `jkr` normal model instead (`native`; `lammps_jkr`), and
-parameters with a `cohesion` are that model's in `response`, `stepper`, `snippet`.
+A `jkr` law goes to LAMMPS's `jkr` normal model instead (`native`; `lammps_jkr`), a `dmt`
+law to its `dmt` model with `damping viscoelastic` (`lammps_dmt`); parameters with a
+`cohesion` are the jkr model's in `response`, `stepper`, `snippet`, and with a `damp` too
+(or `normal` "dmt") the dmt model's.
 """
 
 import math
 
 import numpy as np
 
-from . import _stepping, lammps_jkr
+from . import _stepping, lammps_dmt, lammps_jkr
 from .base import AbstractEngine, Design, Key, Stepping
 from .lammps_tangential import NO_TANGENTIAL, TANGENTIAL_MODELS, with_tangential
 from .materials import check_poisson, check_positive, check_restitution, hertz_stiffness
@@ -222,36 +224,44 @@ class Lammps(AbstractEngine):
 
     def native(self, law) -> AbstractEngine | None:
         """The engine for a law LAMMPS has as its own normal model rather than the Hertz
-        design: `lammps_jkr.LammpsJKR` for a `jkr` law, else None."""
+        design: `lammps_jkr.LammpsJKR` for a `jkr` law, `lammps_dmt.LammpsDMT` (built with
+        the law) for a `dmt` law, else None."""
+        if law.name == lammps_dmt.LammpsDMT.LAW:
+            return lammps_dmt.LammpsDMT(law)
         return _JKR if law.name == _JKR.LAW else None
 
     def law(self, parameters, m):
-        """`tsuji`, or with a `cohesion` in `parameters` the `jkr` law of `LammpsJKR`."""
-        if "cohesion" in parameters:
-            return _JKR.law(parameters, m)
+        """`tsuji`, or with a `cohesion` in `parameters` the `jkr` or `dmt` law of its
+        model."""
+        cohesive = _cohesive_model(parameters)
+        if cohesive is not None:
+            return cohesive.law(parameters, m)
         return super().law(parameters, m)
 
     def law_parameters(self, parameters, m):
         """`tsuji`'s `c` = k (N/m^1.5) and `b` (N s/m^1.25) between the two spheres
         (effective mass `m/2`), or of the sphere on the wall."""
-        if "cohesion" in parameters:
-            return _JKR.law_parameters(parameters, m)
+        cohesive = _cohesive_model(parameters)
+        if cohesive is not None:
+            return cohesive.law_parameters(parameters, m)
         return {"c": parameters["k"], "b": parameters["b"]}
 
     def response(self, parameters, *, m, radius=None):
         """`(law, separation)` that `parameters` (`E`, `coeff_restitution`, `poisson`,
         `limit_damping`) give two spheres of mass `m` (kg) and radius `radius` (m); with a
         `cohesion` (J/m^2), the `jkr` model's (`lammps_jkr.LammpsJKR.response`)."""
-        if "cohesion" in parameters:
-            return _JKR.response(parameters, m=m, radius=radius)
+        cohesive = _cohesive_model(parameters)
+        if cohesive is not None:
+            return cohesive.response(parameters, m=m, radius=radius)
         clamped = bool(parameters.get("limit_damping", False))
         return tsuji_response(self, parameters, m=m, radius=radius, clamped=clamped)
 
     def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
         """Velocity Verlet at `parameters["timestep"]` (s), or None without one (with a
         `cohesion`: the `jkr` model's, `lammps_jkr.replica`)."""
-        if "cohesion" in parameters:
-            return _JKR.stepper(parameters, m=m, radius=radius)
+        cohesive = _cohesive_model(parameters)
+        if cohesive is not None:
+            return cohesive.stepper(parameters, m=m, radius=radius)
         if parameters.get("timestep") is None:
             return None
         h = check_positive("timestep", parameters["timestep"], "s")
@@ -266,8 +276,9 @@ class Lammps(AbstractEngine):
         return Stepping(h, lambda v: replica(stepping, m, v))
 
     def snippet(self, parameters) -> str:
-        if "cohesion" in parameters:
-            return _JKR.snippet(parameters)
+        cohesive = _cohesive_model(parameters)
+        if cohesive is not None:
+            return cohesive.snippet(parameters)
         return "\n".join(
             [
                 "units si",
@@ -283,3 +294,13 @@ class Lammps(AbstractEngine):
 
 
 _JKR = lammps_jkr.LammpsJKR()
+_DMT = lammps_dmt.LammpsDMT()
+
+
+def _cohesive_model(parameters) -> AbstractEngine | None:
+    """LAMMPS's cohesive normal model that `parameters` are for: `dmt` (a `cohesion` with a
+    viscoelastic `damp`, or `normal` "dmt"), `jkr` (a `cohesion` alone), or None (the
+    Hertz design)."""
+    if "cohesion" not in parameters:
+        return None
+    return _DMT if parameters.get("normal") == _DMT.LAW or "damp" in parameters else _JKR

@@ -182,3 +182,48 @@ def test_jkr_to_an_engine_without_it_names_the_nearest_law():
     assert x.warnings[0].startswith("MuJoCo has no jkr law") and "kelvin_voigt" in x.warnings[0]
     gaps = np.abs(np.array(x.e_engine) - np.array(x.e_target))
     assert _worst(x.warnings[0]) == pytest.approx(gaps.max(), abs=1e-3)
+
+
+def _dmt_law():
+    """The rubber-like sphere on a flat with DMT adhesion (w = 30 J/m^2) and law 14's damping:
+    it sticks below about 0.04 m/s."""
+    return ji.law("dmt", c=ji.hertz_stiffness(E=E, nu=NU, R=R), b=3.0, R=R, w=30.0)
+
+
+@pytest.mark.parametrize("geometry", ["wall", "spheres"])
+def test_dmt_export_to_lammps_is_the_law_itself(geometry):
+    """LAMMPS's `dmt` with `damping viscoelastic` is the `dmt` law: the export's engine law
+    is the law (its c, b and pull-off 2 pi w R to 1e-12, each force scaled back by m/meff;
+    its R is the contact's effective one, R/2 for two spheres), ends contact at x = 0, and its
+    replica at the export's step realises the law's e and T within the stepping's error
+    (0.5 %) above the sticking speed and sticks below it, as the law does."""
+    law = _dmt_law()
+    x = ji.export(law, "lammps", m=M, v0=0.3, radius=R, geometry=geometry)
+    assert x.separation == "penetration" and "dmt" in x.snippet and "viscoelastic" in x.snippet
+
+    def pulloff(law):
+        return float(law.parameters["w"] * law.parameters["R"])
+
+    for key in ("c", "b"):
+        assert float(x.law.parameters[key]) == pytest.approx(float(law.parameters[key]), rel=1e-12)
+    assert pulloff(x.law) == pytest.approx(pulloff(law), rel=1e-12)
+    assert x.e == pytest.approx(x.target_e, rel=5e-3) and x.T == pytest.approx(x.target_T, rel=5e-3)
+    stepping = {**x.parameters, "timestep": x.timestep}
+    for v in (0.02, 0.1, 0.3):
+        es, _ = stepped_response("lammps", stepping, m=M, speeds=[v], radius=R)[1:3]
+        exact = float(ji.impact(law, m=M, v0=v, throw=False).e)
+        assert es[0] == pytest.approx(exact, rel=5e-3, abs=1e-12), (v, es, exact)
+    # the inverse: the engine's parameters give the law back
+    back, separation, _, _ = engine_response("lammps", x.parameters, m=M, speeds=[0.3], radius=R)
+    assert back.name == "dmt" and separation == "penetration"
+    assert pulloff(back) == pytest.approx(pulloff(law), rel=1e-12)
+
+
+def test_dmt_export_refusals_are_one_line():
+    law = _dmt_law()
+    with pytest.raises(ValueError, match="limit_damping") as error:
+        ji.export(law, "lammps", m=M, v0=0.3, radius=R, limit_damping=True)
+    assert "\n" not in str(error.value)
+    with pytest.raises(ValueError, match="does not separate") as error:
+        ji.export(law, "lammps", m=M, v0=0.02, radius=R)
+    assert "\n" not in str(error.value)

