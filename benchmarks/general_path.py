@@ -40,6 +40,25 @@ if what == "bare":
     jax.block_until_ready(jax.jit(lambda x: jnp.sin(x) * 2.0)(1.0))
     print(json.dumps({"total": time.perf_counter() - start}))
     sys.exit()
+if what.startswith("diffrax"):  # the floor: diffrax alone, the same contact, one event
+    import diffrax as dfx, optimistix as optx
+
+    def rhs(t, y, c):
+        return jnp.stack([y[1], -c * jnp.maximum(y[0], 0.0) ** 1.5 * (1 + 0.3 * 2.5 * y[1])])
+
+    def solve(c):
+        event = dfx.Event(lambda t, y, args, **kw: y[0] + (t < 1e-3),
+                          root_finder=optx.Newton(rtol=1e-13, atol=1e-13))
+        sol = dfx.diffeqsolve(dfx.ODETerm(rhs), dfx.Tsit5(), 0.0, 10.0, None,
+                              jnp.array([0.0, 1.0]), args=c, event=event, max_steps=4096,
+                              stepsize_controller=dfx.PIDController(rtol=1e-12, atol=1e-12),
+                              throw=False)
+        return sol.ys[-1, 1]
+
+    t0 = time.perf_counter()
+    jax.block_until_ready((jax.jit(solve) if what == "diffrax_solve" else jax.grad(solve))(1.0))
+    print(json.dumps({"total": time.perf_counter() - start, "call": time.perf_counter() - t0}))
+    sys.exit()
 import jaximpact as ji
 
 def f(x, v, p):
@@ -153,6 +172,7 @@ def main():
 
     bare = min(_fresh("bare")["total"] for _ in range(2))
     firsts = {what: _fresh(what) for what in ("impact", "grad", "calibrate", "compare_laws")}
+    floors = {what: _fresh(what) for what in ("diffrax_solve", "diffrax_grad")}
     loads.append(load_average())
 
     rows = [
@@ -190,6 +210,18 @@ def main():
                 f"bare JAX process {bare:.1f} s",
                 f"+{extra:.1f} s ({reached})",
                 f"within {targets[what]:g} s" if what != "compare_laws" else "within 10 s",
+            ]
+        )
+    for what, label in (("diffrax_solve", "solve"), ("diffrax_grad", "grad")):
+        out = floors[what]
+        rows.append(
+            [
+                f"floor: first {label} of a bare diffrax contact (Tsit5, one event) in a "
+                "fresh process",
+                f"{out['total']:.1f} s (call {out['call']:.1f} s)",
+                f"bare JAX process {bare:.1f} s",
+                f"+{out['total'] - bare:.1f} s",
+                "-",
             ]
         )
     text = "\n".join(
