@@ -78,7 +78,7 @@ _PUBLIC.update(
         "Export": "_engines",
     }
 )
-# oblique impacts: tangential laws, oblique_impact, fit_oblique (issue 27)
+# oblique impacts: tangential laws, oblique_impact, fit_oblique, video tracks (issue 27)
 _PUBLIC.update(
     dict.fromkeys(
         (
@@ -95,6 +95,8 @@ _PUBLIC.update(
             "two_spheres",
             "fit_oblique",
             "ObliqueFit",
+            "track_rebounds",
+            "TrackRebounds",
         ),
         "_oblique",
     )

@@ -21,3 +21,4 @@ from .tangential import (
     tangential_law as tangential_law,
 )
 from .theory import rigid_oblique as rigid_oblique
+from .track import TrackRebounds as TrackRebounds, track_rebounds as track_rebounds
