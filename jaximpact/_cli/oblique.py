@@ -5,6 +5,10 @@ Columns (a header names them; an empty cell is a value not measured):
 - the incidence: `theta_deg` (from the normal, degrees; with `--speed`) or `v_n,v_t` (m/s);
 - optionally `omega` (spin before impact, rad/s; default 0);
 - what was measured: `e_t` (the centre's tangential restitution) and/or `omega_out` (rad/s).
+
+Or a video track of the ball bouncing across a floor, one row per frame: `t` (s), `x`, `y`
+(m, `y` up) and `phi` (a mark's angle, rad, counterclockwise), read by `track_rebounds`
+(each impact's speeds and spin before and after, with their standard errors) under `--g`.
 """
 
 import math
@@ -26,6 +30,7 @@ from .common import (
 INCIDENCE = ("theta_deg", "v_n", "v_t", "omega")
 MEASURED = ("e_t", "omega_out")
 COLUMNS = INCIDENCE + MEASURED
+TRACK = ("t", "x", "y", "phi")
 
 
 def add_fit_oblique(subparsers):
@@ -41,7 +46,9 @@ def add_fit_oblique(subparsers):
         "--param is held fixed (fit it first with 'jaximpact calibrate'). Each impact is "
         "integrated with stick and slip as segments ended by events, so the fit's "
         "derivatives are exact through the transitions. Prints the parameters with "
-        "standard errors and the goodness of fit (rms of e_t and of the spin).",
+        "standard errors and the goodness of fit (rms of e_t and of the spin). Or FILE.csv "
+        "is a video track, one row per frame: t (s), x, y (m, y up) and phi (a mark's angle, "
+        "rad, counterclockwise), whose impacts are read off its flights (with --g).",
         example="jaximpact fit-oblique rebounds.csv --speed 3.9 --mass 2.6e-4 --radius 2.5e-3 "
         "--law tsuji --param c=1.1e9 b=0.5 --tangential mindlin --tparam G_star=1.35e10 "
         "mu=0.092\n"
@@ -76,6 +83,14 @@ def add_fit_oblique(subparsers):
         help="impact speed, m/s, for a file that gives the incidence as theta_deg",
     )
     parser.add_argument(
+        "--g",
+        type=float,
+        default=None,
+        metavar="M/S2",
+        help="gravity, m/s^2, of a video track's flights and contacts (default 9.81 for a "
+        "track, 0 for rebounds)",
+    )
+    parser.add_argument(
         "--inertia",
         type=float,
         default=0.4,
@@ -93,10 +108,45 @@ def add_fit_oblique(subparsers):
     parser.set_defaults(handler=run_fit_oblique)
 
 
-def read_rebounds(path: Path, speed: float | None) -> dict:
+def read_track(path: Path, header, rows, g: float) -> dict:
+    """The rebounds (as `read_rebounds`, with `sigma_e_t` and `sigma_omega`) of the video
+    track in the CSV at `path` (`t, x, y, phi`), through `track_rebounds`."""
+    import numpy as np
+
+    from .._oblique import track_rebounds
+
+    if set(header) != set(TRACK):
+        raise CLIError(f"{path}: a track has the columns {', '.join(TRACK)} (one row per frame)")
+    columns = {name: [] for name in TRACK}
+    for number, cells in rows:
+        if len(cells) != len(header):
+            raise CLIError(f"{path}, line {number}: {len(cells)} cells for {len(header)} columns")
+        for name, cell in zip(header, cells, strict=True):
+            value = _number(cell, path, number, name)
+            if math.isnan(value):
+                raise CLIError(f"{path}, line {number}: no {name}; drop frames not tracked")
+            columns[name].append(value)
+    try:
+        track = track_rebounds(*(np.asarray(columns[k]) for k in TRACK), g=g)
+        inputs = track.fit_inputs()
+    except ValueError as error:
+        raise CLIError(f"{path}: {error}") from None
+    out = {k: list(map(float, v)) for k, v in inputs.items()}
+    pairs = zip(out["v_n"], out["v_t"], strict=True)
+    out["theta"] = [math.degrees(math.atan2(t, n)) for n, t in pairs]
+    return out
+
+
+def read_rebounds(path: Path, speed: float | None, g: float = 9.81) -> dict:
     """`{v_n, v_t, omega, e_t, omega_out, theta}` (lists; NaN where not measured) from the
-    CSV at `path`; one-line `CLIError`s for what is missing or not a number."""
-    header, rows = read_table(path, COLUMNS, label=str(path), hint=", ".join(COLUMNS))
+    CSV at `path`, rebounds or a video track (`read_track`, gravity `g` in m/s^2);
+    one-line `CLIError`s for what is missing or not a number."""
+    hint = f"{', '.join(COLUMNS)} (rebounds) or {', '.join(TRACK)} (a track)"
+    header, rows = read_table(path, COLUMNS + TRACK, label=str(path), hint=hint)
+    if "t" in header:
+        if speed is not None:
+            raise CLIError(f"{path} is a video track: --speed is not used; leave it out")
+        return read_track(path, header, rows, g)
     by_angle = "theta_deg" in header
     if by_angle == ("v_n" in header or "v_t" in header) or (
         not by_angle and not {"v_n", "v_t"} <= set(header)
@@ -159,15 +209,21 @@ def run_fit_oblique(args):
     check_plot_path(args.plot, inputs=(args.file,))
     if args.speed is not None and not args.speed > 0:
         raise CLIError(f"--speed must be > 0 (m/s), got {args.speed:g}")
-    data = read_rebounds(args.file, args.speed)
+    g = args.g
+    if g is not None and not (math.isfinite(g) and g >= 0):
+        raise CLIError(f"--g must be a finite number >= 0 (m/s^2), got {g:g}")
+    data = read_rebounds(args.file, args.speed, 9.81 if g is None else g)
+    track = "sigma_e_t" in data
+    g = (9.81 if track else 0.0) if g is None else g
     law = law_from_args(args)
     tangential = tangential_law(args.tangential, **parse_params(args.tparam, "--tparam"))
     free = free_names(args.free)
     if free is None:
         stiffness = "G_star" if "G_star" in tangential.params else "kt"
         free = (stiffness, "mu")
-    rows = {k: np.asarray(data[k], dtype=float) for k in (*COLUMNS, "theta")}
+    rows = {k: np.asarray(data.get(k, []), dtype=float) for k in (*COLUMNS, "theta")}
     measured = {k: rows[k] if np.any(np.isfinite(rows[k])) else None for k in MEASURED}
+    sigmas = {k: np.asarray(data[k]) for k in ("sigma_e_t", "sigma_omega") if k in data}
     fit = fit_oblique(
         law,
         tangential,
@@ -180,6 +236,8 @@ def run_fit_oblique(args):
         omega_out=measured["omega_out"],
         free=free,
         inertia=args.inertia,
+        g=g,
+        **sigmas,
     )
     if args.plot is not None:
         _plot(args.plot, rows, fit)

@@ -83,3 +83,57 @@ def test_fits_rebounds_made_by_the_library(capsys, tmp_path):
     assert fit["converged"] is True and fit["n_data"] == 10 and fit["dof"] == 8
     assert fit["params"]["kt"] == pytest.approx(5e6, rel=1e-6)
     assert fit["params"]["mu"] == pytest.approx(0.12, rel=1e-6)
+
+
+def _track_csv(tmp_path, scale=1.0, columns=("t", "x", "y", "phi")):
+    """The synthetic track of tests/oblique/test_track.py (clean) as a CSV, `y` times
+    `scale`."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parents[1] / "oblique"))
+    from test_track import synthetic_track
+
+    t, x, y, phi, _ = synthetic_track()
+    values = {"t": t, "x": x, "y": y * scale, "phi": phi}
+    lines = [",".join(columns)]
+    lines += [",".join(repr(float(values[c][i])) for c in columns) for i in range(len(t))]
+    return _write(tmp_path, "\n".join(lines) + "\n", "track.csv")
+
+
+TRACK_BASE = ["--mass", "0.05", "--radius", "0.02", "--law", "hertz_rate", "--param",
+              "c=1.32e7", "b1=30", "--tangential", "linear_history", "--tparam", "kt=1e4",
+              "mu=0.2"]  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "scale, columns, extra, message",
+    [
+        (1000.0, ("t", "x", "y", "phi"), [], "give the positions in metres"),
+        (1.0, ("t", "x", "y"), [], "a track has the columns t, x, y, phi"),
+        (1.0, ("t", "x", "y", "phi"), ["--speed", "2"], "--speed is not used"),
+        (1.0, ("t", "x", "y", "phi"), ["--g", "-9.81"], "--g must be"),
+    ],
+)
+def test_a_bad_track_is_one_line(capsys, tmp_path, scale, columns, extra, message):
+    data = _track_csv(tmp_path, scale, columns)
+    status, out, err = run_cli(capsys, ["fit-oblique", data, *TRACK_BASE, *extra])
+    assert_one_line_error(status, out, err, contains=message)
+
+
+@pytest.mark.slow
+def test_fits_a_video_track(capsys, tmp_path):
+    """The clean synthetic track (kt = 2e4 N/m, mu = 0.3; its normal law's c is
+    hertz_stiffness(5e7, 0.45, 0.02, inf) = 1.3173e7): the command reads its four impacts
+    and finds kt and mu to 1e-3 (the track's impacts are exact to 1e-9; the normal law is
+    given to five digits)."""
+    import jaximpact as ji
+
+    c = ji.hertz_stiffness(E=5e7, nu=0.45, R=0.02, E2=float("inf"))
+    argv = ["fit-oblique", _track_csv(tmp_path), *TRACK_BASE, "--json"]
+    argv[argv.index("c=1.32e7")] = f"c={c!r}"
+    status, out, err = run_cli(capsys, argv)
+    assert status == 0, err
+    fit = json.loads(out)
+    assert fit["params"]["kt"] == pytest.approx(2e4, rel=1e-3)
+    assert fit["params"]["mu"] == pytest.approx(0.3, rel=1e-3)
