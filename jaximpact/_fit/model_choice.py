@@ -1,9 +1,12 @@
 """Which law do the measurements support? Fit them all and rank them."""
 
+import concurrent.futures
 import dataclasses
 import math
+import os
 import warnings
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 from jax.scipy.special import gammaln
@@ -225,6 +228,7 @@ def compare_laws(
     warn: bool = True,
     max_rms_e=MAX_RMS_E,
     max_rms_T=MAX_RMS_T,
+    workers: int | None = None,
     **calibrate_options,
 ) -> list[Ranking]:
     """Fit every law of `laws` to the same measurements and rank them, best first.
@@ -243,7 +247,10 @@ def compare_laws(
     numbers (`reduced_chi2`, `dof`, `rms_e`, `rms_T`).
 
     `progress`: a meter of the fits: `True` the default one (on stderr), `False` none, or
-    an `AbstractMeter`.
+    an `AbstractMeter`. `workers`: how many fits run side by side (threads; a first call
+    spends most of its time compiling, which XLA does outside Python's lock, so the laws
+    compile in parallel): default one per CPU core, `1` one after another. The results do
+    not depend on it.
 
     **Example**: `compare_laws(m=0.0027, v0=[1, 2, 3], e=[0.9, 0.87, 0.85])[0].name`.
     """
@@ -260,43 +267,51 @@ def compare_laws(
     middle = int(np.argsort(v0_rows)[len(v0_rows) // 2])
     n_data = len(e_rows) + (0 if T_rows is None else int(np.sum(np.isfinite(T_rows))))
     has_sigma = sigma_e is not None or sigma_T is not None
-    rankings = []
-    with metered(progress, len(laws), "fitting laws") as bar:
-        for entry in laws:
-            if isinstance(entry, AbstractLaw):  # a law object (a user's own): its own start
-                name, start = entry.name, entry
-                free = _free_for_law(entry, has_T=T_rows is not None, n_data=n_data)
-            else:
-                name = entry
-                start = starting_law(
-                    name,
-                    m=float(m),
-                    v0=float(v0_rows[middle]),
-                    e=float(e_rows[middle]),
-                    T=None if T_rows is None else float(T_rows[middle]),
-                )
-                free = _free_for(name, has_T=T_rows is not None, n_data=n_data)
-            if len(free) > n_data:
-                bar.update(1, f"{name} (skipped)")
-                continue
-            fit = calibrate(
-                start,
-                m=m,
-                v0=v0_rows,
-                e=e_rows,
-                T=T_rows,
-                sigma_e=sigma_e,
-                sigma_T=sigma_T,
-                free=free,
-                separation=separation,
-                **calibrate_options,
+    jobs, skipped = [], []  # (name, start law, free parameters), in the order of `laws`
+    for entry in laws:
+        if isinstance(entry, AbstractLaw):  # a law object (a user's own): its own start
+            name, start = entry.name, entry
+            free = _free_for_law(entry, has_T=T_rows is not None, n_data=n_data)
+        else:
+            name = entry
+            start = starting_law(
+                name,
+                m=float(m),
+                v0=float(v0_rows[middle]),
+                e=float(e_rows[middle]),
+                T=None if T_rows is None else float(T_rows[middle]),
             )
-            sum_sq = float(jnp.sum(fit.residuals**2))
-            k = len(free)
-            aic = sum_sq + 2 * k if has_sigma else None
-            bic = sum_sq + k * math.log(n_data) if has_sigma else None
-            rankings.append(Ranking(name, fit, sum_sq, k, aic, bic))
-            bar.update(1, name)
+            free = _free_for(name, has_T=T_rows is not None, n_data=n_data)
+        (skipped if len(free) > n_data else jobs).append((name, start, free))
+    # the main thread's precision, for the threads (JAX's config contexts are per thread)
+    x64 = jnp.result_type(float) == jnp.float64
+
+    def one(job):
+        name, start, free = job
+        with jax.enable_x64(x64):
+            fit = calibrate(start, m=m, v0=v0_rows, e=e_rows, T=T_rows, sigma_e=sigma_e,
+                            sigma_T=sigma_T, free=free, separation=separation,
+                            **calibrate_options)  # fmt: skip
+        sum_sq = float(jnp.sum(fit.residuals**2))
+        k = len(free)
+        aic = sum_sq + 2 * k if has_sigma else None
+        bic = sum_sq + k * math.log(n_data) if has_sigma else None
+        return Ranking(name, fit, sum_sq, k, aic, bic)
+
+    workers = _workers(workers, len(jobs))
+    rankings: list[Ranking | None] = [None] * len(jobs)
+    with metered(progress, len(laws), "fitting laws") as bar:
+        for name, _, _ in skipped:
+            bar.update(1, f"{name} (skipped)")
+        pool = concurrent.futures.ThreadPoolExecutor(max_workers=workers)
+        try:
+            futures = {pool.submit(one, job): i for i, job in enumerate(jobs)}
+            for future in concurrent.futures.as_completed(futures):
+                ranking = future.result()
+                rankings[futures[future]] = ranking
+                bar.update(1, ranking.name)
+        finally:  # an interrupt or a failed fit: the fits not started are dropped
+            pool.shutdown(wait=False, cancel_futures=True)
     key = (lambda r: r.aic) if has_sigma else (lambda r: r.sum_sq)
     rankings = sorted(rankings, key=key)
     if warn and rankings:
@@ -310,6 +325,16 @@ def compare_laws(
                 stacklevel=2,
             )
     return rankings
+
+
+def _workers(workers, jobs: int) -> int:
+    """How many fits run side by side: `workers` (an integer >= 1), default one per CPU
+    core, never more than the fits."""
+    if workers is None:
+        workers = os.cpu_count() or 1
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
+    return max(1, min(workers, jobs))
 
 
 def _free_for_law(law, *, has_T, n_data):

@@ -651,3 +651,19 @@ def test_calibrate_takes_the_closed_form(name, truth, start):
     assert bool(fit.converged)
     for key in ("c", "b"):
         assert float(fit.params[key]) == pytest.approx(truth[key], rel=1e-10)
+
+
+def test_compare_laws_in_threads_ranks_as_one_after_another():
+    """The fits side by side (threads, `workers=2`) give the rankings one after another
+    gives, to the bit; `workers` other than an integer >= 1 is refused in one line."""
+    data = dict(m=0.0027, v0=[1.0, 1.4, 1.9, 2.4], e=[0.95, 0.94, 0.936, 0.912], progress=False,
+                laws=("kelvin_voigt", "hertz_rate", "hunt_crossley"))  # fmt: skip
+    one = ji.compare_laws(workers=1, **data)
+    two = ji.compare_laws(workers=2, **data)
+    assert [r.name for r in one] == [r.name for r in two]
+    for a, b in zip(one, two, strict=True):
+        assert a.sum_sq == b.sum_sq
+        for key in a.fit.params:
+            assert float(a.fit.params[key]) == float(b.fit.params[key])
+    with pytest.raises(ValueError, match="workers must be an integer >= 1"):
+        ji.compare_laws(workers=0, **data)
