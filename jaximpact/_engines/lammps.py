@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from . import _stepping, lammps_dmt, lammps_jkr
+from . import _stepping, lammps_dmt, lammps_jkr, lammps_script
 from .base import AbstractEngine, Design, Key, Stepping
 from .lammps_tangential import NO_TANGENTIAL, TANGENTIAL_MODELS, with_tangential
 from .materials import check_poisson, check_positive, check_restitution, hertz_stiffness
@@ -276,21 +276,7 @@ class Lammps(AbstractEngine):
         return Stepping(h, lambda v: replica(stepping, m, v))
 
     def snippet(self, parameters) -> str:
-        cohesive = _cohesive_model(parameters)
-        if cohesive is not None:
-            return cohesive.snippet(parameters)
-        return "\n".join(
-            [
-                "units si",
-                "atom_style sphere",
-                "comm_modify vel yes",
-                parameters["pair_style"],
-                parameters["pair_coeff"],
-                *([parameters["fix_wall"]] if parameters.get("fix_wall") else []),
-                "fix 1 all nve/sphere",
-                parameters["timestep"],
-            ]
-        )
+        return lammps_script.snippet(parameters)  # every LAMMPS model's scene alike
 
 
 _JKR = lammps_jkr.LammpsJKR()

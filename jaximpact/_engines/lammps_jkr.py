@@ -48,7 +48,7 @@ import math
 
 import numpy as np
 
-from . import _stepping
+from . import _stepping, lammps_script
 from .base import AbstractEngine, Design, Key, Stepping
 from .lammps_tangential import NO_TANGENTIAL, TANGENTIAL_MODELS, with_tangential
 from .materials import check_poisson, check_positive
@@ -341,7 +341,7 @@ class LammpsJKR(AbstractEngine):
     def response(self, parameters, *, m, radius=None):
         """`(law, "force")`: `law_parameters`' `jkr` law for `parameters` (`E`, `cohesion`,
         `poisson`; `geometry` "wall" or two spheres) of spheres of radius `radius` (m)."""
-        return self.law(self._with_radius(parameters, radius), m), "force"
+        return self.law(lammps_script.with_effective_radius(parameters, radius), m), "force"
 
     def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
         """`replica` at `parameters["timestep"]` (s), or None without one."""
@@ -349,30 +349,8 @@ class LammpsJKR(AbstractEngine):
             return None
         h = check_positive("timestep", parameters["timestep"], "s")
         _check(parameters)
-        full = {**self._with_radius(parameters, radius), "timestep": h}
+        full = {**lammps_script.with_effective_radius(parameters, radius), "timestep": h}
         return Stepping(h, lambda v: replica(full, m, v))
 
-    def _with_radius(self, parameters, radius) -> dict:
-        """`parameters` with `R_eff` (m) from the spheres' `radius` where not given."""
-        if parameters.get("R_eff") is not None:
-            return dict(parameters)
-        wall = parameters.get("geometry", "spheres") == "wall"
-        if radius is None:
-            what = "sphere's" if wall else "spheres'"
-            raise ValueError(f"lammps needs the {what} radius: pass radius= (m)")
-        radius = check_positive("radius", radius, "m")
-        return {**parameters, "R_eff": radius if wall else radius / 2.0}
-
     def snippet(self, parameters) -> str:
-        return "\n".join(
-            [
-                "units si",
-                "atom_style sphere",
-                "comm_modify vel yes",
-                parameters["pair_style"],
-                parameters["pair_coeff"],
-                *([parameters["fix_wall"]] if parameters.get("fix_wall") else []),
-                "fix 1 all nve/sphere",
-                parameters["timestep"],
-            ]
-        )
+        return lammps_script.snippet(parameters)
