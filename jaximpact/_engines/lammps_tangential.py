@@ -36,6 +36,12 @@ def tangential_clause(tangential) -> str:
             "LAMMPS scales its tangential damping with the normal one (xgammat), which a "
             f"constant ct = {params['ct']:g} N s/m does not match: export with ct=0"
         )
+    if params.get("beta", 0.0) != 0.0:
+        raise ValueError(
+            "LAMMPS scales its tangential damping with the normal one (xgammat) and caps spring "
+            f"plus damper, not as EDEM's damper 2 (5/6)^0.5 beta (m k_t)^0.5 (beta = "
+            f"{params['beta']:g}): export with beta=0"
+        )
     k = params["kt"] if name == "linear_history" else 8.0 * params["G_star"]
     return f"tangential {TANGENTIAL_MODELS[name]} {k:.10g} 0 {params['mu']:.10g}"
 

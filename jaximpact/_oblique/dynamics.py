@@ -53,6 +53,12 @@ class ObliqueDynamics(eqx.Module):
         y_n, q, _, _ = self.parts(y)
         return self.tangential.trial(q, self.normal.position(y_n), self.slip(y))
 
+    def tested(self, y):
+        """The force Coulomb's limit caps at `y` (the trial force, or the spring's alone:
+        `TangentialDynamics.tested`)."""
+        y_n, q, _, _ = self.parts(y)
+        return self.tangential.tested(q, self.normal.position(y_n), self.slip(y))
+
     def tangential_force(self, y, mode, sense, compressing):
         return jnp.where(mode == STICK, self.trial(y), -sense * self.cap(y, compressing))
 
@@ -82,8 +88,8 @@ class ObliqueDynamics(eqx.Module):
         return y.at[self.size].set(q)
 
     def stick_margin(self, y, compressing, sign=None):
-        """`mu |F_n| - |F_trial|`: positive while the contact can stick."""
-        return self.cap(y, compressing, sign) - jnp.abs(self.trial(y))
+        """`mu |F_n| - |F_tested|`: positive while the contact can stick."""
+        return self.cap(y, compressing, sign) - jnp.abs(self.tested(y))
 
     def slide_excess(self, y, sense, compressing, sign=None):
         """The rate at which a sticking contact held at the limit would leave it,
@@ -93,7 +99,7 @@ class ObliqueDynamics(eqx.Module):
         y_held = self.held(y, sense, compressing, sign)
 
         def excess(z):
-            return -sense * self.trial(z) - self.cap(z, compressing, sign)
+            return -sense * self.tested(z) - self.cap(z, compressing, sign)
 
         direction = self.rhs(y_held, STICK, sense, compressing)
         return jax.jvp(excess, (y_held,), (direction,))[1]

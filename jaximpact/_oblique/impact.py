@@ -164,7 +164,7 @@ def _first_mode(dyn: ObliqueDynamics, y0, compressing):
         max_steps=512,
         throw=False,
     ).ys[-1]
-    trial = dyn_.trial(stuck)
+    trial = dyn_.tested(stuck)
     u0 = dyn_.slip(y0_)
     holds = dyn_.cap(stuck, compressing) >= jnp.abs(trial)
     sense = jnp.where(trial != 0, -jnp.sign(trial), jnp.sign(u0))
@@ -244,7 +244,7 @@ def _segment(setup: _Setup, carry, _):
     # a sticking segment that still ended beyond Coulomb's limit: a failure, never a
     # silent force beyond mu |F_n|
     beyond = (mode == STICK) & (
-        jnp.abs(dyn.trial(y1)) > (1.0 + 1e-6) * dyn.cap(y1, compressing) + OVERTAKEN
+        jnp.abs(dyn.tested(y1)) > (1.0 + 1e-6) * dyn.cap(y1, compressing) + OVERTAKEN
     )
     failed = ~overtaken & ~out_of_steps & (broke | ~jnp.all(jnp.isfinite(y1)) | beyond)
     y1_n = y1[:size]
@@ -279,7 +279,7 @@ def _segment(setup: _Setup, carry, _):
     to_stick = change & (mode == SLIP)
     y_next = jnp.where(to_stick, dyn.held(y_at, sense, compressing), y_at)
     y_next = jnp.where(redo, y, y_next)
-    sense_next = jnp.where(to_slip, -jnp.sign(dyn.trial(y_at)), sense)
+    sense_next = jnp.where(to_slip, -jnp.sign(dyn.tested(y_at)), sense)
     carry = (
         jnp.where(alive, y_next, y),
         jnp.where(alive & ~redo, tau_at, tau),

@@ -22,6 +22,19 @@ names them):
 
 Neither rescales the history on unloading (LAMMPS `mindlin_rescale`,
 `mindlin_rescale/force`: not built here).
+
+Damping on the slip while sticking, in the two conventions the engines use:
+
+- `linear_history`'s constant `ct` (N s/m), as LAMMPS adds its tangential damper: the
+  damper is part of the force that Coulomb's limit caps, and the spring is held so that
+  spring plus damper sit at the limit while sliding.
+- the Mindlin laws' `beta`, the damper of EDEM's and LIGGGHTS' Hertz-Mindlin,
+  `2 (5/6)^0.5 beta (m k_t(x))^0.5` (N s/m; `m` the sphere's mass, the pair's effective one
+  for two spheres; `beta = -ln e / (pi^2 + ln^2 e)^0.5` from a restitution `e`), growing as
+  `x^(1/4)`: as in LIGGGHTS' `tangential history`, Coulomb's test is on the spring's force
+  alone, and the damper acts only while sticking. (With the damper inside the test, a
+  Hertz-Mindlin contact could neither stick nor slide at first touch: the damper, `x^(1/4)`,
+  outgrows the limit, `x^(3/2)`, while the held spring's sliding rate is negative.)
 """
 
 import abc
@@ -43,10 +56,11 @@ class TangentialSpec:
 
     `parameters`: the law's own parameters, as the law object holds them (arrays; what a
     fit frees); `inputs`: what `tangential_law` also accepts and converts (Mindlin's `G`,
-    `nu`, `G2`, `nu2` to `G_star`). `history`: `"displacement"` or `"force"` (module
-    docstring); `power`: the exponent of the overlap in the stiffness, `k_t = k0 x^power`
-    (0 for a constant spring, 0.5 for Mindlin's `8 G* sqrt(R x)`); `engines`: where the same
-    variant is found.
+    `nu`, `G2`, `nu2` to `G_star`); `damper_tested`: Coulomb's limit caps spring plus
+    damper (LAMMPS's convention), else the spring alone (LIGGGHTS', EDEM's). `history`:
+    `"displacement"` or `"force"` (module docstring); `power`: the exponent of the overlap
+    in the stiffness, `k_t = k0 x^power` (0 for a constant spring, 0.5 for Mindlin's
+    `8 G* sqrt(R x)`); `engines`: where the same variant is found.
     """
 
     name: str
@@ -60,6 +74,7 @@ class TangentialSpec:
     positive: tuple[str, ...]
     defaults: dict[str, float] = dataclasses.field(default_factory=dict)
     inputs: tuple[str, ...] = ()
+    damper_tested: bool = True
 
     def __post_init__(self):
         if self.history not in HISTORIES:
@@ -68,9 +83,11 @@ class TangentialSpec:
 
 class TangentialDynamics(eqx.Module):
     """A tangential law in the normal contact's units (`x*`, `t*`, force `m v_n^2 / x*`,
-    velocity `v_n`): stiffness `K(X) = k0 X^power`, damping `D` on the slip `U`, friction
-    `mu`, and `inv_inertia = m R^2 / I`. The spring state `Q` is the stretch `delta / x*`
-    (displacement history) or the elastic force itself (force history)."""
+    velocity `v_n`): stiffness `K(X) = k0 X^power`, damping `D(X) = damping X^damping_power`
+    on the slip `U` while sticking, friction `mu`, and `inv_inertia = m R^2 / I`;
+    `damper_tested`: Coulomb's limit caps spring plus damper (else the spring alone). The
+    spring state `Q` is the stretch `delta / x*` (displacement history) or the elastic force
+    itself (force history)."""
 
     mu: Array
     k0: Array
@@ -78,6 +95,14 @@ class TangentialDynamics(eqx.Module):
     inv_inertia: Array
     power: float = eqx.field(static=True)
     history: str = eqx.field(static=True)
+    damping_power: float = eqx.field(static=True, default=0.0)
+    damper_tested: bool = eqx.field(static=True, default=True)
+
+    def damper(self, x):
+        """`D(X)`: 0 outside the surface where it grows with the overlap."""
+        if self.damping_power == 0:
+            return self.damping + jnp.zeros_like(x)
+        return self.damping * safe_pow(x, self.damping_power)
 
     def stiffness(self, x):
         """`K(X)`: 0 outside the surface (Mindlin), without a NaN in value or gradient."""
@@ -91,21 +116,27 @@ class TangentialDynamics(eqx.Module):
 
     def trial(self, q, x, u):
         """The force the contact would carry if it stuck: spring plus damper."""
-        return self.elastic(q, x) - self.damping * u
+        return self.elastic(q, x) - self.damper(x) * u
+
+    def tested(self, q, x, u):
+        """The force Coulomb's limit caps: the trial force, or the spring's alone."""
+        return self.trial(q, x, u) if self.damper_tested else self.elastic(q, x)
 
     def stick_rate(self, q, x, u):
         """`dQ/dtau` while sticking."""
         return u if self.history == "displacement" else -self.stiffness(x) * u
 
     def held(self, sense, cap, x, u):
-        """The spring state that puts the trial force at the limit, `trial = -sense cap`
+        """The spring state that puts the tested force at the limit, `tested = -sense cap`
         (where sliding stops, the spring resumes from there). Displacement history:
-        `(sense cap - D u) / K`, 0 where `K = 0` (outside the surface)."""
+        `(sense cap - D u) / K` (the damper tested; else `sense cap / K`), 0 where `K = 0`
+        (outside the surface)."""
+        damped = self.damper(x) * u if self.damper_tested else jnp.zeros_like(u)
         if self.history == "force":
-            return -sense * cap + self.damping * u
+            return -sense * cap + damped
         k = self.stiffness(x)
         inside = k > 0
-        return jnp.where(inside, (sense * cap - self.damping * u) / jnp.where(inside, k, 1.0), 0.0)
+        return jnp.where(inside, (sense * cap - damped) / jnp.where(inside, k, 1.0), 0.0)
 
 
 class AbstractTangentialLaw(eqx.Module):
@@ -113,7 +144,7 @@ class AbstractTangentialLaw(eqx.Module):
 
     What every tangential law declares: `name`, its row `spec`, `params` (arrays by name);
     its stiffness `stiffness(x, R=...)` (N/m) at overlap `x` (m), its friction
-    coefficient `mu`, its damping (N s/m, 0 for an undamped spring), the history it keeps
+    coefficient `mu`, its damping (`damping_scale`), the history it keeps
     (`spec.history`), and `dynamics(...)`, its equations in a normal contact's units.
     Concrete laws are final: `LinearHistoryLaw`, `MindlinLaw`.
     """
@@ -136,10 +167,11 @@ class AbstractTangentialLaw(eqx.Module):
         """Coulomb's friction coefficient."""
         return self.params["mu"]
 
-    @property
-    def damping(self) -> Array:
-        """The tangential damping coefficient (N s/m) on the slip velocity."""
-        return self.params.get("ct", jnp.zeros_like(self.params["mu"]))
+    def damping_scale(self, *, m, R) -> tuple[Array, float]:
+        """`(D0, power)` of the damper on the slip while sticking, `D = D0 x^power` (N s/m at
+        overlap x in m) for a sphere of mass `m` (kg) and radius `R` (m): `linear_history`'s
+        constant `ct`; the Mindlin laws' `2 (5/6)^0.5 beta (m 8 G* R^0.5)^0.5 x^(1/4)`."""
+        return self.params.get("ct", jnp.zeros_like(self.params["mu"])), 0.0
 
     @property
     def parameters(self) -> dict[str, Array]:
@@ -159,13 +191,16 @@ class AbstractTangentialLaw(eqx.Module):
         (m) and normal speed `v_n` (m/s)."""
         energy = m * v_n**2
         k0 = self._stiffness_scale(R) * x_star ** (self.spec.power + 2.0) / energy
+        d0, damping_power = self.damping_scale(m=m, R=R)
         return TangentialDynamics(
             mu=jnp.asarray(self.mu, dtype=float),
             k0=jnp.asarray(k0, dtype=float),
-            damping=jnp.asarray(self.damping * x_star / (m * v_n), dtype=float),
+            damping=jnp.asarray(d0 * x_star ** (damping_power + 1.0) / (m * v_n), dtype=float),
             inv_inertia=jnp.asarray(1.0 / inertia, dtype=float),
             power=self.spec.power,
             history=self.spec.history,
+            damping_power=damping_power,
+            damper_tested=self.spec.damper_tested,
         )
 
     def _refuse_unknown(self, params):
@@ -243,13 +278,18 @@ class MindlinLaw(AbstractTangentialLaw):
     def _stiffness_scale(self, R):
         return 8.0 * self.params["G_star"] * jnp.sqrt(R)
 
+    def damping_scale(self, *, m, R):
+        scale = 8.0 * self.params["G_star"] * jnp.sqrt(R)  # k_t = scale x^0.5
+        return 2.0 * jnp.sqrt(5.0 / 6.0) * self.params["beta"] * jnp.sqrt(m * scale), 0.25
+
     def replace(self, **params):
         self._refuse_unknown(params)
         return tangential_law(self.name, **{**self.params, **params})
 
 
 _LINEAR_UNITS = {"kt": "N/m", "mu": "-", "ct": "N s/m"}
-_MINDLIN_UNITS = {"G_star": "Pa", "mu": "-", "G": "Pa", "nu": "-", "G2": "Pa", "nu2": "-"}
+_MINDLIN_UNITS = {"G_star": "Pa", "mu": "-", "beta": "-", "G": "Pa", "nu": "-", "G2": "Pa",
+                  "nu2": "-"}  # fmt: skip
 _MINDLIN_REFERENCE = (
     "R. D. Mindlin, J. Appl. Mech. 16 (1949) 259; k_t = 8 G* a, a = sqrt(R x); "
     "Di Renzo & Di Maio, Chem. Eng. Sci. 59 (2004) 525"
@@ -270,20 +310,24 @@ LINEAR_HISTORY = TangentialSpec(
 )
 MINDLIN = TangentialSpec(
     name="mindlin",
-    formula="F_t = -8 G* sqrt(R x) delta, delta' = u while sticking; |F_t| <= mu |F_n|",
-    parameters=("G_star", "mu"),
+    formula="F_t = -8 G* sqrt(R x) delta - 2 sqrt(5/6) beta sqrt(m k_t) u, delta' = u while "
+    "sticking; |8 G* sqrt(R x) delta| <= mu |F_n|",
+    parameters=("G_star", "mu", "beta"),
     units=_MINDLIN_UNITS,
     reference=_MINDLIN_REFERENCE,
     history="displacement",
     power=0.5,
     engines="LAMMPS pair granular tangential mindlin (no rescaling)",
     positive=("G_star",),
+    defaults={"beta": 0.0},
     inputs=("G", "nu", "G2", "nu2"),
+    damper_tested=False,  # LIGGGHTS' and EDEM's: Coulomb's test on the spring alone
 )
 MINDLIN_FORCE = dataclasses.replace(
     MINDLIN,
     name="mindlin_force",
-    formula="F_t' = -8 G* sqrt(R x) u while sticking; |F_t| <= mu |F_n|",
+    formula="F_t = S - 2 sqrt(5/6) beta sqrt(m k_t) u, S' = -8 G* sqrt(R x) u while "
+    "sticking; |S| <= mu |F_n|",
     history="force",
     engines="LAMMPS pair granular tangential mindlin/force (no rescaling); Yade "
     "Law2_ScGeom_MindlinPhys_Mindlin (incremental shear force)",
@@ -350,7 +394,8 @@ def tangential_law(name: str, **params) -> AbstractTangentialLaw:
     - `"linear_history"`: `kt` (N/m, > 0), `mu` (>= 0), `ct` (N s/m, >= 0, default 0).
     - `"mindlin"`, `"mindlin_force"`: `mu` and either `G_star` (Pa) or the sphere's shear
       modulus `G` (Pa) and Poisson's ratio `nu` (and `G2`, `nu2` of a second body; a rigid
-      plane without them).
+      plane without them); `beta` (>= 0, default 0), the damper of EDEM's and LIGGGHTS'
+      Hertz-Mindlin (module docstring).
 
     **Example**: `tangential_law("linear_history", kt=1e7, mu=0.3)`.
     """
@@ -372,7 +417,7 @@ def tangential_law(name: str, **params) -> AbstractTangentialLaw:
     if "mu" not in given:
         raise ValueError(f"tangential law {name!r} needs mu, the friction coefficient (>= 0)")
     if spec.power == 0.5:
-        values = {**_mindlin_parameters(name, given), "mu": given["mu"]}
+        values = {**_mindlin_parameters(name, given), "mu": given["mu"], "beta": given["beta"]}
     else:
         missing = [k for k in spec.parameters if k not in given]
         if missing:

@@ -75,6 +75,9 @@ def test_other_engines_and_a_damped_spring_are_refused_in_one_line():
     damped = ji.tangential_law("linear_history", kt=1e6, mu=0.1, ct=0.5)
     with pytest.raises(ValueError, match="export with ct=0"):
         ji.export(LAW, "lammps", m=M, v0=3.9, radius=R, tangential=damped)
+    beta = ji.tangential_law("mindlin", G_star=1.35e10, mu=0.092, beta=0.2)  # EDEM's damper
+    with pytest.raises(ValueError, match="export with beta=0"):
+        ji.export(LAW, "lammps", m=M, v0=3.9, radius=R, tangential=beta)
 
 
 def test_the_clause_is_lammps_own():

@@ -24,10 +24,18 @@ from scipy.integrate import solve_ivp
 
 
 def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_star=None,
-                   history="displacement", rtol=1e-12, max_switches=40):  # fmt: skip
-    """Returns dict(e, v_t_out, omega_out, T, switches)."""
+                   history="displacement", beta=0.0, rtol=1e-12, max_switches=40):  # fmt: skip
+    """Returns dict(e, v_t_out, omega_out, T, switches). `beta` (Mindlin only): the damper
+    `2 (5/6)^0.5 beta (m k_t)^0.5` on the slip while sticking, left out of Coulomb's test
+    (LIGGGHTS' convention), so the switches are the undamped ones' formulas."""
     moment = inertia * m * R**2
     mindlin = G_star is not None
+
+    def damper(x):
+        xp = max(x, 0.0)
+        if not mindlin:
+            return 0.0
+        return 2.0 * math.sqrt(5.0 / 6.0) * beta * math.sqrt(m * 8.0 * G_star * math.sqrt(R * xp))
 
     def normal(x, v):
         xp = max(x, 0.0)
@@ -45,13 +53,17 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
         dk = 0.0 if xp == 0 else 4.0 * G_star * math.sqrt(R / xp) * v
         return k, dk
 
+    def spring(state):
+        x, v, q, vt, w = state
+        k, _ = stiffness(x, v)
+        return -k * q if history == "displacement" else q
+
     def force_t(state, mode, s):
         x, v, q, vt, w = state
         f, _ = normal(x, v)
         if mode == "slip":
             return -s * mu * abs(f)
-        k, _ = stiffness(x, v)
-        return -k * q if history == "displacement" else q
+        return spring(state) - damper(x) * (vt - R * w)
 
     def rhs(t, state, mode, s):
         x, v, q, vt, w = state
@@ -120,7 +132,7 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
 
             def ev_switch(t, y, mode, s):
                 f, _ = normal(y[0], y[1])
-                return mu * abs(f) - abs(force_t(y, "stick", s))
+                return mu * abs(f) - abs(spring(y))
 
         else:
 
@@ -144,7 +156,7 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
         t, state = sol.t_events[1][0], sol.y_events[1][0].copy()
         switches += 1
         if mode == "stick":
-            s = -math.copysign(1.0, force_t(state, "stick", s))
+            s = -math.copysign(1.0, spring(state))
             mode = "slip"
         else:
             state[2] = held(state, s)

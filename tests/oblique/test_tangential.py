@@ -57,7 +57,7 @@ def test_mindlin_stiffness_and_shear_modulus():
     assert float(shear_modulus_star(G, nu, G2, nu2)) == pytest.approx(expected, rel=1e-14)
     assert two.history == "force"
     direct = tangential_law("mindlin", G_star=G_star, mu=0.092)
-    assert set(direct.params) == {"G_star", "mu"}
+    assert set(direct.params) == {"G_star", "mu", "beta"} and float(direct.beta) == 0.0
 
 
 def test_dynamics_scales():
