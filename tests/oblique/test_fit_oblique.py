@@ -125,3 +125,25 @@ def test_fits_kharaz_measurements():
     d = fit.to_dict()
     assert d["tangential"]["name"] == "mindlin" and d["free"] == ["G_star", "mu"]
     assert "rms e_t" in fit.summary() and "reduced chi2" in fit.summary()
+
+
+@pytest.mark.slow
+def test_fit_oblique_finds_the_mindlin_damper():
+    """e_t and spin at six angles from Mindlin with EDEM's damper (beta 0.3): mu and beta
+    come back to 1e-8 from mu 0.08, beta 0.1."""
+    E, nu, rho, R = 380e9, 0.23, 4000.0, 2.5e-3
+    m = rho * 4.0 / 3.0 * np.pi * R**3
+    law = ji.law("hunt_crossley", c=4.0 / 3.0 * E / (1 - nu**2) * np.sqrt(R), a=0.0)
+    truth = ji.tangential_law("mindlin", G_star=E / (2 * (1 + nu)) / (2 - nu), mu=0.092, beta=0.3)
+    degrees = np.array([3.0, 6.0, 10.0, 15.0, 25.0, 40.0])
+    v_n, v_t = 3.9 * np.cos(np.deg2rad(degrees)), 3.9 * np.sin(np.deg2rad(degrees))
+    made = [
+        ji.oblique_impact(law, truth, m=m, R=R, v_n=a, v_t=b) for a, b in zip(v_n, v_t, strict=True)
+    ]
+    e_t = np.array([float(r.e_t) for r in made])
+    omega_out = np.array([float(r.omega_out) for r in made])
+    fit = ji.fit_oblique(law, truth.replace(beta=0.1, mu=0.08), m=m, R=R, v_n=v_n, v_t=v_t,
+                         e_t=e_t, omega_out=omega_out, free=("mu", "beta"))  # fmt: skip
+    assert bool(fit.converged)
+    assert float(fit.params["mu"]) == pytest.approx(0.092, rel=1e-8)
+    assert float(fit.params["beta"]) == pytest.approx(0.3, rel=1e-8)
