@@ -85,16 +85,31 @@ def test_fits_rebounds_made_by_the_library(capsys, tmp_path):
     assert fit["params"]["mu"] == pytest.approx(0.12, rel=1e-6)
 
 
-def _track_csv(tmp_path, scale=1.0, columns=("t", "x", "y", "phi")):
-    """The synthetic track of tests/oblique/test_track.py (clean) as a CSV, `y` times
-    `scale`."""
+def _track_csv(tmp_path, scale=1.0, columns=("t", "x", "y", "phi"), solved=False):
+    """A track as a CSV, `y` times `scale`: with `solved`, the synthetic track of
+    tests/oblique/test_track.py (its impacts from `oblique_impact`), else three flights of
+    a ball reflected with e = 0.9, e_t = 0.8 (for the refusals: no solve)."""
     import sys
     from pathlib import Path
 
-    sys.path.insert(0, str(Path(__file__).parents[1] / "oblique"))
-    from test_track import synthetic_track
+    import numpy as np
 
-    t, x, y, phi, _ = synthetic_track()
+    if solved:
+        sys.path.insert(0, str(Path(__file__).parents[1] / "oblique"))
+        from test_track import synthetic_track
+
+        t, x, y, phi, _ = synthetic_track()
+    else:
+        frames, t0, x0, vx, vy, h0 = [], 0.0, 0.0, 1.0, 0.0, 0.25
+        for _ in range(3):
+            tc = (vy + np.sqrt(vy**2 + 2 * 9.81 * (h0 - 0.02))) / 9.81
+            s = np.arange(np.ceil(t0 * 240), np.floor((t0 + tc) * 240) + 1) / 240 - t0
+            frames.append(np.stack([t0 + s, x0 + vx * s, h0 + vy * s - 4.905 * s**2], 1))
+            t0, x0, h0, vy, vx = t0 + tc, x0 + vx * tc, 0.02, 0.9 * (9.81 * tc - vy), 0.8 * vx
+        t, x, y = np.concatenate(frames).T
+        t, keep = np.unique(t, return_index=True)
+        x, y = x[keep], y[keep]
+        phi = -x / 0.02
     values = {"t": t, "x": x, "y": y * scale, "phi": phi}
     lines = [",".join(columns)]
     lines += [",".join(repr(float(values[c][i])) for c in columns) for i in range(len(t))]
@@ -130,7 +145,7 @@ def test_fits_a_video_track(capsys, tmp_path):
     import jaximpact as ji
 
     c = ji.hertz_stiffness(E=5e7, nu=0.45, R=0.02, E2=float("inf"))
-    argv = ["fit-oblique", _track_csv(tmp_path), *TRACK_BASE, "--json"]
+    argv = ["fit-oblique", _track_csv(tmp_path, solved=True), *TRACK_BASE, "--json"]
     argv[argv.index("c=1.32e7")] = f"c={c!r}"
     status, out, err = run_cli(capsys, argv)
     assert status == 0, err

@@ -93,7 +93,9 @@ def _points(separation, count):
     return np.exp(s), table.gamma_max[k] * rng.uniform(0.0, 1.0, count) ** 2
 
 
-@pytest.mark.parametrize("separation", SEPARATIONS)
+@pytest.mark.parametrize(
+    "separation", ["force", pytest.param("penetration", marks=pytest.mark.slow)]
+)
 def test_table_matches_scipy(separation):
     """e, T, x_max, F_max within 1e-9 of scipy, without a solver step, status separated."""
     betas, pis = _points(separation, 6 if separation == "force" else 4)
@@ -120,6 +122,7 @@ def test_table_matches_scipy_widely(separation):
             assert error < TOL, f"{field} at beta={beta:.3g}, pi={pi:.3g}: {error:.2e}"
 
 
+@pytest.mark.slow
 def test_the_seed_papers_case_takes_the_table():
     """The paper's case 5 (c = 2e6, b1 = 200, P = 400, m = 1 kg, v0 = 2.5 m/s): read off
     the table (`path` similarity, no solver step), the integrated path at rtol 1e-12 to
@@ -133,6 +136,7 @@ def test_the_seed_papers_case_takes_the_table():
     assert ji.impact(law, m=1.0, v0=2.5, method="integrate").path == "integrated"
 
 
+@pytest.mark.slow
 def test_outside_the_table_integrates_with_the_same_status():
     """A dry force that holds the body (stuck at maximum compression, or, under the
     penetration criterion, after its speed comes back to 0) is integrated inside the same

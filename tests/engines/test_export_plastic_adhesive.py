@@ -198,7 +198,7 @@ def test_dmt_export_to_lammps_is_the_law_itself(geometry):
     replica at the export's step realises the law's e and T within the stepping's error
     (0.5 %) above the sticking speed and sticks below it, as the law does."""
     law = _dmt_law()
-    x = ji.export(law, "lammps", m=M, v0=0.3, radius=R, geometry=geometry)
+    x = ji.export(law, "lammps", m=M, v0=0.3, radius=R, geometry=geometry, curves=False)
     assert x.separation == "penetration" and "dmt" in x.snippet and "viscoelastic" in x.snippet
 
     def pulloff(law):

@@ -327,6 +327,7 @@ def test_soft_spring_restick_in_the_first_step():
     assert float(r.omega_out) == pytest.approx(o["omega_out"], rel=1e-8)
 
 
+@pytest.mark.slow
 def test_the_mindlin_damper_against_scipy_and_its_limits():
     """EDEM's and LIGGGHTS' damper `2 (5/6)^0.5 beta (m k_t)^0.5` on the Mindlin spring,
     left out of Coulomb's test: at 10 degrees (sticking, then micro-slip) both histories
@@ -349,8 +350,12 @@ def test_the_mindlin_damper_against_scipy_and_its_limits():
     r = oblique_impact(hertz(), tl, m=M, R=R, v_n=v_n, v_t=v_t)
     rigid = rigid_oblique(e=float(r.e), mu=0.092, v_n=v_n, v_t=v_t, R=R)
     assert float(r.v_t_out) == pytest.approx(float(rigid["v_t_out"]), rel=1e-10)
-    with pytest.raises(ValueError, match="beta"):
+
+
+def test_a_negative_damper_is_refused_in_one_line():
+    with pytest.raises(ValueError, match="beta") as error:
         tangential_law("mindlin", G_star=G_STAR, mu=0.092, beta=-0.1)
+    assert "\n" not in str(error.value)
 
 
 @pytest.mark.slow
