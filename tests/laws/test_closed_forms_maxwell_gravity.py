@@ -252,7 +252,8 @@ def check(cases, separation, refine=False):
 FAST_SEPARATION = ["force", pytest.param("penetration", marks=pytest.mark.slow)]
 
 
-@pytest.mark.parametrize("separation", FAST_SEPARATION)
+@pytest.mark.slow  # 12 s of compiling; the fast suite keeps the gradients and the path
+@pytest.mark.parametrize("separation", SEPARATIONS)
 def test_matches_scipy(separation):
     _, endings = check(FAST, separation)
     assert {"separated", "horizon"} <= endings

@@ -233,7 +233,11 @@ def test_throw_raises_when_not_separated():
 # ----------------------------------------------------------------------- (c) gravity
 
 
-@pytest.mark.parametrize("name", ["hertz_rate", "bingham", "maxwell"])
+@pytest.mark.parametrize(
+    "name",
+    # Bingham's closed form with gravity: tests/laws/test_closed_forms_linear.py
+    ["hertz_rate", pytest.param("bingham", marks=pytest.mark.slow), "maxwell"],
+)
 def test_gravity_matches_scipy(name):
     params = next(p for n, p, _, _ in PAPER_SETS if n == name)
     r = solver(name, rtol=rtol_for(name))(params, g=9.81)
