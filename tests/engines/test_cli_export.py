@@ -247,5 +247,6 @@ def test_cli_export_tangential_to_lammps(capsys):
     x = ji.export(ji.law("tsuji", c=4.2e9, b=15.0), "lammps", m=2.618e-4, v0=3.9,
                   radius=2.5e-3, geometry="wall", tangential=tl, curves=False)  # fmt: skip
     assert data["e_t_engine"] == pytest.approx(list(x.e_t_engine), rel=1e-12)
-    assert data["tangential"] == {"name": "mindlin", "parameters": {"G_star": 1.35e10,
-                                                                     "mu": 0.092}}  # fmt: skip
+    # every parameter of the law, the Mindlin damper beta at its default 0 included
+    parameters = {"G_star": 1.35e10, "mu": 0.092, "beta": 0.0}
+    assert data["tangential"] == {"name": "mindlin", "parameters": parameters}
