@@ -72,6 +72,45 @@ def velocity_verlet(accel, h, v0, phases=PHASES, max_steps=2_000_000):
     return step_until_separated(step, h, v0, phases, max_steps)
 
 
+def cohesive_verlet(force, holds, h, m_eff, v0, phases=PHASES, max_steps=10_000_000):
+    """`(e, T)` per start phase of LAMMPS's `fix nve/sphere` (velocity Verlet) on a contact
+    that can hold the body (a cohesive normal model, `jkr` or `dmt`): `force(x, v)` (N,
+    pushing apart) at overlap `x` (m) and the half-step approach speed `v` (m/s), `holds(x,
+    attached)` whether the contact exists at `x` given that it did before, effective mass
+    `m_eff` (kg), impact speed `v0` (m/s). T (s) is the number of steps with a contact times
+    `h`; a body the contact holds (its speed turns back in before it lets go) gives `e = 0`
+    and T the steps until then (as `impact`'s `captured`)."""
+    x = -v0 * h * np.asarray(phases, float)
+    v = np.full_like(x, v0)  # approach speed, d delta / dt
+    a = np.zeros_like(x)
+    attached = np.zeros(x.shape, bool)
+    started = np.zeros(x.shape, bool)
+    done = np.zeros(x.shape, bool)
+    captured = np.zeros(x.shape, bool)
+    leaving = np.zeros(x.shape, bool)
+    steps = np.zeros_like(x)
+    for _ in range(max_steps):
+        v_half = v + 0.5 * h * a
+        x_new = x + h * v_half
+        attach = holds(x_new, attached)
+        pushing = np.where(attach, force(np.where(attach, x_new, 0.0), v_half), 0.0)
+        a_new = -pushing / m_eff
+        v_new = v_half + 0.5 * h * a_new
+        live = ~done
+        x, v, a = np.where(live, x_new, x), np.where(live, v_new, v), np.where(live, a_new, a)
+        attached = np.where(live, attach, attached)
+        started |= attach
+        turned_in = leaving & attach & (v > 0.0)  # held: turns back in before letting go
+        leaving |= started & (v < 0.0)
+        ends = live & ((started & ~attach) | turned_in)
+        captured |= ends & turned_in
+        steps += live & attach & ~turned_in
+        done |= ends
+        if done.all():
+            return np.where(captured, 0.0, -v / v0), steps * h
+    raise RuntimeError("the replica did not finish the contact; the time step is far too small")
+
+
 def nice_down(h: float) -> float:
     """`h` (s) rounded down to two significant digits (a number one types into an input)."""
     scale = 10.0 ** math.floor(math.log10(h))

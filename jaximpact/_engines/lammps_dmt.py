@@ -52,33 +52,15 @@ def replica(parameters, m: float, v0: float, phases=_stepping.PHASES, max_steps=
     wall = parameters.get("geometry", "spheres") == "wall"
     m_eff = m if wall else m / 2.0
     c, b, pull = _contact(parameters, m_eff)
-    x = -v0 * h * np.asarray(phases, float)
-    v = np.full_like(x, v0)  # approach speed, d delta / dt
-    a = np.zeros_like(x)
-    started = np.zeros(x.shape, bool)
-    done = np.zeros(x.shape, bool)
-    captured = np.zeros(x.shape, bool)
-    leaving = np.zeros(x.shape, bool)
-    steps = np.zeros_like(x)
-    for _ in range(max_steps):
-        v_half = v + 0.5 * h * a
-        x_new = x + h * v_half
-        touch = x_new > 0.0
-        force = np.where(touch, normal_force(x_new, v_half, c=c, b=b, pull=pull), 0.0)
-        a_new = -force / m_eff
-        v_new = v_half + 0.5 * h * a_new
-        live = ~done
-        x, v, a = np.where(live, x_new, x), np.where(live, v_new, v), np.where(live, a_new, a)
-        started |= touch
-        turned_in = leaving & touch & (v > 0.0)
-        leaving |= started & (v < 0.0)
-        ends = live & ((started & ~touch) | turned_in)
-        captured |= ends & turned_in
-        steps += live & touch & ~turned_in
-        done |= ends
-        if done.all():
-            return np.where(captured, 0.0, -v / v0), steps * h
-    raise RuntimeError("the replica did not finish the contact; the time step is far too small")
+    return _stepping.cohesive_verlet(
+        lambda x, v: normal_force(x, v, c=c, b=b, pull=pull),
+        lambda x, attached: x > 0.0,  # the contact holds while the spheres overlap
+        h,
+        m_eff,
+        v0,
+        phases,
+        max_steps,
+    )
 
 
 def _contact(parameters, m_eff: float) -> tuple[float, float, float]:

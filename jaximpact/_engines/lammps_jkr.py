@@ -176,36 +176,16 @@ def replica(parameters, m: float, v0: float, phases=_stepping.PHASES, max_steps=
     E, nu, _ = _check(parameters)
     E_mix = emix(E, nu)
     pull = pulloff_distance(R_eff, cohesion, E_mix)
-    x = -v0 * h * np.asarray(phases, float)
-    v = np.full_like(x, v0)  # approach speed, d delta / dt
-    a = np.zeros_like(x)
-    attached = np.zeros(x.shape, bool)
-    started = np.zeros(x.shape, bool)
-    done = np.zeros(x.shape, bool)
-    captured = np.zeros(x.shape, bool)
-    leaving = np.zeros(x.shape, bool)
-    steps = np.zeros_like(x)
-    for _ in range(max_steps):
-        v_half = v + 0.5 * h * a
-        x_new = x + h * v_half
-        attach = np.where(attached, x_new > -pull, x_new > 0.0)
-        force = np.where(attach, normal_force(np.where(attach, x_new, 0.0), R_eff, cohesion,
-                                              E_mix), 0.0)  # fmt: skip
-        a_new = -force / m_eff
-        v_new = v_half + 0.5 * h * a_new
-        live = ~done
-        x, v, a = np.where(live, x_new, x), np.where(live, v_new, v), np.where(live, a_new, a)
-        attached = np.where(live, attach, attached)
-        started |= attach
-        turned_in = leaving & attach & (v > 0.0)  # held: turns back in before the break
-        leaving |= started & (v < 0.0)
-        ends = live & ((started & ~attach) | turned_in)
-        captured |= ends & turned_in
-        steps += live & attach & ~turned_in
-        done |= ends
-        if done.all():
-            return np.where(captured, 0.0, -v / v0), steps * h
-    raise RuntimeError("the replica did not finish the contact; the time step is far too small")
+    return _stepping.cohesive_verlet(
+        lambda x, v: normal_force(x, R_eff, cohesion, E_mix),
+        # a neck forms at zero overlap and holds down to the pull-off distance
+        lambda x, attached: np.where(attached, x > -pull, x > 0.0),
+        h,
+        m_eff,
+        v0,
+        phases,
+        max_steps,
+    )
 
 
 def _check(parameters) -> tuple[float, float, float]:
