@@ -250,17 +250,24 @@ def _lammps_contact(parameters, atoms: str, *, radius, wall: bool):
     return lmp, steps
 
 
+def _phases(parameters, *, m, v0, radius, phases):
+    """`(wall, step, atoms)` of each start phase of the exports' head-on scene: whether the
+    sphere hits the wall, the step (s), and the commands placing the spheres first touch
+    `phase` steps away."""
+    h = parameters["timestep_s"]
+    wall = parameters.get("geometry", "spheres") == "wall"
+    rho = m / (4.0 / 3.0 * math.pi * radius**3)
+    for phase in map(float, phases):
+        yield wall, h, _head_on_atoms(wall=wall, radius=radius, rho=rho, gap=v0 * h * phase, v0=v0)
+
+
 def run_lammps(parameters, *, m, v0, radius, phases=(0.5,)):
     """Run LAMMPS on two spheres (mass `m` kg, radius `radius` m each, head-on at relative
     speed `v0` m/s), or with `parameters["geometry"] == "wall"` on one such sphere hitting
     the exported `fix wall/gran` (the plane z = 0) at `v0`; returns arrays `(e, T)`, T the
     number of steps with a non-zero contact force times the step."""
-    h = parameters["timestep_s"]
-    wall = parameters.get("geometry", "spheres") == "wall"
-    rho = m / (4.0 / 3.0 * math.pi * radius**3)
     es, Ts = [], []
-    for phase in map(float, phases):
-        atoms = _head_on_atoms(wall=wall, radius=radius, rho=rho, gap=v0 * h * phase, v0=v0)
+    for wall, h, atoms in _phases(parameters, m=m, v0=v0, radius=radius, phases=phases):
         lmp, steps = _lammps_contact(parameters, atoms, radius=radius, wall=wall)
         v = lmp.numpy.extract_atom("v")
         if wall:
@@ -450,13 +457,10 @@ def run_lammps_jkr(parameters, *, m, v0, radius, phases=(0.5,)):
     such sphere on the exported `fix wall/gran` (the plane z = 0). Returns arrays `(e, T)`:
     T (s) the number of steps with a non-zero contact force times the step, to the neck's
     breaking; where the neck holds the body (below the sticking speed, no damping: it would
-    oscillate for ever), `e = 0` and T the steps until it turns back in."""
-    h = parameters["timestep_s"]
-    wall = parameters.get("geometry", "spheres") == "wall"
-    rho = m / (4.0 / 3.0 * math.pi * radius**3)
+    oscillate for ever), `e = 0` and T the steps until it turns back in. The same for its
+    `dmt` model (a contact the adhesion holds)."""
     es, Ts = [], []
-    for phase in map(float, phases):
-        atoms = _head_on_atoms(wall=wall, radius=radius, rho=rho, gap=v0 * h * phase, v0=v0)
+    for wall, h, atoms in _phases(parameters, m=m, v0=v0, radius=radius, phases=phases):
         lmp = _lammps_scene(parameters, atoms, radius=radius, wall=wall)
         axis = 2 if wall else 0
         steps, started, leaving, captured = 0, False, False, False
