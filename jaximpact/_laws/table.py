@@ -247,6 +247,7 @@ _SPECS += [
         name="dmt",
         damping="b",
         map_range=(200.0, 2000.0),
+        map_fixed={"w": 0.1},  # a surface energy of 0.1 J/m^2 (glass in air is 0.1-0.4)
         equation="DMT 1975",
         formula="c x^1.5 + b x^0.5 v - 2 pi w R while x > 0 (contact ends at x = 0)",
         parameters=("c", "b", "R", "w"),

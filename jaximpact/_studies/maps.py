@@ -44,6 +44,13 @@ class RestitutionMap(eqx.Module):
     path: str = eqx.field(static=True)
 
 
+def held_fixed(spec, fixed, damping_name) -> dict:
+    """The parameters a map holds fixed: the row's `map_fixed` (less the grid's damping
+    parameter), then the user's `fixed` over them."""
+    defaults = {k: v for k, v in spec.map_fixed.items() if k != damping_name}
+    return {**defaults, **(fixed or {})}
+
+
 def axis(values, default, num, log):
     if values is None:
         lo, hi = default
@@ -80,7 +87,7 @@ def restitution_map(
       e.g.
       `b` for Kelvin-Voigt, `b1` for law 14, `a` for Hunt-Crossley, `P` for eq. 9,
       `e_nominal` for the published Hunt-Crossley variants).
-    - `fixed`: the law's other parameters (default: the row's `map_fixed`, e.g. `P = 400 N` for
+    - `fixed`: the law's other parameters (added to the row's `map_fixed`, e.g. `P = 400 N` for
       Bingham); `m` (kg), `v0` (m/s), `separation` as in `impact`.
     - `method`: `"auto"` takes an exact closed form where it holds on the whole grid
       (Kelvin-Voigt; Maxwell when every point is under-damped, `4 b^2 > m c`, under the
@@ -99,7 +106,7 @@ def restitution_map(
         raise ValueError(f"unknown law {law_name!r}; choose one of: {', '.join(LAW_NAMES)}")
     spec = LAWS[law_name]
     damping_name = spec.damping if damping_name is None else damping_name
-    fixed = dict(spec.map_fixed if fixed is None else fixed)
+    fixed = held_fixed(spec, fixed, damping_name)
     if damping_name not in spec.parameters or damping_name == "c":
         raise ValueError(
             f"law {law_name!r} has no damping parameter {damping_name!r}; "

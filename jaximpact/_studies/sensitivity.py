@@ -13,7 +13,7 @@ from .._batch import build_law, cost_key, prepare_rows, run_batch
 from .._laws import LAWS
 from .._progress import AbstractMeter
 from .._solve.impact import impact
-from .maps import C_RANGE, axis
+from .maps import C_RANGE, axis, held_fixed
 
 
 @functools.lru_cache(maxsize=32)
@@ -137,7 +137,7 @@ def sensitivity_map(
     """
     spec = LAWS[law_name]
     damping_name = spec.damping
-    fixed = dict(spec.map_fixed if fixed is None else fixed)
+    fixed = held_fixed(spec, fixed, damping_name)
     c = axis(c, C_RANGE, num, log=True)
     damping = axis(damping, spec.map_range, num, log=False)
     d_grid, c_grid = np.meshgrid(damping, c, indexing="ij")
