@@ -119,9 +119,10 @@ def add_export(subparsers):
     )  # fmt: skip
     parser.add_argument(
         "--tangential", metavar="NAME",
-        help=f"{_labels(lambda e: bool(e.TANGENTIAL))}: also export the tangential law NAME "
-        "(linear_history, mindlin, mindlin_force) with --tparam, and print the e_t and spin "
-        "it promises from 5 to 75 degrees",
+        help=f"{_labels(lambda e: bool(e.TANGENTIAL or e.FRICTION))}: also export the "
+        "tangential law NAME (linear_history, mindlin, mindlin_force; MuJoCo takes its mu "
+        "alone) with --tparam, and print the e_t, spin and normal e the engine realises from "
+        "5 to 75 degrees, beside the law's e_t",
     )  # fmt: skip
     parser.add_argument(
         "--tparam", action="extend", nargs="+", default=[], metavar="NAME=VALUE",
@@ -251,11 +252,15 @@ def _run_export(args):
                 law_e = f"   {x.e_target[i]:.5g}" if with_law else ""
                 lines.append(f"  {format_number(v):>9}   {x.e_engine[i]:.5g}{law_e}")
         if x.tangential is not None:
-            lines.append(f"tangential {x.tangential.name}: what its laws promise at v0 "
-                         "(continuous, no spin before)")  # fmt: skip
-            lines.append("  angle (deg)   e_t       spin after (rad/s)")
-            for angle, e_t, omega in zip(x.angles, x.e_t_engine, x.omega_engine, strict=True):
-                lines.append(f"  {angle:11g}   {e_t:.5f}   {omega:.4g}")
+            lines.append(f"tangential {x.tangential.name}: what the engine realises at v0 "
+                         "(no spin before)")  # fmt: skip
+            law = x.e_t_target is not None
+            lines.append("  angle (deg)   e_t       spin after (rad/s)   e normal"
+                         + ("   e_t law" if law else ""))  # fmt: skip
+            rows = zip(x.angles, x.e_t_engine, x.omega_engine, x.e_n_engine, strict=True)
+            for k, (angle, e_t, omega, e_n) in enumerate(rows):
+                lines.append(f"  {angle:11g}   {e_t:.5f}   {omega:<18.4g}   {e_n:.5f}"
+                             + (f"    {x.e_t_target[k]:.5f}" if law else ""))  # fmt: skip
         lines += [f"warning: {w}" for w in data["warnings"]]
         return "\n".join(lines)
 

@@ -110,11 +110,17 @@ class AbstractEngine(abc.ABC):
 
     - `TANGENTIAL` (optional, default none): the tangential laws (`tangential_law` names)
       the engine takes exactly, with `with_tangential`.
+    - `FRICTION` (optional, default None): where the engine has no tangential law of
+      jaximpact's but friction alone, what it makes of a tangential law (its nearest), in
+      words; `with_tangential` then takes any tangential law's `mu`.
 
     **Optional methods**: `native(law)`, the engine (its own model) that exports `law`
     where the engine has that law itself (LAMMPS's `jkr`), else None;
     `with_tangential(parameters, tangential)`, the design's parameters with the tangential
-    law set (for the laws of `TANGENTIAL`).
+    law set (for the laws of `TANGENTIAL`, or its friction for a `FRICTION` engine);
+    `check_tangential(tangential, radius)`, its refusal before any work; `oblique(parameters,
+    *, radius, v_n, v_t)`, the oblique impacts the engine's own stepping realises, where it
+    is replicated (else None: an export promises its continuous laws').
     """
 
     NAME: ClassVar[str]
@@ -128,13 +134,26 @@ class AbstractEngine(abc.ABC):
     CONTINUOUS_PLANT: ClassVar[bool]
     NEAREST: ClassVar[str | None] = None
     TANGENTIAL: ClassVar[tuple[str, ...]] = ()
+    FRICTION: ClassVar[str | None] = None
+
+    def check_tangential(self, tangential, radius) -> None:
+        """A one-line ValueError where the engine cannot take `tangential` (before any
+        work); `radius` (m) is the export's."""
+        self.with_tangential({}, tangential)
+
+    def oblique(self, parameters: dict, *, radius: float, v_n, v_t):
+        """`(e, e_t, omega)` per first-touch phase (rad/s for the spin) that the engine's
+        own time stepping realises with `parameters` for a sphere of radius `radius` (m)
+        meeting its plane at `v_n`, `v_t` (m/s, arrays of one shape, no spin before), or
+        None where it is not replicated."""
+        return None
 
     def with_tangential(self, parameters: dict, tangential) -> dict:
         """`parameters` with the tangential law `tangential` (a law of `TANGENTIAL`); a
         one-line ValueError for a law the engine does not take."""
         raise ValueError(
             f"{self.LABEL} has no tangential export yet (the normal law is exported alone); "
-            "export tangential laws to lammps"
+            "export tangential laws to lammps or mujoco"
         )
 
     def native(self, law) -> "AbstractEngine | None":

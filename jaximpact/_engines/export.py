@@ -96,10 +96,13 @@ class Export:
       of speeds.
     - `warnings`: where the engine will not do what was asked, or only with care.
     - With a tangential law (`export(tangential=...)`): `tangential`, and at `v0` from
-      `angles` (degrees from the normal) the tangential restitution `e_t_engine` and the
-      spin after `omega_engine` (rad/s) of the engine's continuous laws (its time stepping
-      not replicated; the real LAMMPS on a wall within 0.002 at the recommended step, two
-      spheres within 0.01, whose line of centres turns during contact; tests/engines).
+      `angles` (degrees from the normal) the tangential restitution `e_t_engine`, the
+      spin after `omega_engine` (rad/s) and the normal restitution `e_n_engine` that the
+      engine realises, no spin before: MuJoCo's Euler step replicated (the mean over
+      first-touch phases; equal to MuJoCo to round-off, tests/engines), else the engine's
+      continuous laws (LAMMPS: the real LAMMPS on a wall within 0.002 at the recommended
+      step, two spheres within 0.01, whose line of centres turns during contact); and
+      `e_t_target`, the given law's with `tangential` (None from targets).
     """
 
     engine: str
@@ -128,6 +131,8 @@ class Export:
     angles: tuple = ()
     e_t_engine: tuple = ()
     omega_engine: tuple = ()
+    e_n_engine: tuple = ()
+    e_t_target: tuple | None = None
 
     def to_dict(self) -> dict:
         laws = ("law", "tangential")
@@ -219,10 +224,12 @@ def export(
 
     `tangential`: a tangential law (`tangential_law(...)`) exported with the normal one,
     to an engine that has it exactly (`AbstractEngine.TANGENTIAL`: LAMMPS's
-    `linear_history`, `mindlin`, `mindlin/force`); the `Export` then also holds the
-    oblique impacts its continuous laws give at `v0` from `OBLIQUE_ANGLES` (degrees from
-    the normal): `e_t_engine`, `omega_engine` (rad/s), from `oblique_impact` with the
-    engine's normal law. Another engine: a one-line ValueError.
+    `linear_history`, `mindlin`, `mindlin/force`), or as its friction `mu` alone to an
+    engine with friction and no tangential spring (`AbstractEngine.FRICTION`: MuJoCo's
+    pyramidal cone, `radius` needed; a warning says how far its e_t and normal e fall);
+    the `Export` then also holds the oblique impacts the engine realises at `v0` from
+    `OBLIQUE_ANGLES` (degrees from the normal): `e_t_engine`, `omega_engine` (rad/s),
+    `e_n_engine`, and the law's `e_t_target`. Another engine: a one-line ValueError.
 
     An export the engine cannot realise at `timestep` is refused: an `UnrealisedExport`
     (a `ValueError`) that names the step that would work (`.working`), or with `strict=False`
@@ -253,7 +260,7 @@ def export(
     options = dict(m=m, v0=v0, radius=radius, poisson=0.3 if poisson is None else poisson,
                    limit_damping=limit_damping, geometry=geometry)  # fmt: skip
     if tangential is not None:  # refused before any work by an engine without it
-        chosen.with_tangential({}, tangential)
+        chosen.check_tangential(tangential, radius)
     out = chosen.design(target_e, target_T, timestep=timestep, **options)
     if out.target_T is not None:  # MuJoCo without T: its default timeconst's
         target_T = out.target_T
@@ -285,8 +292,11 @@ def export(
     parameters, oblique = out.parameters, {}
     if tangential is not None:
         parameters = chosen.with_tangential(parameters, tangential)
-        oblique = _oblique_promise(chosen, engine_law, out.separation, tangential,
-                                   m=m, v0=v0, radius=radius, geometry=geometry)  # fmt: skip
+        oblique = _oblique_promise(chosen, parameters, engine_law, out.separation, tangential,
+                                   source, m=m, v0=v0, radius=radius,
+                                   geometry=geometry)  # fmt: skip
+        if chosen.FRICTION is not None:
+            warnings.append(_friction_note(chosen, tangential, oblique))
     return Export(
         engine=engine,
         scene=chosen.SCENES[geometry],
@@ -314,11 +324,15 @@ def export(
 OBLIQUE_ANGLES = (5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 75.0)
 
 
-def _oblique_promise(chosen, engine_law, separation, tangential, *, m, v0, radius, geometry):
-    """The oblique impacts at speed `v0` (m/s) from `OBLIQUE_ANGLES` that the engine's
-    continuous laws give (its normal law `engine_law`, the exported `tangential` law): a
-    sphere of mass `m` (kg) and radius `radius` (m) on the wall, or the pair's effective
-    sphere (`two_spheres`) for two spheres; no spin before."""
+def _oblique_promise(chosen, parameters, engine_law, separation, tangential, source, *, m,
+                     v0, radius, geometry):  # fmt: skip
+    """The oblique impacts at speed `v0` (m/s) from `OBLIQUE_ANGLES` (no spin before) that
+    the engine realises with `parameters`: its own stepping where it is replicated
+    (`chosen.oblique`, the mean over first-touch phases), else its continuous laws (its
+    normal law `engine_law`, the exported `tangential` law) through `oblique_impact`; and
+    the tangential restitution of the given law `source` with `tangential` (None from
+    targets). A sphere of mass `m` (kg) and radius `radius` (m) on the wall, or the pair's
+    effective sphere (`two_spheres`) for two spheres."""
     import numpy as np
 
     from .._oblique import incidence, oblique_impact, two_spheres
@@ -327,17 +341,47 @@ def _oblique_promise(chosen, engine_law, separation, tangential, *, m, v0, radiu
         scene = two_spheres(m, radius, m, radius)
     else:
         scene = dict(m=m, R=radius, inertia=0.4)
-    e_t, omega = [], []
-    for angle in OBLIQUE_ANGLES:
-        v_n, v_t = (float(v) for v in incidence(v0, np.deg2rad(angle)))
+    v_n, v_t = (np.asarray(v, float) for v in incidence(v0, np.deg2rad(OBLIQUE_ANGLES)))
+
+    def continuous(normal_law):
         # a soft spring sticks and slips many times (throw=False: a solve that still
         # fails is NaN in the promise, not an error of the export)
-        r = oblique_impact(engine_law, tangential, **scene, v_n=v_n, v_t=v_t,
-                           separation=separation, max_segments=64, throw=False)  # fmt: skip
-        e_t.append(float(r.e_t))
-        omega.append(float(r.omega_out))
-    return dict(tangential=tangential, angles=OBLIQUE_ANGLES, e_t_engine=tuple(e_t),
-                omega_engine=tuple(omega))  # fmt: skip
+        rows = [oblique_impact(normal_law, tangential, **scene, v_n=float(a), v_t=float(b),
+                               separation=separation, max_segments=64, throw=False)
+                for a, b in zip(v_n, v_t, strict=True)]  # fmt: skip
+        return tuple(
+            np.array([[float(getattr(r, k)) for r in rows] for k in ("e", "e_t", "omega_out")])
+        )
+
+    stepped = chosen.oblique(parameters, radius=radius, v_n=v_n, v_t=v_t)
+    if stepped is None:
+        e_n, e_t, omega = continuous(engine_law)
+    else:
+        e_n, e_t, omega = (np.asarray(a).mean(axis=-1) for a in stepped)
+    target = None if source is None else tuple(float(v) for v in continuous(source)[1])
+    return dict(tangential=tangential, angles=OBLIQUE_ANGLES, e_t_engine=tuple(map(float, e_t)),
+                omega_engine=tuple(map(float, omega)), e_n_engine=tuple(map(float, e_n)),
+                e_t_target=target)  # fmt: skip
+
+
+def _friction_note(chosen, tangential, oblique) -> str:
+    """The warning of an export to an engine with friction alone (`FRICTION`): what it
+    takes, how far its e_t falls from the law's over the angles, how its normal e moves."""
+    import numpy as np
+
+    angles, e_n = np.asarray(oblique["angles"]), np.asarray(oblique["e_n_engine"])
+    note = (
+        f"{chosen.FRICTION} (mu = {float(tangential.params['mu']):.4g} of "
+        f"{tangential.name}); over {angles.min():g}-{angles.max():g} degrees its normal e "
+        f"runs {e_n.min():.4g} to {e_n.max():.4g}"
+    )
+    if oblique["e_t_target"] is not None:
+        gap = np.abs(np.asarray(oblique["e_t_engine"]) - np.asarray(oblique["e_t_target"]))
+        k = int(np.nanargmax(gap))
+        note += (
+            f", and its e_t departs from the law's by up to {gap[k]:.3g} (at {angles[k]:g} degrees)"
+        )
+    return note
 
 
 def _inputs(chosen: AbstractEngine, law_or_fit, m, v0, timestep, poisson):

@@ -151,6 +151,48 @@ class Mujoco(AbstractEngine):
         "contact force: replicated"
     )
     CONTINUOUS_PLANT = False
+    FRICTION = (
+        "MuJoCo has no tangential spring: a tangential law goes as its Coulomb mu alone, in "
+        "MuJoCo's soft pyramidal friction cone (condim 3), solref corrected for the cone's "
+        "stiffening head-on; the cone acts on the slip at the rate of the contact's damping, "
+        "so a nearly elastic contact (low dampratio) barely slows it"
+    )
+
+    def check_tangential(self, tangential, radius):
+        """MuJoCo takes any tangential law's `mu`; the sphere's radius is needed."""
+        if radius is None:
+            raise ValueError(
+                "mujoco with a tangential law needs the sphere's radius (its friction's lever "
+                "arm and inertia): pass radius= (m)"
+            )
+
+    def with_tangential(self, parameters, tangential):
+        """`parameters` with friction `mu` (the tangential law's) on the pyramidal cone, and
+        solref in its direct form divided by `head_on_factor(mu)`, so that head-on MuJoCo
+        realises the frictionless design (mujoco_friction.py). `mu = 0`: no friction
+        (condim 1), unchanged."""
+        from .mujoco_friction import frictional_solref, head_on_factor
+
+        mu = float(tangential.params["mu"])
+        out = dict(parameters, friction=[mu, 0.0, 0.0], condim=3 if mu > 0 else 1,
+                   cone="pyramidal", impratio=1.0)  # fmt: skip
+        if mu > 0:
+            out["solref"] = frictional_solref(parameters["solref"], parameters["timestep"], mu)
+            out["cone_factor"] = head_on_factor(mu)
+        return out
+
+    def oblique(self, parameters, *, radius, v_n, v_t):
+        """MuJoCo's Euler step on the sphere with the exported friction (mujoco_friction.py);
+        without friction the normal replica, the tangential speed and spin unchanged."""
+        from .mujoco_friction import oblique_replica
+
+        mu = float(parameters.get("friction", [0.0])[0])
+        if mu > 0:
+            return oblique_replica(parameters["solref"], parameters["timestep"], mu=mu,
+                                   radius=radius, v_n=v_n, v_t=v_t)  # fmt: skip
+        v_n = np.atleast_1d(np.asarray(v_n, float))
+        e = np.stack([replica(parameters["solref"], parameters["timestep"], v)[0] for v in v_n])
+        return e, np.ones_like(e), np.zeros_like(e)
 
     def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
                limit_damping=False, geometry=None) -> Design:  # fmt: skip
@@ -226,11 +268,17 @@ class Mujoco(AbstractEngine):
     def snippet(self, parameters) -> str:
         solref = " ".join(f"{v:.10g}" for v in parameters["solref"])
         solimp = " ".join(f"{v:g}" for v in parameters["solimp"])
+        option, geom, note = "", "", ""
+        if "friction" in parameters:
+            friction = " ".join(f"{v:.10g}" for v in parameters["friction"])
+            option = ' cone="pyramidal" impratio="1"'
+            geom = f' friction="{friction}" condim="{parameters["condim"]}"'
+            note = "; it takes the larger friction of the two"
         return (
-            f'<option timestep="{parameters["timestep"]:.6g}" integrator="Euler"/>\n'
+            f'<option timestep="{parameters["timestep"]:.6g}" integrator="Euler"{option}/>\n'
             "<default>\n"
-            f'  <geom solref="{solref}" solimp="{solimp}"/>\n'
+            f'  <geom solref="{solref}" solimp="{solimp}"{geom}/>\n'
             "</default>\n"
             "<!-- MuJoCo mixes the solref/solimp of the two geoms in contact: give both these\n"
-            "     values (the default class above does), or use a <pair> -->"
+            f"     values (the default class above does), or use a <pair>{note} -->"
         )

@@ -90,6 +90,44 @@ def run_mujoco(
     return np.array(es), np.array(Ts)
 
 
+def run_mujoco_oblique(parameters, *, radius: float, v_n: float, v_t: float, phases=(0.5,),
+                       m: float = 0.05):  # fmt: skip
+    """Run MuJoCo on an export with friction (`parameters` with `friction`, `condim`, `cone`,
+    `impratio`): a free sphere of mass `m` (kg) and radius `radius` (m) meeting the plane at
+    `v_n`, `v_t` (m/s), no spin, gravity off, first touch `phase * timestep` after a step's
+    start, the solver to its tightest tolerance. Returns arrays `(e, e_t, omega)` per phase
+    (omega in rad/s, positive rolling forward: MuJoCo's spin about y)."""
+    import mujoco
+
+    h = parameters["timestep"]
+    solref = " ".join(f"{v!r}" for v in parameters["solref"])
+    solimp = " ".join(f"{v!r}" for v in parameters["solimp"])
+    friction = " ".join(f"{v!r}" for v in parameters["friction"])
+    xml = f"""<mujoco><option timestep="{h!r}" gravity="0 0 0" integrator="Euler"
+      cone="{parameters["cone"]}" impratio="{parameters["impratio"]!r}" tolerance="1e-15"
+      iterations="200"/>
+      <default><geom solref="{solref}" solimp="{solimp}" friction="{friction}"
+      condim="{parameters["condim"]}"/></default>
+      <worldbody><geom type="plane" size="1 1 0.1"/>
+      <body pos="0 0 1"><freejoint/><geom type="sphere" size="{radius!r}" mass="{m!r}"/>
+      </body></worldbody></mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    rows = []
+    for phase in phases:
+        data = mujoco.MjData(model)
+        data.qpos[2] = radius + v_n * h * phase
+        data.qvel[:3] = [v_t, 0.0, -v_n]
+        started = False
+        for _ in range(10_000_000):
+            mujoco.mj_step(model, data)
+            if data.ncon:
+                started = True
+            elif started:
+                break
+        rows.append((data.qvel[2] / v_n, data.qvel[0] / v_t, data.qvel[4]))
+    return tuple(np.array(column) for column in zip(*rows, strict=True))
+
+
 def run_drake(
     parameters, *, m, v0, radius=0.01, time_step=0.0, accuracy=1e-10, approximation=None, gap=0.0
 ):

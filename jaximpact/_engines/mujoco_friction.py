@@ -1,0 +1,124 @@
+"""MuJoCo's friction on a sphere meeting a plane obliquely: Coulomb's `mu` in its soft
+pyramidal cone, the oblique impact its Euler step realises (replicated), and how the cone
+changes the normal contact.
+
+MuJoCo has no tangential spring: a contact with `condim="3"` and the default
+`cone="pyramidal"` is four constraint rows, the cone's edges `J_n +- mu J_t1`,
+`J_n +- mu J_t2` (src/engine/engine_core_constraint.c, `mj_instantiateContact`), each
+pushing only (`f >= 0`) and softened as the normal row is:
+
+- `mj_diagApprox`: each edge's approximate inverse inertia `diagA = tran (1 + mu^2)`, `tran`
+  the body's translational `invweight0` (1/m for a free body);
+- `mj_makeImpedance`: `R = (1 - d)/d diagA`, then for a pyramid the common
+  `R_py = 2 mu^2 R` on every edge (`impratio = 1`), `D = 1/R_py`; the reference
+  acceleration of each edge `aref = -B (J v) - K d r` with `r` the contact's distance
+  (negative inside) and `K`, `B` from solref as for the normal row;
+- the solver (Newton, to its tolerance) gives the unique minimum of
+  `1/2 (a - a0)' M (a - a0) + sum 1/2 D (J a - aref)^2` over the edges where
+  `J a < aref` (`a0 = 0` here: no gravity, and a sphere's gyroscopic term is zero);
+- the contact point lies halfway through the penetration: the lever arm of the friction
+  about the centre is `R + r/2`.
+
+Head-on (no slip) the four edges share the normal acceleration, which is then
+`d_eff aref` with `d_eff = 1 / (1 + mu^2 (1 + mu^2) (1 - d) / (2 d))` in place of the
+frictionless row's `d aref`: friction stiffens and damps the normal contact by `d_eff / d`
+(`head_on_factor`), which an export with friction divides out. Obliquely the edges' damping
+`B (J v)` carries the slip `mu u`, so MuJoCo's normal restitution changes with the incidence
+(measured in tests/engines: the replica equals MuJoCo 4.0 to round-off).
+
+The motion stays in the plane of incidence, so the two edges across it carry equal forces
+and act as normal rows; the replica solves the other two and the pair in one 3 x 3 system
+per active set (x, z and the spin about y, per unit mass), and takes the consistent one.
+"""
+
+import itertools
+
+import numpy as np
+
+from . import _stepping
+from .mujoco import SOLIMP, effective
+
+INERTIA = 0.4  # MuJoCo's solid sphere, I = 0.4 m R^2
+# the active sets: edge + (mu along the slip), edge -, the pair across the plane
+_ACTIVE = np.array(list(itertools.product([0.0, 1.0], repeat=3)))
+
+
+def head_on_factor(mu: float, impedance: float = SOLIMP[0]) -> float:
+    """`d_eff / d`: how much stiffer and more damped MuJoCo's pyramidal cone with friction
+    `mu` makes the normal contact head-on than a frictionless one (impedance `d`)."""
+    d = impedance
+    d_eff = 1.0 / (1.0 + mu**2 * (1.0 + mu**2) * (1.0 - d) / (2.0 * d))
+    return d_eff / d
+
+
+def frictional_solref(solref, timestep: float, mu: float) -> list[float]:
+    """The direct solref `[-stiffness, -damping]` with which MuJoCo's pyramidal cone of
+    friction `mu` realises head-on the contact that `solref` (at `timestep`, s) gives a
+    frictionless row: the effective stiffness (1/s^2) and damping (1/s) over
+    `head_on_factor(mu)`."""
+    stiffness, damping = effective(solref, timestep)
+    s = head_on_factor(mu)
+    return [-stiffness / s, -damping / s]
+
+
+def _edge_solve(J, aref, D, inv_mass):
+    """The acceleration `(a_x, a_z, a_spin)` per row of `J` (..., 3, 3: edge +, edge -, the
+    pair across), from the active set whose solution is consistent (each active edge's
+    `J a <= aref`, each inactive one's `J a >= aref`); `D` per edge (the pair's doubled)."""
+    M = np.diag(1.0 / inv_mass)
+    best, violation = None, None
+    for active in _ACTIVE:
+        weights = D * active  # (..., 3)
+        H = M + np.einsum("...i,...ij,...ik->...jk", weights, J, J)
+        rhs = np.einsum("...i,...ij->...j", weights * aref, J)
+        a = np.linalg.solve(H, rhs[..., None])[..., 0]
+        jar = np.einsum("...ij,...j->...i", J, a) - aref
+        bad = np.where(active > 0, np.maximum(jar, 0.0), np.maximum(-jar, 0.0)).sum(-1)
+        if best is None:
+            best, violation = a, bad
+        else:
+            take = bad < violation
+            best = np.where(take[..., None], a, best)
+            violation = np.where(take, bad, violation)
+    return best
+
+
+def oblique_replica(solref, timestep, *, mu, radius, v_n, v_t, phases=_stepping.PHASES,
+                    impedance=SOLIMP[0], inertia=INERTIA):  # fmt: skip
+    """`(e, e_t, omega)` per start phase (the last axis; `v_n`, `v_t` arrays of one shape
+    before it): the normal restitution, the centre's tangential
+    restitution and the spin after (rad/s, positive rolling forward) of a free sphere of
+    radius `radius` (m) and moment of inertia `inertia m R^2` meeting a plane at normal
+    speed `v_n` and tangential speed `v_t` (m/s, no spin before) under MuJoCo's Euler step
+    `timestep` (s) with `solref` (either form; solimp `SOLIMP`), friction `mu`,
+    `condim="3"`, the pyramidal cone, impratio 1. The mass cancels (per unit mass)."""
+    h = float(timestep)
+    stiffness, damping = effective(solref, h)
+    d = impedance
+    K_d, B = stiffness / d, damping / d  # aref = -B (J v) - (K d) r
+    diag = 1.0 + mu**2  # mj_diagApprox, per unit mass
+    D = 1.0 / (2.0 * mu**2 * (1.0 - d) / d * diag)
+    D_rows = np.array([D, D, 2.0 * D])
+    inv_mass = np.array([1.0, 1.0, 1.0 / (inertia * radius**2)])
+    v_n = np.asarray(v_n, float)[..., None]  # (..., phase)
+    v_t = np.asarray(v_t, float)[..., None]
+    gap = v_n * h * np.asarray(phases, float)  # the distance at the first step (> 0: apart)
+    vel = np.stack(np.broadcast_arrays(v_t, -v_n, 0.0 * gap), -1)
+    started = np.zeros(gap.shape, bool)
+    done = np.zeros(gap.shape, bool)
+    for _ in range(10_000_000):
+        touching = gap < 0.0
+        lever = radius + 0.5 * np.minimum(gap, 0.0)
+        t = np.stack([np.ones_like(gap), np.zeros_like(gap), -lever], -1)
+        n = np.broadcast_to(np.array([0.0, 1.0, 0.0]), t.shape)
+        J = np.stack([n + mu * t, n - mu * t, n], -2)
+        aref = -B * np.einsum("...ij,...j->...i", J, vel) - K_d * gap[..., None]
+        a = np.where(touching[..., None], _edge_solve(J, aref, D_rows, inv_mass), 0.0)
+        live = ~done
+        vel = np.where(live[..., None], vel + h * a, vel)
+        gap = np.where(live, gap + h * vel[..., 1], gap)
+        started |= touching
+        done |= started & ~touching
+        if done.all():
+            return vel[..., 1] / v_n, vel[..., 0] / v_t, vel[..., 2]
+    raise RuntimeError("the replica did not finish the contact; the time step is far too small")
