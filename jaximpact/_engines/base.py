@@ -118,9 +118,9 @@ class AbstractEngine(abc.ABC):
     where the engine has that law itself (LAMMPS's `jkr`), else None;
     `with_tangential(parameters, tangential)`, the design's parameters with the tangential
     law set (for the laws of `TANGENTIAL`, or its friction for a `FRICTION` engine);
-    `check_tangential(tangential, radius)`, its refusal before any work; `oblique(parameters,
-    *, radius, v_n, v_t)`, the oblique impacts the engine's own stepping realises, where it
-    is replicated (else None: an export promises its continuous laws').
+    `check_tangential(tangential, radius=, timestep=)`, its refusal before any work;
+    `oblique(parameters, *, m, radius, v_n, v_t)`, the oblique impacts the engine realises
+    where it is replicated (else None: an export promises its continuous laws').
     """
 
     NAME: ClassVar[str]
@@ -136,14 +136,15 @@ class AbstractEngine(abc.ABC):
     TANGENTIAL: ClassVar[tuple[str, ...]] = ()
     FRICTION: ClassVar[str | None] = None
 
-    def check_tangential(self, tangential, radius) -> None:
+    def check_tangential(self, tangential, *, radius, timestep) -> None:
         """A one-line ValueError where the engine cannot take `tangential` (before any
-        work); `radius` (m) is the export's."""
+        work); `radius` (m) and `timestep` (s or None) are the export's."""
         self.with_tangential({}, tangential)
 
-    def oblique(self, parameters: dict, *, radius: float, v_n, v_t):
+    def oblique(self, parameters: dict, *, m: float, radius: float, v_n, v_t):
         """`(e, e_t, omega)` per first-touch phase (rad/s for the spin) that the engine's
-        own time stepping realises with `parameters` for a sphere of radius `radius` (m)
+        own time stepping realises with `parameters` for a sphere of mass `m` (kg) and
+        radius `radius` (m)
         meeting its plane at `v_n`, `v_t` (m/s, arrays of one shape, no spin before), or
         None where it is not replicated."""
         return None

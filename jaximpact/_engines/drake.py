@@ -146,6 +146,43 @@ class Drake(AbstractEngine):
         "replicated; the continuous plant (time_step = 0) has no step error"
     )
     CONTINUOUS_PLANT = True
+    FRICTION = (
+        "Drake has no tangential spring: a tangential law goes as its Coulomb mu alone "
+        "(static = dynamic), regularised by Drake's Stribeck curve below the stiction "
+        "tolerance, in the continuous plant"
+    )
+
+    def check_tangential(self, tangential, *, radius, timestep):
+        """Drake takes any tangential law's `mu` on its continuous plant; the sphere's
+        radius is needed."""
+        if radius is None:
+            raise ValueError(
+                "drake with a tangential law needs the sphere's radius (its friction's lever "
+                "arm and inertia): pass radius= (m)"
+            )
+        if timestep:
+            raise ValueError(
+                "drake's friction is exported for its continuous plant only (a discrete "
+                "plant's friction is not replicated here): leave timestep unset"
+            )
+
+    def with_tangential(self, parameters, tangential):
+        """`parameters` with Coulomb's `mu` of `tangential` as static and dynamic friction
+        of both geometries, and Drake's default stiction tolerance (drake_friction.py)."""
+        from .drake_friction import STICTION_TOLERANCE
+
+        mu = float(tangential.params["mu"])
+        return dict(parameters, friction=[mu, mu], stiction_tolerance=STICTION_TOLERANCE)
+
+    def oblique(self, parameters, *, m, radius, v_n, v_t):
+        """The continuous plant's oblique impact with the exported friction, integrated
+        (drake_friction.py)."""
+        from .drake_friction import oblique_replica
+
+        return oblique_replica(k=parameters["point_contact_stiffness"],
+                               d=parameters["hunt_crossley_dissipation"], m=m, radius=radius,
+                               mu=parameters["friction"][0], v_n=v_n, v_t=v_t,
+                               stiction=parameters["stiction_tolerance"])  # fmt: skip
 
     def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
                limit_damping=False, geometry=None) -> Design:  # fmt: skip
@@ -226,11 +263,17 @@ class Drake(AbstractEngine):
 
     def snippet(self, parameters) -> str:
         per = parameters["per_geometry"]
+        friction, tolerance = "", ""
+        if "friction" in parameters:
+            mu_s, mu_d = parameters["friction"]
+            friction = f"friction=CoulombFriction({mu_s!r}, {mu_d!r}), "
+            tolerance = f"plant.set_stiction_tolerance({parameters['stiction_tolerance']!r})\n"
         return (
             "from pydrake.geometry import AddContactMaterial, ProximityProperties\n"
-            "props = ProximityProperties()\n"
+            + ("from pydrake.multibody.plant import CoulombFriction\n" if friction else "")
+            + "props = ProximityProperties()\n"
             f"AddContactMaterial(dissipation={per['hunt_crossley_dissipation']!r}, "
-            f"point_stiffness={per['point_contact_stiffness']!r}, properties=props)\n"
+            f"point_stiffness={per['point_contact_stiffness']!r}, {friction}properties=props)\n"
             "# give these props to BOTH geometries in contact (they combine in series)\n"
             f"plant = MultibodyPlant(time_step={parameters['time_step']!r})"
             + (
@@ -240,4 +283,5 @@ class Drake(AbstractEngine):
                 "DiscreteContactApproximation.kLagged)  # not kSap\n"
             )
             + "plant.set_contact_model(ContactModel.kPoint)"
+            + (f"\n{tolerance}" if tolerance else "")
         )

@@ -99,7 +99,8 @@ class Export:
       `angles` (degrees from the normal) the tangential restitution `e_t_engine`, the
       spin after `omega_engine` (rad/s) and the normal restitution `e_n_engine` that the
       engine realises, no spin before: MuJoCo's Euler step replicated (the mean over
-      first-touch phases; equal to MuJoCo to round-off, tests/engines), else the engine's
+      first-touch phases; equal to MuJoCo to round-off, tests/engines), Drake's continuous
+      plant integrated (scipy's Radau at rtol 1e-10; equal to Drake to 1e-8), else the engine's
       continuous laws (LAMMPS: the real LAMMPS on a wall within 0.002 at the recommended
       step, two spheres within 0.01, whose line of centres turns during contact); and
       `e_t_target`, the given law's with `tangential` (None from targets).
@@ -226,7 +227,8 @@ def export(
     to an engine that has it exactly (`AbstractEngine.TANGENTIAL`: LAMMPS's
     `linear_history`, `mindlin`, `mindlin/force`), or as its friction `mu` alone to an
     engine with friction and no tangential spring (`AbstractEngine.FRICTION`: MuJoCo's
-    pyramidal cone, `radius` needed; a warning says how far its e_t and normal e fall);
+    pyramidal cone; Drake's Stribeck-regularised Coulomb friction, continuous plant only;
+    `radius` needed; a warning says how far its e_t falls and how its normal e moves);
     the `Export` then also holds the oblique impacts the engine realises at `v0` from
     `OBLIQUE_ANGLES` (degrees from the normal): `e_t_engine`, `omega_engine` (rad/s),
     `e_n_engine`, and the law's `e_t_target`. Another engine: a one-line ValueError.
@@ -260,7 +262,7 @@ def export(
     options = dict(m=m, v0=v0, radius=radius, poisson=0.3 if poisson is None else poisson,
                    limit_damping=limit_damping, geometry=geometry)  # fmt: skip
     if tangential is not None:  # refused before any work by an engine without it
-        chosen.check_tangential(tangential, radius)
+        chosen.check_tangential(tangential, radius=radius, timestep=timestep)
     out = chosen.design(target_e, target_T, timestep=timestep, **options)
     if out.target_T is not None:  # MuJoCo without T: its default timeconst's
         target_T = out.target_T
@@ -353,7 +355,7 @@ def _oblique_promise(chosen, parameters, engine_law, separation, tangential, sou
             np.array([[float(getattr(r, k)) for r in rows] for k in ("e", "e_t", "omega_out")])
         )
 
-    stepped = chosen.oblique(parameters, radius=radius, v_n=v_n, v_t=v_t)
+    stepped = chosen.oblique(parameters, m=m, radius=radius, v_n=v_n, v_t=v_t)
     if stepped is None:
         e_n, e_t, omega = continuous(engine_law)
     else:

@@ -158,7 +158,7 @@ class Mujoco(AbstractEngine):
         "so a nearly elastic contact (low dampratio) barely slows it"
     )
 
-    def check_tangential(self, tangential, radius):
+    def check_tangential(self, tangential, *, radius, timestep):
         """MuJoCo takes any tangential law's `mu`; the sphere's radius is needed."""
         if radius is None:
             raise ValueError(
@@ -181,7 +181,7 @@ class Mujoco(AbstractEngine):
             out["cone_factor"] = head_on_factor(mu)
         return out
 
-    def oblique(self, parameters, *, radius, v_n, v_t):
+    def oblique(self, parameters, *, m, radius, v_n, v_t):
         """MuJoCo's Euler step on the sphere with the exported friction (mujoco_friction.py);
         without friction the normal replica, the tangential speed and spin unchanged."""
         from .mujoco_friction import oblique_replica

