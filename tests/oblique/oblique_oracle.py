@@ -24,12 +24,18 @@ from scipy.integrate import solve_ivp
 
 
 def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_star=None,
-                   history="displacement", beta=0.0, rtol=1e-12, max_switches=40):  # fmt: skip
+                   history="displacement", beta=0.0, rtol=1e-12, max_switches=40,
+                   midpoint=False):  # fmt: skip
     """Returns dict(e, v_t_out, omega_out, T, switches). `beta` (Mindlin only): the damper
     `2 (5/6)^0.5 beta (m k_t)^0.5` on the slip while sticking, left out of Coulomb's test
-    (LIGGGHTS' convention), so the switches are the undamped ones' formulas."""
+    (LIGGGHTS' convention), so the switches are the undamped ones' formulas. `midpoint`:
+    the tangential force acts halfway through the overlap `x`, lever arm `R - x/2` in the
+    slip and the torque (else `R`)."""
     moment = inertia * m * R**2
     mindlin = G_star is not None
+
+    def lever(x):
+        return R - 0.5 * max(x, 0.0) if midpoint else R
 
     def damper(x):
         xp = max(x, 0.0)
@@ -63,18 +69,18 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
         f, _ = normal(x, v)
         if mode == "slip":
             return -s * mu * abs(f)
-        return spring(state) - damper(x) * (vt - R * w)
+        return spring(state) - damper(x) * (vt - lever(x) * w)
 
     def rhs(t, state, mode, s):
         x, v, q, vt, w = state
         f, _ = normal(x, v)
         ft = force_t(state, mode, s)
-        u = vt - R * w
+        u = vt - lever(x) * w
         k, _ = stiffness(x, v)
         dq = 0.0
         if mode == "stick":
             dq = u if history == "displacement" else -k * u
-        return [v, -f / m, dq, ft / m, -R * ft / moment]
+        return [v, -f / m, dq, ft / m, -lever(x) * ft / moment]
 
     def held(state, s):
         x, v, q, vt, w = state
@@ -90,7 +96,7 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
         x, v, q, vt, w = state
         f, df = normal(x, v)
         k, dk = stiffness(x, v)
-        u = vt - R * w
+        u = vt - lever(x) * w
         if k == 0:  # outside the surface (scipy's last trial points): no contact
             return 1.0
         if history == "displacement":
