@@ -110,6 +110,9 @@ class AbstractEngine(abc.ABC):
 
     - `TANGENTIAL` (optional, default none): the tangential laws (`tangential_law` names)
       the engine takes exactly, with `with_tangential`.
+    - `CONTACT_POINT` (optional, default `"surface"`): where its tangential force acts,
+      as `oblique_impact(contact_point=)` takes it (`"midpoint"`: halfway through the
+      overlap, lever arm `R - x/2`).
     - `FRICTION` (optional, default None): where the engine has no tangential law of
       jaximpact's but friction alone, what it makes of a tangential law (its nearest), in
       words; `with_tangential` then takes any tangential law's `mu`.
@@ -119,6 +122,9 @@ class AbstractEngine(abc.ABC):
     `with_tangential(parameters, tangential)`, the design's parameters with the tangential
     law set (for the laws of `TANGENTIAL`, or its friction for a `FRICTION` engine);
     `check_tangential(tangential, radius=, timestep=)`, its refusal before any work;
+    `tangential_options(design, tangential, options)`, the design options its tangential
+    law needs; `realised_tangential(parameters, tangential)`, the tangential law it realises;
+    and `tangential_changes(parameters, tangential)`, how it differs, in words;
     `oblique(parameters, *, m, radius, v_n, v_t)`, the oblique impacts the engine realises
     where it is replicated (else None: an export promises its continuous laws').
     """
@@ -135,11 +141,30 @@ class AbstractEngine(abc.ABC):
     NEAREST: ClassVar[str | None] = None
     TANGENTIAL: ClassVar[tuple[str, ...]] = ()
     FRICTION: ClassVar[str | None] = None
+    CONTACT_POINT: ClassVar[str] = "surface"
 
     def check_tangential(self, tangential, *, radius, timestep) -> None:
         """A one-line ValueError where the engine cannot take `tangential` (before any
         work); `radius` (m) and `timestep` (s or None) are the export's."""
         self.with_tangential({}, tangential)
+
+    def tangential_options(self, design: "Design", tangential, options: dict) -> dict:
+        """The design `options` (`poisson`, ...) with which the engine's tangential law,
+        tied to its normal contact, realises `tangential`, given a first `design`; an
+        export designs again with them where they differ. Default: `options`."""
+        return options
+
+    def tangential_changes(self, parameters: dict, tangential) -> list[str]:
+        """What the engine changes with `parameters` exported for `tangential`: where the
+        law it realises differs from `tangential`, and what of the normal design it set
+        anew, in words (an empty list where nothing)."""
+        return []
+
+    def realised_tangential(self, parameters: dict, tangential):
+        """The tangential law (a jaximpact one) the engine realises with `parameters`
+        exported for `tangential`: `tangential` itself unless the engine ties its tangential
+        spring or damper to other parameters (LIGGGHTS)."""
+        return tangential
 
     def oblique(self, parameters: dict, *, m: float, radius: float, v_n, v_t):
         """`(e, e_t, omega)` per first-touch phase (rad/s for the spin) that the engine's
@@ -154,7 +179,7 @@ class AbstractEngine(abc.ABC):
         one-line ValueError for a law the engine does not take."""
         raise ValueError(
             f"{self.LABEL} has no tangential export yet (the normal law is exported alone); "
-            "export tangential laws to lammps or mujoco"
+            "export tangential laws to lammps, liggghts, mujoco or drake"
         )
 
     def native(self, law) -> "AbstractEngine | None":

@@ -264,6 +264,11 @@ def export(
     if tangential is not None:  # refused before any work by an engine without it
         chosen.check_tangential(tangential, radius=radius, timestep=timestep)
     out = chosen.design(target_e, target_T, timestep=timestep, **options)
+    if tangential is not None:  # an engine whose tangential law ties to its normal options
+        tied = chosen.tangential_options(out, tangential, options)
+        if tied != options:
+            options = tied
+            out = chosen.design(target_e, target_T, timestep=timestep, **options)
     if out.target_T is not None:  # MuJoCo without T: its default timeconst's
         target_T = out.target_T
     warnings = list(out.warnings)
@@ -297,8 +302,13 @@ def export(
         oblique = _oblique_promise(chosen, parameters, engine_law, out.separation, tangential,
                                    source, m=m, v0=v0, radius=radius,
                                    geometry=geometry)  # fmt: skip
+        warnings += chosen.tangential_changes(parameters, tangential)
         if chosen.FRICTION is not None:
             warnings.append(_friction_note(chosen, tangential, oblique))
+        elif source is not None and not _same_law(
+            chosen.realised_tangential(parameters, tangential), tangential
+        ):
+            warnings.append(_departure(oblique))
     return Export(
         engine=engine,
         scene=chosen.SCENES[geometry],
@@ -345,11 +355,12 @@ def _oblique_promise(chosen, parameters, engine_law, separation, tangential, sou
         scene = dict(m=m, R=radius, inertia=0.4)
     v_n, v_t = (np.asarray(v, float) for v in incidence(v0, np.deg2rad(OBLIQUE_ANGLES)))
 
-    def continuous(normal_law):
+    def continuous(normal_law, tangential_law, contact_point="surface"):
         # a soft spring sticks and slips many times (throw=False: a solve that still
         # fails is NaN in the promise, not an error of the export)
-        rows = [oblique_impact(normal_law, tangential, **scene, v_n=float(a), v_t=float(b),
-                               separation=separation, max_segments=64, throw=False)
+        rows = [oblique_impact(normal_law, tangential_law, **scene, v_n=float(a), v_t=float(b),
+                               separation=separation, contact_point=contact_point,
+                               max_segments=64, throw=False)
                 for a, b in zip(v_n, v_t, strict=True)]  # fmt: skip
         return tuple(
             np.array([[float(getattr(r, k)) for r in rows] for k in ("e", "e_t", "omega_out")])
@@ -357,10 +368,11 @@ def _oblique_promise(chosen, parameters, engine_law, separation, tangential, sou
 
     stepped = chosen.oblique(parameters, m=m, radius=radius, v_n=v_n, v_t=v_t)
     if stepped is None:
-        e_n, e_t, omega = continuous(engine_law)
+        realised = chosen.realised_tangential(parameters, tangential)
+        e_n, e_t, omega = continuous(engine_law, realised, chosen.CONTACT_POINT)
     else:
         e_n, e_t, omega = (np.asarray(a).mean(axis=-1) for a in stepped)
-    target = None if source is None else tuple(float(v) for v in continuous(source)[1])
+    target = None if source is None else tuple(map(float, continuous(source, tangential)[1]))
     return dict(tangential=tangential, angles=OBLIQUE_ANGLES, e_t_engine=tuple(map(float, e_t)),
                 omega_engine=tuple(map(float, omega)), e_n_engine=tuple(map(float, e_n)),
                 e_t_target=target)  # fmt: skip
@@ -378,12 +390,28 @@ def _friction_note(chosen, tangential, oblique) -> str:
         f"runs {e_n.min():.4g} to {e_n.max():.4g}"
     )
     if oblique["e_t_target"] is not None:
-        gap = np.abs(np.asarray(oblique["e_t_engine"]) - np.asarray(oblique["e_t_target"]))
-        k = int(np.nanargmax(gap))
-        note += (
-            f", and its e_t departs from the law's by up to {gap[k]:.3g} (at {angles[k]:g} degrees)"
-        )
+        note += ", and " + _departure(oblique)
     return note
+
+
+def _same_law(a, b) -> bool:
+    """Whether the tangential laws `a` and `b` are one (name, parameters to 1e-9)."""
+    import math
+
+    if a.name != b.name or set(a.params) != set(b.params):
+        return False
+    return all(math.isclose(float(a.params[k]), float(b.params[k]), rel_tol=1e-9,
+                            abs_tol=1e-300) for k in a.params)  # fmt: skip
+
+
+def _departure(oblique) -> str:
+    """How far the engine's e_t falls from the law's over the angles, in words."""
+    import numpy as np
+
+    gap = np.abs(np.asarray(oblique["e_t_engine"]) - np.asarray(oblique["e_t_target"]))
+    k = int(np.nanargmax(gap))
+    angle = oblique["angles"][k]
+    return f"its e_t departs from the law's by up to {gap[k]:.3g} (at {angle:g} degrees)"
 
 
 def _inputs(chosen: AbstractEngine, law_or_fit, m, v0, timestep, poisson):

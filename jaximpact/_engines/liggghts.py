@@ -25,6 +25,9 @@ from . import lammps
 from .base import AbstractEngine, Design, Stepping
 
 MIN_COEFFICIENT = 0.05  # createCoeffRest: "0.05 < coefficientRestitution <= 1 required"
+# the values of LAMMPS's design a LIGGGHTS export keeps (and of liggghts_tangential.design)
+_DESIGN_KEYS = ("timestep", "timestep_s", "youngs_modulus", "coeff_restitution", "poisson", "k",
+                "b", "friction", "G_star", "tangential_beta", "tangential_damping")  # fmt: skip
 _LAMMPS = lammps.Lammps()  # the same contact, design and stepping, in other words
 
 
@@ -41,8 +44,12 @@ def particle_range_line(youngs_modulus: float) -> str | None:
 def _parameters(p: dict, limit_damping: bool, extra: str | None, wall: bool) -> dict:
     """LAMMPS's design parameters `p` in LIGGGHTS's words: `fix property/global` lines for
     the material, `pair_style gran model hertz`, `limitForce` for `limit_damping`, the
-    sanity-range line `extra`, and with `wall` the primitive wall z = 0."""
+    sanity-range line `extra`, and with `wall` the primitive wall z = 0; with `p`'s
+    `friction` (liggghts_tangential.design) its coefficientFriction and, for an undamped
+    tangential law, `tangential_damping off`."""
     limit = " limitForce on" if limit_damping else ""
+    if p.get("friction") is not None and not p["tangential_damping"]:
+        limit += " tangential_damping off"
     parameters = {
         "pair_style": "pair_style gran model hertz tangential history" + limit,
         "pair_coeff": "pair_coeff * *",
@@ -56,12 +63,12 @@ def _parameters(p: dict, limit_damping: bool, extra: str | None, wall: bool) -> 
             "fix m3 all property/global coefficientRestitution peratomtypepair 1 "
             f"{p['coeff_restitution']:.10g}"
         ),
-        "coefficientFriction": "fix m4 all property/global coefficientFriction peratomtypepair 1 0",
+        "coefficientFriction": (
+            "fix m4 all property/global coefficientFriction peratomtypepair 1 "
+            f"{p.get('friction') or 0:.10g}"
+        ),
         "timestep": p["timestep"],
-        **{
-            k: p[k]
-            for k in ("timestep_s", "youngs_modulus", "coeff_restitution", "poisson", "k", "b")
-        },
+        **{k: p[k] for k in _DESIGN_KEYS if k in p},
         "limitForce": limit_damping,
         "units": "units si",
         "particle_range": extra,
@@ -94,6 +101,54 @@ class Liggghts(AbstractEngine):
     LAW = lammps.Lammps.LAW
     STEPPING = lammps.Lammps.STEPPING  # fix nve/sphere: the same velocity Verlet
     CONTINUOUS_PLANT = False
+    TANGENTIAL = ("mindlin",)
+    CONTACT_POINT = "midpoint"  # surface_model_default.h: cri = radi - 0.5 deltan
+
+    def check_tangential(self, tangential, *, radius, timestep):
+        """LIGGGHTS's `tangential history` is Mindlin's displacement-history spring."""
+        if tangential.name not in self.TANGENTIAL:
+            raise ValueError(
+                "LIGGGHTS's tangential history is Mindlin's spring with displacement history "
+                f"(k_t = 8 G* (R x)^0.5), not {tangential.name!r}: export a mindlin law"
+            )
+
+    def tangential_options(self, design, tangential, options):
+        """The Poisson's ratio at which LIGGGHTS's G* is the law's (liggghts_tangential.py)."""
+        from .liggghts_tangential import tied_poisson
+
+        return dict(options, poisson=tied_poisson(design.parameters, tangential))
+
+    def with_tangential(self, parameters, tangential):
+        """`parameters` (designed at `tangential_options`' Poisson's ratio) with `tangential`
+        (a `mindlin` law) as LIGGGHTS's tangential history: its friction, the damper on or
+        off (liggghts_tangential.py)."""
+        from .liggghts_tangential import tangential_values
+
+        self.check_tangential(tangential, radius=None, timestep=None)
+        p = tangential_values({k: parameters[k] for k in _DESIGN_KEYS if k in parameters},
+                              tangential)  # fmt: skip
+        return _parameters(p, parameters["limitForce"], parameters["particle_range"],
+                           "fix_wall" in parameters)  # fmt: skip
+
+    def tangential_changes(self, parameters, tangential):
+        """Poisson's ratio set for G*, and where LIGGGHTS's `mindlin` law is the nearest."""
+        from .liggghts_tangential import differences
+
+        out = [
+            f"LIGGGHTS's G* comes from E and nu: poissonsRatio {parameters['poisson']:.6g} "
+            f"(youngsModulus {parameters['youngs_modulus']:.6g} Pa) gives the tangential "
+            "law's G* with the normal contact's Y*"
+        ]
+        changed = differences(parameters, tangential)
+        if changed:
+            out.append("LIGGGHTS realises the nearest mindlin law: " + "; ".join(changed))
+        return out
+
+    def realised_tangential(self, parameters, tangential):
+        """The `mindlin` law LIGGGHTS realises (its G* and damper tied to E, nu, e)."""
+        from .liggghts_tangential import realised
+
+        return realised(parameters, tangential)
 
     def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
                limit_damping=False, geometry=None) -> Design:  # fmt: skip

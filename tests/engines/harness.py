@@ -456,6 +456,63 @@ run {steps}
     return np.array(es), np.array(Ts)
 
 
+def run_liggghts_oblique(parameters, *, m, radius, v_n, v_t, executable="liggghts"):
+    """Run LIGGGHTS on a wall export with a tangential law: one sphere (mass `m` kg, radius
+    `radius` m, no spin) hitting the exported primitive wall (z = 0) at normal speed `v_n`
+    and tangential speed `v_t` along x (m/s), first touch half a step away. Returns
+    `(e, e_t, omega)`: the normal and tangential restitution and the spin after about y
+    (rad/s; positive where it rolls the sphere along +x)."""
+    h = parameters["timestep_s"]
+    rho = m / (4.0 / 3.0 * math.pi * radius**3)
+    gap = v_n * h * 0.5
+    steps = int(4 * radius / v_n / h) + 10
+    box = 10 * radius + 4 * radius * abs(v_t) / v_n  # the sphere stays inside
+    script = f"""atom_style granular
+atom_modify map array
+boundary f f f
+newton off
+communicate single vel yes
+units si
+{parameters.get("particle_range") or ""}
+region box block {-box!r} {box!r} {-box!r} {box!r} {-box!r} {box!r} units box
+create_box 1 box
+neighbor {0.5 * radius!r} bin
+neigh_modify delay 0
+{parameters["youngsModulus"]}
+{parameters["poissonsRatio"]}
+{parameters["coefficientRestitution"]}
+{parameters["coefficientFriction"]}
+{parameters["pair_style"]}
+{parameters["pair_coeff"]}
+{parameters["timestep"]}
+{parameters["fix_wall"]}
+create_atoms 1 single 0 0 {radius + gap!r} units box
+set atom 1 diameter {2 * radius!r} density {rho!r} vx {v_t!r} vy 0 vz {-v_n!r}
+fix integr all nve/sphere
+variable vx equal vx[1]
+variable vz equal vz[1]
+variable wy equal omegay[1]
+variable m1 equal mass[1]
+fix out all print 1 "${{vx}} ${{vz}} ${{wy}} ${{m1}}" file out.txt screen no
+run {steps}
+"""
+    with tempfile.TemporaryDirectory() as folder:
+        with open(os.path.join(folder, "in.oblique"), "w") as handle:
+            handle.write(script)
+        run = subprocess.run(
+            [executable, "-in", "in.oblique", "-log", "none", "-screen", "none"],
+            cwd=folder, capture_output=True, text=True, timeout=600,
+        )  # fmt: skip
+        path = os.path.join(folder, "out.txt")
+        if not os.path.exists(path):
+            raise RuntimeError(f"LIGGGHTS gave no output: {run.stdout[-400:]}{run.stderr}")
+        rows = np.loadtxt(path, comments="#", ndmin=2)
+    if abs(rows[0, 3] / m - 1) > 1e-9:
+        raise RuntimeError(f"LIGGGHTS's sphere has mass {rows[0, 3]}, not {m}")
+    vx, vz, wy = rows[-1, :3]
+    return vz / v_n, vx / v_t, wy
+
+
 _SCRIPT = """
 import sys
 from yade import utils
