@@ -110,9 +110,9 @@ class AbstractEngine(abc.ABC):
 
     - `TANGENTIAL` (optional, default none): the tangential laws (`tangential_law` names)
       the engine takes exactly, with `with_tangential`.
-    - `CONTACT_POINT` (optional, default `"surface"`): where its tangential force acts,
-      as `oblique_impact(contact_point=)` takes it (`"midpoint"`: halfway through the
-      overlap, lever arm `R - x/2`).
+    - `CONTACT_POINT` (optional, default on the undeformed surface): where its tangential
+      force acts, by scene, as the share `f` of the overlap off each sphere's lever arm
+      `R - f x` (`oblique_impact(contact_point=)`; 0.5: halfway through the overlap).
     - `FRICTION` (optional, default None): where the engine has no tangential law of
       jaximpact's but friction alone, what it makes of a tangential law (its nearest), in
       words; `with_tangential` then takes any tangential law's `mu`.
@@ -141,7 +141,7 @@ class AbstractEngine(abc.ABC):
     NEAREST: ClassVar[str | None] = None
     TANGENTIAL: ClassVar[tuple[str, ...]] = ()
     FRICTION: ClassVar[str | None] = None
-    CONTACT_POINT: ClassVar[str] = "surface"
+    CONTACT_POINT: ClassVar[Mapping[str, float]] = {"wall": 0.0, "spheres": 0.0}
 
     def check_tangential(self, tangential, *, radius, timestep) -> None:
         """A one-line ValueError where the engine cannot take `tangential` (before any
@@ -179,7 +179,7 @@ class AbstractEngine(abc.ABC):
         one-line ValueError for a law the engine does not take."""
         raise ValueError(
             f"{self.LABEL} has no tangential export yet (the normal law is exported alone); "
-            "export tangential laws to lammps, liggghts, mujoco or drake"
+            "export tangential laws to lammps, liggghts, yade, mujoco or drake"
         )
 
     def native(self, law) -> "AbstractEngine | None":

@@ -102,7 +102,8 @@ class Liggghts(AbstractEngine):
     STEPPING = lammps.Lammps.STEPPING  # fix nve/sphere: the same velocity Verlet
     CONTINUOUS_PLANT = False
     TANGENTIAL = ("mindlin",)
-    CONTACT_POINT = "midpoint"  # surface_model_default.h: cri = radi - 0.5 deltan
+    # surface_model_default.h: cri = radi - 0.5 deltan, on a wall and between spheres
+    CONTACT_POINT = {"wall": 0.5, "spheres": 0.5}
 
     def check_tangential(self, tangential, *, radius, timestep):
         """LIGGGHTS's `tangential history` is Mindlin's displacement-history spring."""

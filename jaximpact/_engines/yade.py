@@ -23,6 +23,18 @@ non-viscous damping `a *= 1 - damping sign(a (v + dt a/2))` (`cundallDamp2nd`), 
 report in the issue). The snippet sets `damping=0`; `replica` models any value.
 Pitfall: a sphere on a wall or facet of mass 0 gets `massR = m/2` (Yade copies the other
 body's mass), not `m`: then `tc` is sqrt(2) too long and the damping ratio 1/sqrt(2) too low.
+
+Tangential (`computeForceTorqueViscEl`): the elastic shear force grows by `ks dt v_s` (`v_s`
+the slip of the contact point), is tested alone against `tan(frictionAngle) |F_n|` (the
+clamped normal force) and rescaled to it while sliding; the damper `cs v_s` is added only
+while sticking. The contact point is halfway through the overlap (ScGeom's `contactPoint`),
+so the lever arm is `R - x/2`. With `ks` constant this is jaximpact's `linear_history`
+(`kt = ks`, `ct = 0`; a damper outside Coulomb's test is not `linear_history`'s `ct`, so
+`ct > 0` is refused), with `contact_point="midpoint"`. Pournin's `et` ties `ks` and `cs`
+to `tc` (`ks = 2/7 massR (pi^2 + ln^2 et)/tc^2`), so a tangential export gives ViscElMat its
+explicit `kn`, `cn`, `ks`, `cs` instead (`Calculate_ViscElMat_ViscElMat_ViscElPhys`: each
+material's value, two equal ones in series: twice the contact's), `kn`, `cn` those `tc`,
+`en` give: the normal contact is unchanged.
 """
 
 import math
@@ -128,6 +140,38 @@ class Yade(AbstractEngine):
         "here): replicated"
     )
     CONTINUOUS_PLANT = False
+    TANGENTIAL = ("linear_history",)
+    # ScGeom's contactPoint: halfway through the overlap between spheres
+    # (Ig2_Sphere_Sphere_ScGeom), the sphere's centre projected on a wall (Ig2_Wall_Sphere)
+    CONTACT_POINT = {"wall": 1.0, "spheres": 0.5}
+
+    def check_tangential(self, tangential, *, radius, timestep):
+        """Yade's ViscElMat shear is a constant spring without a damper in Coulomb's test."""
+        if tangential.name not in self.TANGENTIAL:
+            raise ValueError(
+                "Yade's ViscElMat shear is a constant spring (ks), not "
+                f"{tangential.name!r}: export a linear_history law"
+            )
+        ct = float(tangential.params.get("ct", 0.0))
+        if ct != 0.0:
+            raise ValueError(
+                "Yade adds its shear damper cs outside Coulomb's test, not as "
+                f"linear_history's ct = {ct:g} N s/m (inside it): export with ct=0"
+            )
+
+    def with_tangential(self, parameters, tangential):
+        """`parameters` with ViscElMat's explicit `kn`, `cn` (the design's) and `ks` = kt,
+        `cs` = 0, `frictionAngle` = atan(mu), each material's value twice the contact's
+        (two equal ones in series)."""
+        self.check_tangential(tangential, radius=None, timestep=None)
+        kt, mu = float(tangential.params["kt"]), float(tangential.params["mu"])
+        angle = math.atan(mu)
+        material = (
+            f"ViscElMat(kn={2.0 * parameters['kn']!r}, cn={2.0 * parameters['cn']!r}, "
+            f"ks={2.0 * kt!r}, cs=0.0, density={parameters['density']!r}, "
+            f"frictionAngle={angle!r})"
+        )
+        return dict(parameters, ks=kt, frictionAngle=angle, material=material)
 
     def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
                limit_damping=False, geometry=None) -> Design:  # fmt: skip

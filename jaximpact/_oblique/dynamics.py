@@ -10,9 +10,9 @@ velocity `U_c = v_t / v_n` and the spin `W = R omega / v_n`; the contact point s
     U_c' = F_t,    W' = -(m R^2 / I) F_t,    so    U' = (1 + m R^2 / I) F_t,
 
 (`m v_t' = F_t`, `I omega' = -R F_t` in the sign convention of DESIGN.md). With the
-contact point halfway through the overlap (`contact_point="midpoint"`, as LIGGGHTS, MuJoCo
-and Drake place it) the lever arm is `R - x/2`: `U = U_c - (1 - h X) W` and
-`W' = -(m R^2 / I) (1 - h X) F_t`, `h = x* / (2 R)` (`half_overlap`). While the
+contact point inside the overlap (`oblique_impact(contact_point=)`: LIGGGHTS, MuJoCo and
+Drake place it halfway) the lever arm is `R - f x`: `U = U_c - (1 - h X) W` and
+`W' = -(m R^2 / I) (1 - h X) F_t`, `h = f x* / R` (`lever_loss`). While the
 contact sticks, `F_t` is the spring's trial force and `Q` follows the slip; while it
 slides in the sense `s` (+1: the contact point moves forward), `F_t = -s mu |F_n|` and the
 spring is held at the limit (`Q` is not integrated: it is set from the limit where sliding
@@ -36,7 +36,7 @@ class ObliqueDynamics(eqx.Module):
     normal: AbstractDynamics
     tangential: TangentialDynamics
     size: int = eqx.field(static=True)  # the normal state's length
-    half_overlap: object = None  # `x* / (2 R)` with the contact point at mid-overlap
+    lever_loss: object = None  # `f x* / R`: the lever arm `R - f x` (None: R)
 
     def parts(self, y):
         """`(normal state, Q, U_c, W)`."""
@@ -44,11 +44,11 @@ class ObliqueDynamics(eqx.Module):
 
     def lever(self, y):
         """The lever arm of the tangential force about the centre, in units of `R`: 1, or
-        `1 - x/(2R)` with the contact point at mid-overlap."""
-        if self.half_overlap is None:
+        `1 - f x / R` with the contact point inside the overlap."""
+        if self.lever_loss is None:
             return 1.0
         overlap = jnp.maximum(self.normal.position(y[: self.size]), 0.0)
-        return 1.0 - self.half_overlap * overlap
+        return 1.0 - self.lever_loss * overlap
 
     def slip(self, y):
         """`U = U_c - lever W`, the contact point's velocity over the surface (units of

@@ -26,9 +26,35 @@ from .roots import BracketedNewton
 from .tangential import AbstractTangentialLaw
 
 SEPARATIONS = ("force", "penetration")
-# where the tangential force acts: on the undeformed surface (lever arm R) or halfway
-# through the overlap (R - x/2: LIGGGHTS, MuJoCo, Drake)
-CONTACT_POINTS = ("surface", "midpoint")
+# where the tangential force acts, as the share f of the overlap x taken off the lever arm
+# R - f x: the undeformed surface (LAMMPS), halfway through the overlap (LIGGGHTS, MuJoCo,
+# Drake, Yade between spheres), the plane's surface (Yade's wall)
+CONTACT_POINTS = {"surface": 0.0, "midpoint": 0.5, "plane": 1.0}
+
+
+def lever_share(contact_point) -> float:
+    """The share `f` of the overlap off the lever arm `R - f x` for `contact_point` (a name
+    of `CONTACT_POINTS` or a number in [0, 1]), or a one-line ValueError."""
+    if isinstance(contact_point, str):
+        if contact_point not in CONTACT_POINTS:
+            names = ", ".join(map(repr, CONTACT_POINTS))
+            raise ValueError(
+                f"contact_point must be one of {names} or a number f in [0, 1] (the lever "
+                f"arm R - f x), got {contact_point!r}"
+            )
+        return CONTACT_POINTS[contact_point]
+    try:
+        share = float(contact_point)
+    except (TypeError, ValueError):
+        share = math.nan
+    if not 0.0 <= share <= 1.0:
+        raise ValueError(
+            "contact_point must be one of 'surface', 'midpoint', 'plane' or a number f in "
+            f"[0, 1] (the lever arm R - f x), got {contact_point!r}"
+        )
+    return share
+
+
 # the time (units of t*) after first touch at which the first-touch mode is decided
 # (`_first_mode`): limit and trial force grow as powers of the time there
 FIRST_TOUCH = 1e-6
@@ -52,7 +78,7 @@ class ObliqueOptions(eqx.Module):
     tau_max: float = eqx.field(static=True)
     rest_tol: float = eqx.field(static=True)
     land: bool = eqx.field(static=True, default=False)
-    contact_point: str = eqx.field(static=True, default="surface")
+    lever_share: float = eqx.field(static=True, default=0.0)
 
 
 def _conditions(dyn: ObliqueDynamics, separation: str, rest_tol: float):
@@ -378,9 +404,9 @@ def solve_oblique(law, tangential, m, R, v_n, v_t, omega, inertia, g, options: O
     normal = law.dynamics(m=m, v0=v_n, g=g)
     spring = tangential.dynamics(m=m, R=R, inertia=inertia, x_star=normal.x_star, v_n=v_n)
     y_n0 = normal.y0()
-    half = normal.x_star / (2.0 * R) if options.contact_point == "midpoint" else None
+    loss = options.lever_share * normal.x_star / R if options.lever_share else None
     dyn = ObliqueDynamics(normal=normal, tangential=spring, size=int(y_n0.shape[0]),
-                          half_overlap=half)  # fmt: skip
+                          lever_loss=loss)  # fmt: skip
     y0 = jnp.concatenate([y_n0, jnp.stack([jnp.zeros(()), v_t / v_n, R * omega / v_n])])
     y, tau, status, switches, steps = _segments(dyn, y0, options)
     y_n = y[: dyn.size]
@@ -470,7 +496,7 @@ def oblique_impact(
     inertia=0.4,
     g=0.0,
     separation: str = "force",
-    contact_point: str = "surface",
+    contact_point="surface",
     solver=None,
     rtol: float | None = None,
     atol: float | None = None,
@@ -513,11 +539,14 @@ def oblique_impact(
     - `g` (m/s^2): gravity along the inward normal (0: an isolated impact).
     - `separation`: `"force"` (contact ends where the normal force returns to zero) or
       `"penetration"` (where the overlap does), as in `impact`.
-    - `contact_point`: where the tangential force acts, `"surface"` (lever arm `R`, the
-      equations above; LAMMPS) or `"midpoint"`, halfway through the overlap `x` (lever arm
-      `R - x/2` in both the slip and the torque: LIGGGHTS, MuJoCo, Drake); they differ by
-      about `x_max / R` (measured: 0.004 in e_t at 5 degrees for Kharaz's sphere, whose
-      `x_max / R` is 0.006).
+    - `contact_point`: where the tangential force acts, as the lever arm `R - f x` in the
+      slip and the torque (`x` the overlap): `"surface"` (`f = 0`, the equations above;
+      LAMMPS), `"midpoint"` (`f = 1/2`, halfway through the overlap: LIGGGHTS, MuJoCo,
+      Drake, Yade between spheres), `"plane"` (`f = 1`, on the plane: Yade's wall) or a
+      number `f` in [0, 1]. Two equal spheres through their effective values: each
+      sphere's share over 2 (`"midpoint"` there is `f = 1/4`). The choices differ by about
+      `f x_max / R` (measured: 0.004 in e_t at 5 degrees for Kharaz's sphere, `x_max / R =
+      0.006`, at `f = 1/2`).
     - `solver` (default `diffrax.Tsit5()`), `rtol`, `atol` (default `rtol`): in the normal
       contact's units (default as `impact`'s: 1e-11 for a law of the table, 1e-12 for a
       user's law); `max_steps` per segment; `max_segments`: the most segments (one
@@ -546,8 +575,7 @@ def oblique_impact(
         rtol = DEFAULT_RTOL if law.spec is not None else CUSTOM_RTOL
     if separation not in SEPARATIONS:
         raise ValueError(f"separation must be one of {SEPARATIONS}, got {separation!r}")
-    if contact_point not in CONTACT_POINTS:
-        raise ValueError(f"contact_point must be one of {CONTACT_POINTS}, got {contact_point!r}")
+    share = lever_share(contact_point)
     for name, value in (("rtol", rtol), ("atol", atol), ("rest_tol", rest_tol)):
         if value is not None and not (isinstance(value, (int, float)) and 0 < value < 1):
             raise ValueError(f"{name} must be a number in (0, 1), got {value!r}")
@@ -581,7 +609,7 @@ def oblique_impact(
         max_segments=max_segments,
         tau_max=float(tau_max),
         rest_tol=float(rest_tol),
-        contact_point=contact_point,
+        lever_share=share,
     )
     result = solve_oblique(law, tangential, *values, options)
     if throw is not False and not is_traced(result.status) and np.ndim(result.status) == 0:

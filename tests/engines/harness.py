@@ -607,6 +607,59 @@ def run_yade(parameters, *, m, v0, radius, phases=(0.5,), damping=0.0, executabl
     return np.array(es), np.array(Ts)
 
 
+_SCRIPT_OBLIQUE = """
+import sys, math
+from yade import utils
+material, rho, R, v_n, v_t, h = {args}
+mat = O.materials.append(eval(material))
+O.bodies.append(utils.sphere((0, 0, R + 0.5 * v_n * h), R, material=mat))
+O.bodies.append(utils.wall(0.0, axis=2, sense=1, material=mat))
+O.bodies[0].state.vel = Vector3(v_t, 0, -v_n)
+O.engines = [
+    ForceResetter(),
+    InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),
+    InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()],
+                    [Ip2_ViscElMat_ViscElMat_ViscElPhys()], [Law2_ScGeom_ViscElPhys_Basic()]),
+    NewtonIntegrator(damping=0.0, gravity=(0, 0, 0)),
+]
+O.dt = h
+started = False
+for _ in range(10000000):
+    O.step()
+    if O.forces.f(0).norm() != 0.0:
+        started = True
+    elif started:
+        break
+s = O.bodies[0].state
+print("RESULT %r %r %r %r" % (s.vel[2] / v_n, s.vel[0] / v_t, s.angVel[1], s.mass))
+sys.stdout.flush()
+"""
+
+
+def run_yade_oblique(parameters, *, m, radius, v_n, v_t, executable="yade"):
+    """Run Yade on a wall export with a tangential law (`parameters["material"]`, the
+    explicit ViscElMat): one sphere (mass `m` kg, radius `radius` m, no spin) meeting the
+    fixed wall z = 0 at `v_n`, `v_t` (m/s), first touch half a step away, NewtonIntegrator
+    damping 0. Returns `(e, e_t, omega)`, omega the spin after about y (rad/s, positive
+    rolling along +x)."""
+    rho = m / (4.0 / 3.0 * math.pi * radius**3)
+    args = (parameters["material"], rho, radius, v_n, v_t, parameters["timestep"])
+    with tempfile.TemporaryDirectory() as folder:
+        path = os.path.join(folder, "oblique.py")
+        with open(path, "w") as handle:
+            handle.write(_SCRIPT_OBLIQUE.format(args=repr(args)))
+        out = subprocess.run(
+            [executable, "-n", "-x", path], capture_output=True, text=True, timeout=600
+        )
+    lines = [line for line in out.stdout.splitlines() if line.startswith("RESULT")]
+    if not lines:
+        raise RuntimeError(f"Yade gave no result: {out.stderr.strip()[-400:]}")
+    e, e_t, omega, mass = map(float, lines[-1].split()[1:])
+    if abs(mass / m - 1) > 1e-9:
+        raise RuntimeError(f"Yade's sphere has mass {mass}, not {m}")
+    return e, e_t, omega
+
+
 def run_lammps_jkr(parameters, *, m, v0, radius, phases=(0.5,)):
     """Run LAMMPS on an export to its `jkr` normal model (`parameters` of
     `export(law("jkr", ...), "lammps", ...)`): two spheres (mass `m` kg, radius `radius` m

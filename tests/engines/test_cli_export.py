@@ -214,8 +214,8 @@ TANGENTIAL_ARGV = ["--law", "tsuji", "--param", "c=4.2e9", "b=15", "--mass", "2.
 @pytest.mark.parametrize(
     "extra, message",
     [
-        (["yade", "--radius", "2.5e-3", "--tangential", "mindlin", "--tparam",
-          "G_star=1e10", "mu=0.1"], "Yade has no tangential export yet"),
+        (["chrono", "--radius", "2.5e-3", "--tangential", "mindlin", "--tparam",
+          "G_star=1e10", "mu=0.1"], "Chrono has no tangential export yet"),
         (["drake", "--tangential", "mindlin", "--tparam", "G_star=1e10", "mu=0.1"],
          "needs the sphere's radius"),
         (["mujoco", "--tangential", "mindlin", "--tparam", "G_star=1e10", "mu=0.1"],

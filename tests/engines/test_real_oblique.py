@@ -70,8 +70,8 @@ def test_lammps_realises_the_tangential_promise_between_two_spheres():
 
 def test_other_engines_and_a_damped_spring_are_refused_in_one_line():
     tl = TANGENTIAL["mindlin"]
-    with pytest.raises(ValueError, match="Yade has no tangential export yet"):
-        ji.export(LAW, "yade", m=M, v0=3.9, radius=R, tangential=tl)
+    with pytest.raises(ValueError, match="Chrono has no tangential export yet"):
+        ji.export(LAW, "chrono", m=M, v0=3.9, radius=R, tangential=tl)
     with pytest.raises(ValueError, match=r"needs the sphere's radius .*: pass radius="):
         ji.export(LAW, "mujoco", m=M, v0=3.9, tangential=tl)
     damped = ji.tangential_law("linear_history", kt=1e6, mu=0.1, ct=0.5)

@@ -25,17 +25,17 @@ from scipy.integrate import solve_ivp
 
 def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_star=None,
                    history="displacement", beta=0.0, rtol=1e-12, max_switches=40,
-                   midpoint=False):  # fmt: skip
+                   share=0.0):  # fmt: skip
     """Returns dict(e, v_t_out, omega_out, T, switches). `beta` (Mindlin only): the damper
     `2 (5/6)^0.5 beta (m k_t)^0.5` on the slip while sticking, left out of Coulomb's test
-    (LIGGGHTS' convention), so the switches are the undamped ones' formulas. `midpoint`:
-    the tangential force acts halfway through the overlap `x`, lever arm `R - x/2` in the
-    slip and the torque (else `R`)."""
+    (LIGGGHTS' convention), so the switches are the undamped ones' formulas. `share` f: the
+    tangential force acts inside the overlap `x`, lever arm `R - f x` in the slip and the
+    torque (0: `R`)."""
     moment = inertia * m * R**2
     mindlin = G_star is not None
 
     def lever(x):
-        return R - 0.5 * max(x, 0.0) if midpoint else R
+        return R - share * max(x, 0.0)
 
     def damper(x):
         xp = max(x, 0.0)

@@ -372,12 +372,17 @@ def test_gradient_of_the_mindlin_damper_against_central_differences():
 
 @pytest.mark.slow
 @pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")  # scipy's probes
-@pytest.mark.parametrize("name, history", [("mindlin", "displacement"), ("mindlin_force", "force")])
-def test_the_contact_point_at_mid_overlap_against_scipy(name, history):
-    """`contact_point="midpoint"` (lever arm `R - x/2`, as LIGGGHTS, MuJoCo and Drake) on a
-    contact 300 times softer than Kharaz's (x_max / R about 0.06): the same switches and
-    e, v_t_out, omega_out, T within 1e-8 of scipy's with the same lever; and it matters
-    (the undeformed surface's lever gives e_t more than 1e-3 away)."""
+@pytest.mark.parametrize(
+    "name, history, contact_point, share",
+    [("mindlin", "displacement", "midpoint", 0.5), ("mindlin_force", "force", "midpoint", 0.5),
+     ("mindlin", "displacement", "plane", 1.0)],
+)  # fmt: skip
+def test_the_contact_point_inside_the_overlap_against_scipy(name, history, contact_point, share):
+    """`contact_point="midpoint"` (lever arm `R - x/2`, as LIGGGHTS, MuJoCo and Drake) and
+    `"plane"` (`R - x`, Yade's wall) on a contact 300 times softer than Kharaz's (x_max / R
+    about 0.06): the same switches and e, v_t_out, omega_out, T within 1e-8 of scipy's with
+    the same lever; and it matters (the undeformed surface's lever gives e_t more than
+    1e-3 away)."""
     c = C / 300.0
     law = ji.law("hunt_crossley", c=c, a=0.0)
     tl = tangential_law(name, mu=0.092, G_star=G_STAR / 300.0)
@@ -385,9 +390,9 @@ def test_the_contact_point_at_mid_overlap_against_scipy(name, history):
     for degrees in (5.0, 20.0, 45.0):
         v_n, v_t = (float(v) for v in incidence(3.9, np.deg2rad(degrees)))
         r = oblique_impact(law, tl, m=M, R=R, v_n=v_n, v_t=v_t, rtol=1e-12,
-                           contact_point="midpoint")  # fmt: skip
+                           contact_point=contact_point)  # fmt: skip
         o = oblique_oracle(c=c, m=M, R=R, inertia=0.4, v_n=v_n, v_t=v_t, omega=0.0, mu=0.092,
-                           G_star=G_STAR / 300.0, history=history, midpoint=True)  # fmt: skip
+                           G_star=G_STAR / 300.0, history=history, share=share)  # fmt: skip
         what = f"{name}, {degrees} degrees"
         assert int(r.num_switches) == o["switches"], what
         assert float(r.e) == pytest.approx(o["e"], rel=1e-8), what
@@ -400,6 +405,7 @@ def test_the_contact_point_at_mid_overlap_against_scipy(name, history):
 
 
 def test_a_contact_point_not_known_is_refused_in_one_line():
-    with pytest.raises(ValueError, match="contact_point must be one of"):
-        oblique_impact(hertz(), tangential_law("mindlin", G_star=G_STAR, mu=0.1), m=M, R=R,
-                       v_n=1.0, v_t=1.0, contact_point="centre")  # fmt: skip
+    for bad in ("centre", 1.5, -0.1, None):
+        with pytest.raises(ValueError, match="contact_point must be one of"):
+            oblique_impact(hertz(), tangential_law("mindlin", G_star=G_STAR, mu=0.1), m=M, R=R,
+                           v_n=1.0, v_t=1.0, contact_point=bad)  # fmt: skip
