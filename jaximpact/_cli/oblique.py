@@ -98,6 +98,14 @@ def add_fit_oblique(subparsers):
         help="moment of inertia over m R^2 (default 0.4, a solid sphere)",
     )
     parser.add_argument(
+        "--contact-point",
+        choices=("surface", "midpoint", "plane"),
+        default="surface",
+        help="where the tangential force acts: lever arm R (surface, LAMMPS; the default), "
+        "R - x/2 (midpoint: LIGGGHTS, MuJoCo, Drake), R - x (plane: Yade's wall); fit with "
+        "the engine's to export to it",
+    )
+    parser.add_argument(
         "--free",
         action="extend",
         nargs="+",
@@ -237,6 +245,7 @@ def run_fit_oblique(args):
         free=free,
         inertia=args.inertia,
         g=g,
+        contact_point=args.contact_point,
         **sigmas,
     )
     if args.plot is not None:

@@ -14,8 +14,9 @@ from .._checks import check_positive, is_traced
 from .._format import format_fields, format_value, jsonable
 from .._laws import AbstractLaw
 from .._solve.options import CUSTOM_RTOL, DEFAULT_RTOL
+from .._solve.precision import resolvable_tolerances
 from .._status import Status
-from .impact import ObliqueOptions, _check_laws, solve_oblique
+from .impact import ObliqueOptions, _check_laws, lever_share, solve_oblique
 from .tangential import AbstractTangentialLaw
 
 
@@ -189,6 +190,7 @@ def fit_oblique(
     inertia=0.4,
     g=0.0,
     separation: str = "force",
+    contact_point="surface",
     rtol: float | None = None,
     max_steps: int = 100,
     tol: float = 1e-10,
@@ -210,7 +212,10 @@ def fit_oblique(
     `start_scan=0` starts from `tangential` alone. The impacts are
     solved with forward-mode derivatives and landed events (`oblique_impact(...,
     land_events=True)`), so the Jacobian is exact across the stick-slip transitions. A
-    row with NaN in `e_t` (or in `omega_out`) is left out of that part.
+    row with NaN in `e_t` (or in `omega_out`) is left out of that part. `separation` and
+    `contact_point` (where the tangential force acts: `oblique_impact`'s; fit with the
+    engine's, e.g. `"midpoint"` for LIGGGHTS, to export the fitted law to it) as in
+    `oblique_impact`.
 
     **Example**: `fit_oblique(law, tangential_law("linear_history", kt=1e7, mu=0.2),
     m=2.6e-4, R=2.5e-3, v_n=vns, v_t=vts, e_t=measured, free=("kt", "mu"))`.
@@ -245,17 +250,19 @@ def fit_oblique(
     s_w = _rows("sigma_omega", scale_w if sigma_omega is None else sigma_omega, n)
     if rtol is None:
         rtol = DEFAULT_RTOL if law.spec is not None else CUSTOM_RTOL
+    rtol, atol, rest_tol = resolvable_tolerances(rtol, rtol, 1e-7)
     options = ObliqueOptions(
         separation=separation,
         solver=dfx.Tsit5(),
         adjoint=dfx.ForwardMode(),
         rtol=float(rtol),
-        atol=float(rtol),
+        atol=float(atol),
         max_steps=4096,
         max_segments=16,
         tau_max=1e4,
-        rest_tol=1e-7,
+        rest_tol=rest_tol,
         land=True,
+        lever_share=lever_share(contact_point),
     )
     data = (v_n, v_t, omega, e_t, omega_out, s_e, s_w, has_e, has_w)
     m, R, inertia, g = (jnp.asarray(a, dtype=float) for a in (m, R, inertia, g))

@@ -19,6 +19,7 @@ from .._solve.adjoint import _tracer_kinds, auto_adjoint
 from .._solve.impact import check_custom_law
 from .._solve.options import CUSTOM_RTOL, DEFAULT_RTOL
 from .._solve.phases import solve_broke
+from .._solve.precision import resolvable_tolerances
 from .._status import Status
 from .dynamics import SLIP, STICK, ObliqueDynamics
 from .results import _NOT_RESULTS, ObliqueResult
@@ -598,13 +599,14 @@ def oblique_impact(
             "use jax.vmap for a batch (e.g. over incidence angles)"
         )
     check_custom_law(law, values[2])
+    rtol, atol, rest_tol = resolvable_tolerances(rtol, rtol if atol is None else atol, rest_tol)
     options = ObliqueOptions(
         separation=separation,
         solver=dfx.Tsit5() if solver is None else solver,
         adjoint=auto_adjoint(law, tangential, *values) if adjoint is None else adjoint,
         land=_differentiated(law, tangential, *values) if land_events is None else land_events,
         rtol=float(rtol),
-        atol=float(rtol if atol is None else atol),
+        atol=float(atol),
         max_steps=max_steps,
         max_segments=max_segments,
         tau_max=float(tau_max),
