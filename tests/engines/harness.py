@@ -382,39 +382,11 @@ def run_lammps(parameters, *, m, v0, radius, phases=(0.5,)):
     return np.array(es), np.array(Ts)
 
 
-def run_liggghts(parameters, *, m, v0, radius, phases=(0.5,), executable="liggghts"):
-    """Run LIGGGHTS (`executable`) on two spheres (mass `m` kg, radius `radius` m each,
-    head-on at relative speed `v0` m/s) with the exported `parameters`, or with
-    `parameters["geometry"] == "wall"` on one such sphere hitting the exported primitive wall
-    (the plane z = 0) at `v0`; returns arrays `(e, T)`, T the number of steps with a non-zero
-    contact force times the step."""
-    h = parameters["timestep_s"]
-    rho = m / (4.0 / 3.0 * math.pi * radius**3)
-    steps = int(20 * radius / v0 / h) + 10  # far longer than any contact the export makes
-    wall = parameters.get("geometry", "spheres") == "wall"
-    if wall:  # it rises by at most 4 R, inside the box (10 R), after any contact the export makes
-        steps = int(4 * radius / v0 / h) + 10
-    es, Ts = [], []
-    for phase in map(float, phases):
-        gap = v0 * h * phase
-        box = 10 * radius
-        extra = particle_range_line(parameters["youngs_modulus"])
-        if wall:  # the sphere above the wall z = 0, first touch `gap` away
-            atoms = f"""{parameters["fix_wall"]}
-create_atoms 1 single 0 0 {radius + gap!r} units box
-set atom 1 diameter {2 * radius!r} density {rho!r} vx 0 vy 0 vz {-v0!r}
-fix integr all nve/sphere
-variable f1 equal fz[1]
-variable dv equal vz[1]"""
-        else:
-            atoms = f"""create_atoms 1 single {-radius - gap / 2!r} 0 0 units box
-create_atoms 1 single {radius + gap / 2!r} 0 0 units box
-set atom 1 diameter {2 * radius!r} density {rho!r} vx {v0 / 2!r} vy 0 vz 0
-set atom 2 diameter {2 * radius!r} density {rho!r} vx {-v0 / 2!r} vy 0 vz 0
-fix integr all nve/sphere
-variable f1 equal fx[1]
-variable dv equal vx[2]-vx[1]"""
-        script = f"""atom_style granular
+def _liggghts_setup(parameters, radius, box) -> str:
+    """The lines of a LIGGGHTS script up to the time step: a box of half-width `box` (m),
+    the exported material, contact and step (`parameters`)."""
+    extra = particle_range_line(parameters["youngs_modulus"])
+    return f"""atom_style granular
 atom_modify map array
 boundary f f f
 newton off
@@ -431,25 +403,66 @@ neigh_modify delay 0
 {parameters["coefficientFriction"]}
 {parameters["pair_style"]}
 {parameters["pair_coeff"]}
-{parameters["timestep"]}
+{parameters["timestep"]}"""
+
+
+def _liggghts_rows(script, executable, m, *, mass_column):
+    """Run LIGGGHTS on `script` (which prints its rows to out.txt) and return them, after
+    checking the sphere's mass (column `mass_column`) is `m` (kg)."""
+    with tempfile.TemporaryDirectory() as folder:
+        with open(os.path.join(folder, "in.run"), "w") as handle:
+            handle.write(script)
+        run = subprocess.run(
+            [executable, "-in", "in.run", "-log", "none", "-screen", "none"],
+            cwd=folder, capture_output=True, text=True, timeout=600,
+        )  # fmt: skip
+        path = os.path.join(folder, "out.txt")
+        if not os.path.exists(path):
+            raise RuntimeError(f"LIGGGHTS gave no output: {run.stdout[-400:]}{run.stderr}")
+        rows = np.loadtxt(path, comments="#", ndmin=2)
+    if abs(rows[0, mass_column] / m - 1) > 1e-9:
+        raise RuntimeError(f"LIGGGHTS's sphere has mass {rows[0, mass_column]}, not {m}")
+    return rows
+
+
+def run_liggghts(parameters, *, m, v0, radius, phases=(0.5,), executable="liggghts"):
+    """Run LIGGGHTS (`executable`) on two spheres (mass `m` kg, radius `radius` m each,
+    head-on at relative speed `v0` m/s) with the exported `parameters`, or with
+    `parameters["geometry"] == "wall"` on one such sphere hitting the exported primitive wall
+    (the plane z = 0) at `v0`; returns arrays `(e, T)`, T the number of steps with a non-zero
+    contact force times the step."""
+    h = parameters["timestep_s"]
+    rho = m / (4.0 / 3.0 * math.pi * radius**3)
+    steps = int(20 * radius / v0 / h) + 10  # far longer than any contact the export makes
+    wall = parameters.get("geometry", "spheres") == "wall"
+    if wall:  # it rises by at most 4 R, inside the box (10 R), after any contact the export makes
+        steps = int(4 * radius / v0 / h) + 10
+    es, Ts = [], []
+    for phase in map(float, phases):
+        gap = v0 * h * phase
+        box = 10 * radius
+        if wall:  # the sphere above the wall z = 0, first touch `gap` away
+            atoms = f"""{parameters["fix_wall"]}
+create_atoms 1 single 0 0 {radius + gap!r} units box
+set atom 1 diameter {2 * radius!r} density {rho!r} vx 0 vy 0 vz {-v0!r}
+fix integr all nve/sphere
+variable f1 equal fz[1]
+variable dv equal vz[1]"""
+        else:
+            atoms = f"""create_atoms 1 single {-radius - gap / 2!r} 0 0 units box
+create_atoms 1 single {radius + gap / 2!r} 0 0 units box
+set atom 1 diameter {2 * radius!r} density {rho!r} vx {v0 / 2!r} vy 0 vz 0
+set atom 2 diameter {2 * radius!r} density {rho!r} vx {-v0 / 2!r} vy 0 vz 0
+fix integr all nve/sphere
+variable f1 equal fx[1]
+variable dv equal vx[2]-vx[1]"""
+        script = f"""{_liggghts_setup(parameters, radius, box)}
 {atoms}
 variable m1 equal mass[1]
 fix out all print 1 "${{f1}} ${{dv}} ${{m1}}" file out.txt screen no
 run {steps}
 """
-        with tempfile.TemporaryDirectory() as folder:
-            with open(os.path.join(folder, "in.impact"), "w") as handle:
-                handle.write(script)
-            run = subprocess.run(
-                [executable, "-in", "in.impact", "-log", "none", "-screen", "none"],
-                cwd=folder, capture_output=True, text=True, timeout=600,
-            )  # fmt: skip
-            path = os.path.join(folder, "out.txt")
-            if not os.path.exists(path):
-                raise RuntimeError(f"LIGGGHTS gave no output: {run.stdout[-400:]}{run.stderr}")
-            rows = np.loadtxt(path, comments="#", ndmin=2)
-        if abs(rows[0, 2] / m - 1) > 1e-9:
-            raise RuntimeError(f"LIGGGHTS's sphere has mass {rows[0, 2]}, not {m}")
+        rows = _liggghts_rows(script, executable, m, mass_column=2)
         pushing = rows[:, 0] != 0.0
         es.append(rows[-1, 1] / v0)
         Ts.append(pushing.sum() * h)
@@ -467,24 +480,7 @@ def run_liggghts_oblique(parameters, *, m, radius, v_n, v_t, executable="liggght
     gap = v_n * h * 0.5
     steps = int(4 * radius / v_n / h) + 10
     box = 10 * radius + 4 * radius * abs(v_t) / v_n  # the sphere stays inside
-    script = f"""atom_style granular
-atom_modify map array
-boundary f f f
-newton off
-communicate single vel yes
-units si
-{parameters.get("particle_range") or ""}
-region box block {-box!r} {box!r} {-box!r} {box!r} {-box!r} {box!r} units box
-create_box 1 box
-neighbor {0.5 * radius!r} bin
-neigh_modify delay 0
-{parameters["youngsModulus"]}
-{parameters["poissonsRatio"]}
-{parameters["coefficientRestitution"]}
-{parameters["coefficientFriction"]}
-{parameters["pair_style"]}
-{parameters["pair_coeff"]}
-{parameters["timestep"]}
+    script = f"""{_liggghts_setup(parameters, radius, box)}
 {parameters["fix_wall"]}
 create_atoms 1 single 0 0 {radius + gap!r} units box
 set atom 1 diameter {2 * radius!r} density {rho!r} vx {v_t!r} vy 0 vz {-v_n!r}
@@ -496,19 +492,7 @@ variable m1 equal mass[1]
 fix out all print 1 "${{vx}} ${{vz}} ${{wy}} ${{m1}}" file out.txt screen no
 run {steps}
 """
-    with tempfile.TemporaryDirectory() as folder:
-        with open(os.path.join(folder, "in.oblique"), "w") as handle:
-            handle.write(script)
-        run = subprocess.run(
-            [executable, "-in", "in.oblique", "-log", "none", "-screen", "none"],
-            cwd=folder, capture_output=True, text=True, timeout=600,
-        )  # fmt: skip
-        path = os.path.join(folder, "out.txt")
-        if not os.path.exists(path):
-            raise RuntimeError(f"LIGGGHTS gave no output: {run.stdout[-400:]}{run.stderr}")
-        rows = np.loadtxt(path, comments="#", ndmin=2)
-    if abs(rows[0, 3] / m - 1) > 1e-9:
-        raise RuntimeError(f"LIGGGHTS's sphere has mass {rows[0, 3]}, not {m}")
+    rows = _liggghts_rows(script, executable, m, mass_column=3)
     vx, vz, wy = rows[-1, :3]
     return vz / v_n, vx / v_t, wy
 
