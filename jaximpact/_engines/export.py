@@ -355,11 +355,11 @@ def _oblique_promise(chosen, parameters, engine_law, separation, tangential, sou
         scene = dict(m=m, R=radius, inertia=0.4)
     v_n, v_t = (np.asarray(v, float) for v in incidence(v0, np.deg2rad(OBLIQUE_ANGLES)))
 
-    def continuous(normal_law, tangential_law, contact_point=0.0):
+    def continuous(normal_law, tangential_law, contact_point=0.0, ends=separation):
         # a soft spring sticks and slips many times (throw=False: a solve that still
         # fails is NaN in the promise, not an error of the export)
         rows = [oblique_impact(normal_law, tangential_law, **scene, v_n=float(a), v_t=float(b),
-                               separation=separation, contact_point=contact_point,
+                               separation=ends, contact_point=contact_point,
                                max_segments=64, throw=False)
                 for a, b in zip(v_n, v_t, strict=True)]  # fmt: skip
         return tuple(
@@ -372,7 +372,9 @@ def _oblique_promise(chosen, parameters, engine_law, separation, tangential, sou
         e_n, e_t, omega = continuous(engine_law, realised, _engine_share(chosen, geometry))
     else:
         e_n, e_t, omega = (np.asarray(a).mean(axis=-1) for a in stepped)
-    target = None if source is None else tuple(map(float, continuous(source, tangential)[1]))
+    # the law's own: under the force criterion, as its e and T (`_targets`)
+    target = (None if source is None
+              else tuple(map(float, continuous(source, tangential, ends="force")[1])))  # fmt: skip
     return dict(tangential=tangential, angles=OBLIQUE_ANGLES, e_t_engine=tuple(map(float, e_t)),
                 omega_engine=tuple(map(float, omega)), e_n_engine=tuple(map(float, e_n)),
                 e_t_target=target)  # fmt: skip

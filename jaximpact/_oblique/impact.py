@@ -261,7 +261,12 @@ def _segment(setup: _Setup, carry, _):
     # (the mode changes at once, where the segment began)
     # (judged with the normal force's sign at the segment's start: |F_n| has a kink
     # where the contact ends, and the sliding condition, a rate, jumps there)
+    # (or with its sign at the segment's end where it is clearly away from zero there: under
+    # the penetration criterion the force turns to pulling before the overlap closes, and
+    # the segment's event conditions followed |F_n| through that)
     sign = jnp.where(normal.force(y[:size], compressing) < 0, -1.0, 1.0)
+    force_end = normal.force(y1[:size], compressing)
+    sign = jnp.where(jnp.abs(force_end) > OVERTAKEN, jnp.sign(force_end), sign)
     overtaken = (
         alive
         & ~switched

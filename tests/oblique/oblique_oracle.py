@@ -3,8 +3,9 @@ written again in SI units with numpy and integrated by scipy's `solve_ivp` (DOP8
 rtol 1e-12), the stick-slip transitions handled by scipy's own events (terminal, then a
 restart in the other mode). Nothing of jaximpact is imported here.
 
-Normal law: Hunt-Crossley `F_n = c x^1.5 (1 + 1.5 a v)` (Hertz for a = 0), contact ending
-at x = 0. Tangential: a spring `k(x)` (constant `kt`, or Mindlin's `8 G* sqrt(R x)`), with
+Normal law: Hunt-Crossley `F_n = c x^1.5 (1 + 1.5 a v)` (Hertz for a = 0), plus Tsuji's
+`b x^0.25 v` where given, contact ending at x = 0. Tangential: a spring `k(x)` (constant
+`kt`, or Mindlin's `8 G* sqrt(R x)`), with
 displacement history (`q' = u`, `F_t = -k q`) or force history (`q' = -k u`, `F_t = q`),
 undamped, limited by `mu F_n`. The first-touch mode comes from the leading powers of t,
 derived by hand (not from the library's rule): the contact sticks where the spring's force
@@ -25,12 +26,13 @@ from scipy.integrate import solve_ivp
 
 def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_star=None,
                    history="displacement", beta=0.0, rtol=1e-12, max_switches=40,
-                   share=0.0):  # fmt: skip
+                   share=0.0, b_tsuji=0.0):  # fmt: skip
     """Returns dict(e, v_t_out, omega_out, T, switches). `beta` (Mindlin only): the damper
     `2 (5/6)^0.5 beta (m k_t)^0.5` on the slip while sticking, left out of Coulomb's test
     (LIGGGHTS' convention), so the switches are the undamped ones' formulas. `share` f: the
     tangential force acts inside the overlap `x`, lever arm `R - f x` in the slip and the
-    torque (0: `R`)."""
+    torque (0: `R`). `b_tsuji`: Tsuji's damping `b x^0.25 v` added to the normal force
+    (N s/m^1.25), which pulls before the overlap closes."""
     moment = inertia * m * R**2
     mindlin = G_star is not None
 
@@ -46,9 +48,11 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
     def normal(x, v):
         xp = max(x, 0.0)
         v = v if xp > 0 else 0.0  # outside the surface: no force, no rate
-        f = c * xp**1.5 * (1.0 + 1.5 * a * v)
+        f = c * xp**1.5 * (1.0 + 1.5 * a * v) + b_tsuji * xp**0.25 * v
         acc = -f / m
         df = 1.5 * c * math.sqrt(xp) * v * (1.0 + 1.5 * a * v) + c * xp**1.5 * 1.5 * a * acc
+        if b_tsuji and xp > 0:
+            df += b_tsuji * (0.25 * xp**-0.75 * v * v + xp**0.25 * acc)
         return f, df
 
     def stiffness(x, v):
@@ -87,8 +91,8 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
         f, _ = normal(x, v)
         k, _ = stiffness(x, v)
         if history == "displacement":
-            return s * mu * f / k
-        return -s * mu * f
+            return s * mu * abs(f) / k
+        return -s * mu * abs(f)
 
     def slide_rate(state, s):
         """s times the sliding speed of a spring held at the limit (displacement), or the
@@ -99,6 +103,9 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
         u = vt - lever(x) * w
         if k == 0:  # outside the surface (scipy's last trial points): no contact
             return 1.0
+        # the limit is mu |F_n|: its rate carries the normal force's sign (the force turns
+        # to pulling before the overlap closes, under this oracle's end at x = 0)
+        f, df = abs(f), math.copysign(1.0, f) * df
         if history == "displacement":
             dheld = s * mu * (df * k - f * dk) / k**2
             return s * (u - dheld)
@@ -110,7 +117,7 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
     x0 = v_n * t0
     u0 = v_t - R * omega
     limit = mu * c * (1.0 + 1.5 * a * v_n) * v_n
-    if u0 == 0:
+    if u0 == 0 or b_tsuji > 0:  # Tsuji's limit grows as t^0.25, faster than any spring
         mode = "stick"
     elif not mindlin:
         mode = "slip"

@@ -453,3 +453,60 @@ def test_float32_without_x64():
         v_n, v_t = (float(v) for v in incidence(3.9, np.deg2rad(degrees)))
         reference = float(oblique_impact(hertz(), tl, m=M, R=R, v_n=v_n, v_t=v_t).e_t)
         assert row["e_t"] == pytest.approx(reference, abs=1e-4), degrees
+
+
+PULLING_SCRIPT = """
+import json, math
+import jax
+jax.config.update("jax_enable_x64", True)
+import jaximpact as ji
+from jaximpact._oblique import incidence
+R = 2.5e-3
+M = 4000.0 * 4.0 / 3.0 * math.pi * R**3
+law = ji.law("tsuji", c=4.2e9, b=15.0)
+tl = ji.tangential_law("linear_history", kt=1e6, mu=0.092)
+rows = []
+for degrees in (20.0, 40.0, 45.0):
+    v_n, v_t = (float(v) for v in incidence(3.9, math.radians(degrees)))
+    r = ji.oblique_impact(law, tl, m=M, R=R, v_n=v_n, v_t=v_t, separation="penetration",
+                          throw=False)
+    rows.append(dict(status=int(r.status), switches=int(r.num_switches), e=float(r.e),
+                     v_t_out=float(r.v_t_out), omega_out=float(r.omega_out)))
+print(json.dumps(rows))
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")  # scipy's probes
+@pytest.mark.filterwarnings("ignore:invalid value encountered:RuntimeWarning")
+def test_the_penetration_criterion_where_the_normal_force_pulls_before_the_end():
+    """Tsuji's damping `b x^0.25 v` pulls before the overlap closes: under
+    `separation="penetration"` the contact slides on through |F_n|'s kink to x = 0. It once
+    failed there (40 and 45 degrees, Kharaz's sphere with c = 4.2e9, linear_history kt = 1e6
+    N/m, default rtol: the end of the last segment was judged with the normal force's sign
+    at its start), in a user's process; the suite's XLA flags (no LLVM optimisation) round
+    differently and hid it, so the impacts run in a process of their own. Now they separate
+    with scipy's switches; e is the normal impact's (the tangential force does not act on
+    it) to 1e-9, and v_t_out, omega_out lie within 1e-4 of scipy's, whose own e is 1.3e-5 off
+    after its restarts near the x^0.25 end (measured; without friction it is not)."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    env = {k: v for k, v in os.environ.items() if k != "XLA_FLAGS"}
+    proc = subprocess.run([sys.executable, "-c", PULLING_SCRIPT], capture_output=True,
+                          text=True, env=env, timeout=300)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    rows = json.loads(proc.stdout.strip().splitlines()[-1])
+    law = ji.law("tsuji", c=4.2e9, b=15.0)
+    for degrees, row in zip((20.0, 40.0, 45.0), rows, strict=True):
+        v_n, v_t = (float(v) for v in incidence(3.9, np.deg2rad(degrees)))
+        o = oblique_oracle(c=4.2e9, b_tsuji=15.0, m=M, R=R, inertia=0.4, v_n=v_n, v_t=v_t,
+                           omega=0.0, mu=0.092, kt=1e6)  # fmt: skip
+        head_on = ji.impact(law, m=M, v0=v_n, separation="penetration")
+        assert row["status"] == ji.Status.separated, (degrees, row)
+        assert row["switches"] == o["switches"], degrees
+        assert row["e"] == pytest.approx(float(head_on.e), rel=1e-9), degrees
+        assert row["v_t_out"] == pytest.approx(o["v_t_out"], rel=1e-4), degrees
+        assert row["omega_out"] == pytest.approx(o["omega_out"], rel=1e-4), degrees
