@@ -470,23 +470,34 @@ run {steps}
 
 
 def run_liggghts_oblique(parameters, *, m, radius, v_n, v_t, executable="liggghts"):
-    """Run LIGGGHTS on a wall export with a tangential law: one sphere (mass `m` kg, radius
+    """Run LIGGGHTS on an export with a tangential law: one sphere (mass `m` kg, radius
     `radius` m, no spin) hitting the exported primitive wall (z = 0) at normal speed `v_n`
-    and tangential speed `v_t` along x (m/s), first touch half a step away. Returns
-    `(e, e_t, omega)`: the normal and tangential restitution and the spin after about y
-    (rad/s; positive where it rolls the sphere along +x)."""
+    and tangential speed `v_t` along x (m/s), or (an export for two spheres) two such
+    spheres at those relative speeds (normal along z, tangential along x), first touch half
+    a step away. Returns `(e, e_t, omega)`: the normal and tangential restitution (of the
+    centres' relative velocity for two spheres) and the spin after about y (rad/s; positive
+    where it rolls the sphere along +x; sphere 1, the upper one, for two spheres)."""
     h = parameters["timestep_s"]
     rho = m / (4.0 / 3.0 * math.pi * radius**3)
     gap = v_n * h * 0.5
     steps = int(4 * radius / v_n / h) + 10
-    box = 10 * radius + 4 * radius * abs(v_t) / v_n  # the sphere stays inside
-    script = f"""{_liggghts_setup(parameters, radius, box)}
-{parameters["fix_wall"]}
+    box = 10 * radius + 4 * radius * abs(v_t) / v_n  # the spheres stay inside
+    if "fix_wall" in parameters:
+        atoms = f"""{parameters["fix_wall"]}
 create_atoms 1 single 0 0 {radius + gap!r} units box
-set atom 1 diameter {2 * radius!r} density {rho!r} vx {v_t!r} vy 0 vz {-v_n!r}
+set atom 1 diameter {2 * radius!r} density {rho!r} vx {v_t!r} vy 0 vz {-v_n!r}"""
+        relative = "vx[1]", "vz[1]"
+    else:
+        atoms = f"""create_atoms 1 single 0 0 {radius + gap / 2!r} units box
+create_atoms 1 single 0 0 {-radius - gap / 2!r} units box
+set atom 1 diameter {2 * radius!r} density {rho!r} vx {v_t / 2!r} vy 0 vz {-v_n / 2!r}
+set atom 2 diameter {2 * radius!r} density {rho!r} vx {-v_t / 2!r} vy 0 vz {v_n / 2!r}"""
+        relative = "vx[1]-vx[2]", "vz[1]-vz[2]"
+    script = f"""{_liggghts_setup(parameters, radius, box)}
+{atoms}
 fix integr all nve/sphere
-variable vx equal vx[1]
-variable vz equal vz[1]
+variable vx equal {relative[0]}
+variable vz equal {relative[1]}
 variable wy equal omegay[1]
 variable m1 equal mass[1]
 fix out all print 1 "${{vx}} ${{vz}} ${{wy}} ${{m1}}" file out.txt screen no
