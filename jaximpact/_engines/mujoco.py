@@ -181,6 +181,22 @@ class Mujoco(AbstractEngine):
             out["cone_factor"] = head_on_factor(mu)
         return out
 
+    def tangential_changes(self, parameters, tangential):
+        """How strongly MuJoCo's friction can act: its cone slows the slip at the rate of
+        the contact's damping `B` (1/s), over the contact's duration `T`; `B T` well below
+        1 leaves the slip almost as it came."""
+        if "cone_factor" not in parameters:
+            return []
+        stiffness, damping = effective(parameters["solref"], parameters["timestep"])
+        zeta = damping / (2.0 * math.sqrt(stiffness))
+        duration = continuous(zeta)[1] / math.sqrt(stiffness)
+        return [
+            f"MuJoCo's friction slows the slip at the rate of its contact damping, "
+            f"{damping:.3g} /s, over a contact of {duration:.3g} s: B T = "
+            f"{damping * duration:.2g} (it acts fully only where B T is several, a damping "
+            "ratio near 1)"
+        ]
+
     def oblique(self, parameters, *, m, radius, v_n, v_t):
         """MuJoCo's Euler step on the sphere with the exported friction (mujoco_friction.py);
         without friction the normal replica, the tangential speed and spin unchanged."""

@@ -96,6 +96,7 @@ def test_the_export_to_mujoco_takes_mu_and_says_how_far_it_falls():
     gap = max(abs(a - b) for a, b in zip(x.e_t_engine, x.e_t_target, strict=True))
     note = next(w for w in x.warnings if w.startswith("MuJoCo has no tangential spring"))
     assert f"by up to {gap:.3g}" in note and "normal e runs" in note
+    assert any("B T = 0.04" in w for w in x.warnings)  # why: 3.1e3 /s over 12.8 us
     assert tuple(x.to_dict()["e_n_engine"]) == x.e_n_engine
 
 
