@@ -153,13 +153,7 @@ class Drake(AbstractEngine):
     )
 
     def check_tangential(self, tangential, *, radius, timestep):
-        """Drake takes any tangential law's `mu` on its continuous plant; the sphere's
-        radius is needed."""
-        if radius is None:
-            raise ValueError(
-                "drake with a tangential law needs the sphere's radius (its friction's lever "
-                "arm and inertia): pass radius= (m)"
-            )
+        """Drake takes any tangential law's `mu` on its continuous plant."""
         if timestep:
             raise ValueError(
                 "drake's friction is exported for its continuous plant only (a discrete "

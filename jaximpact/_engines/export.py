@@ -262,6 +262,11 @@ def export(
     options = dict(m=m, v0=v0, radius=radius, poisson=0.3 if poisson is None else poisson,
                    limit_damping=limit_damping, geometry=geometry)  # fmt: skip
     if tangential is not None:  # refused before any work by an engine without it
+        if radius is None:  # a two-sphere engine asked for it above
+            raise ValueError(
+                f"{engine} with a tangential law needs the sphere's radius (its friction's "
+                "lever arm and inertia): pass radius= (m)"
+            )
         chosen.check_tangential(tangential, radius=radius, timestep=timestep)
     out = chosen.design(target_e, target_T, timestep=timestep, **options)
     if tangential is not None:  # an engine whose tangential law ties to its normal options
@@ -305,8 +310,8 @@ def export(
         warnings += chosen.tangential_changes(parameters, tangential)
         if chosen.FRICTION is not None:
             warnings.append(_friction_note(chosen, tangential, oblique))
-        elif source is not None and _departs(oblique) > E_T_WARN:
-            warnings.append(_departure(oblique) + _contact_point_note(chosen, geometry))
+        elif source is not None and (departure := _departure(oblique))[0] > E_T_WARN:
+            warnings.append(departure[1] + _contact_point_note(chosen, geometry))
     return Export(
         engine=engine,
         scene=chosen.SCENES[geometry],
@@ -392,16 +397,8 @@ def _friction_note(chosen, tangential, oblique) -> str:
         f"runs {e_n.min():.4g} to {e_n.max():.4g}"
     )
     if oblique["e_t_target"] is not None:
-        note += ", and " + _departure(oblique)
+        note += ", and " + _departure(oblique)[1]
     return note
-
-
-def _departs(oblique) -> float:
-    """The largest |e_t engine - e_t law| over the angles."""
-    import numpy as np
-
-    gap = np.abs(np.asarray(oblique["e_t_engine"]) - np.asarray(oblique["e_t_target"]))
-    return float(np.nanmax(gap))
 
 
 def _engine_share(chosen, geometry) -> float:
@@ -424,14 +421,17 @@ def _contact_point_note(chosen, geometry) -> str:
     )
 
 
-def _departure(oblique) -> str:
-    """How far the engine's e_t falls from the law's over the angles, in words."""
+def _departure(oblique) -> tuple[float, str]:
+    """How far the engine's e_t falls from the law's over the angles: the largest
+    |e_t engine - e_t law|, and that in words."""
     import numpy as np
 
     gap = np.abs(np.asarray(oblique["e_t_engine"]) - np.asarray(oblique["e_t_target"]))
     k = int(np.nanargmax(gap))
     angle = oblique["angles"][k]
-    return f"its e_t departs from the law's by up to {gap[k]:.3g} (at {angle:g} degrees)"
+    return float(gap[k]), (
+        f"its e_t departs from the law's by up to {gap[k]:.3g} (at {angle:g} degrees)"
+    )
 
 
 def _inputs(chosen: AbstractEngine, law_or_fit, m, v0, timestep, poisson):

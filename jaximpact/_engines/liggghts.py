@@ -47,11 +47,11 @@ def _parameters(p: dict, limit_damping: bool, extra: str | None, wall: bool) -> 
     sanity-range line `extra`, and with `wall` the primitive wall z = 0; with `p`'s
     `friction` (liggghts_tangential.design) its coefficientFriction and, for an undamped
     tangential law, `tangential_damping off`."""
-    limit = " limitForce on" if limit_damping else ""
+    settings = " limitForce on" if limit_damping else ""  # after the models
     if p.get("friction") is not None and not p["tangential_damping"]:
-        limit += " tangential_damping off"
+        settings += " tangential_damping off"
     parameters = {
-        "pair_style": "pair_style gran model hertz tangential history" + limit,
+        "pair_style": "pair_style gran model hertz tangential history" + settings,
         "pair_coeff": "pair_coeff * *",
         "youngsModulus": (
             f"fix m1 all property/global youngsModulus peratomtype {p['youngs_modulus']:.10g}"
@@ -76,7 +76,7 @@ def _parameters(p: dict, limit_damping: bool, extra: str | None, wall: bool) -> 
     if wall:
         parameters["fix_wall"] = (
             "fix wall all wall/gran model hertz tangential history primitive type 1 zplane 0.0"
-            + limit  # after the wall, or it is refused
+            + settings  # after the wall, or it is refused
         )
         parameters["geometry"] = "wall"
     return parameters

@@ -159,12 +159,7 @@ class Mujoco(AbstractEngine):
     )
 
     def check_tangential(self, tangential, *, radius, timestep):
-        """MuJoCo takes any tangential law's `mu`; the sphere's radius is needed."""
-        if radius is None:
-            raise ValueError(
-                "mujoco with a tangential law needs the sphere's radius (its friction's lever "
-                "arm and inertia): pass radius= (m)"
-            )
+        """MuJoCo takes any tangential law's `mu`."""
 
     def with_tangential(self, parameters, tangential):
         """`parameters` with friction `mu` (the tangential law's) on the pyramidal cone, and
