@@ -54,8 +54,6 @@ def _one(k, d, m, radius, mu, v_n, v_t, stiction, inertia, rtol):
         lever = radius - 0.5 * x
         u = v - lever * omega
         f_t = -float(stribeck(abs(u) / stiction, mu, mu)) * f_n * math.copysign(1.0, u)
-        if u == 0.0:
-            f_t = 0.0
         return [rate, -f_n / m, f_t / m, -f_t * lever / moment]
 
     def out(t, y):
