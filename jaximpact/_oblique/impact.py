@@ -3,6 +3,7 @@ values): `oblique_impact`, integrated with diffrax in segments of one tangential
 (sticking or sliding), each ended by an event with a root finder, so that the
 stick-slip transitions are placed to the solver's tolerance and differentiable."""
 
+import dataclasses
 import functools
 import math
 from typing import NamedTuple
@@ -15,7 +16,7 @@ import numpy as np
 
 from .._checks import check_nonnegative, check_positive, check_values, is_traced
 from .._laws import AbstractLaw
-from .._solve.adjoint import _tracer_kinds, auto_adjoint
+from .._solve.adjoint import _tracer_kinds, auto_adjoint, by_forward_jacobian, reverse_only
 from .._solve.impact import check_custom_law
 from .._solve.options import CUSTOM_RTOL, DEFAULT_RTOL
 from .._solve.phases import solve_broke
@@ -618,7 +619,15 @@ def oblique_impact(
         rest_tol=float(rest_tol),
         lever_share=share,
     )
-    result = solve_oblique(law, tangential, *values, options)
+    if adjoint is None and reverse_only(law, tangential, *values):
+        # jax.grad: the forward-mode Jacobian, transposed (`adjoint.by_forward_jacobian`)
+        forward = dataclasses.replace(options, adjoint=dfx.ForwardMode())
+        solve, closed = jax.closure_convert(
+            lambda *args: solve_oblique(*args, forward), law, tangential, *values
+        )
+        result = by_forward_jacobian((law, tangential, *values, *closed), fn=solve)
+    else:
+        result = solve_oblique(law, tangential, *values, options)
     if throw is not False and not is_traced(result.status) and np.ndim(result.status) == 0:
         status = Status(int(result.status))
         if status.is_failure:
