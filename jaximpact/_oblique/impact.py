@@ -275,7 +275,10 @@ def _segment(setup: _Setup, carry, _):
         & (dyn.switch(y1, mode, sense, compressing, sign) < -OVERTAKEN)
         & jnp.all(jnp.isfinite(y1))
     )
-    armed = dyn.switch(y, mode, sense, compressing) > 0
+    # armed: the condition began at or above 0 within roundoff (a spring just held at the
+    # limit starts at -1e-16, then rises: its later crossing is found by a redo; one that
+    # truly falls at once is found by the redo's finding none, below)
+    armed = dyn.switch(y, mode, sense, compressing) > -OVERTAKEN
     redo = overtaken & armed & ~mute
     at_once = overtaken & ~redo
     # a sticking segment that still ended beyond Coulomb's limit: a failure, never a

@@ -605,11 +605,18 @@ def run_yade(parameters, *, m, v0, radius, phases=(0.5,), damping=0.0, executabl
 _SCRIPT_OBLIQUE = """
 import sys, math
 from yade import utils
-material, rho, R, v_n, v_t, h = {args}
+material, rho, R, v_n, v_t, h, pair = {args}
 mat = O.materials.append(eval(material))
-O.bodies.append(utils.sphere((0, 0, R + 0.5 * v_n * h), R, material=mat))
-O.bodies.append(utils.wall(0.0, axis=2, sense=1, material=mat))
-O.bodies[0].state.vel = Vector3(v_t, 0, -v_n)
+gap = 0.5 * v_n * h
+if pair:  # two spheres meeting at z = 0, each at half the relative speeds
+    O.bodies.append(utils.sphere((0, 0, R + 0.5 * gap), R, material=mat))
+    O.bodies.append(utils.sphere((0, 0, -R - 0.5 * gap), R, material=mat))
+    O.bodies[0].state.vel = Vector3(0.5 * v_t, 0, -0.5 * v_n)
+    O.bodies[1].state.vel = Vector3(-0.5 * v_t, 0, 0.5 * v_n)
+else:
+    O.bodies.append(utils.sphere((0, 0, R + gap), R, material=mat))
+    O.bodies.append(utils.wall(0.0, axis=2, sense=1, material=mat))
+    O.bodies[0].state.vel = Vector3(v_t, 0, -v_n)
 O.engines = [
     ForceResetter(),
     InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),
@@ -626,19 +633,23 @@ for _ in range(10000000):
     elif started:
         break
 s = O.bodies[0].state
-print("RESULT %r %r %r %r" % (s.vel[2] / v_n, s.vel[0] / v_t, s.angVel[1], s.mass))
+vel = s.vel - O.bodies[1].state.vel if pair else s.vel
+print("RESULT %r %r %r %r" % (vel[2] / v_n, vel[0] / v_t, s.angVel[1], s.mass))
 sys.stdout.flush()
 """
 
 
 def run_yade_oblique(parameters, *, m, radius, v_n, v_t, executable="yade"):
-    """Run Yade on a wall export with a tangential law (`parameters["material"]`, the
-    explicit ViscElMat): one sphere (mass `m` kg, radius `radius` m, no spin) meeting the
-    fixed wall z = 0 at `v_n`, `v_t` (m/s), first touch half a step away, NewtonIntegrator
-    damping 0. Returns `(e, e_t, omega)`, omega the spin after about y (rad/s, positive
-    rolling along +x)."""
+    """Run Yade on an export with a tangential law (`parameters["material"]`, the explicit
+    ViscElMat): one sphere (mass `m` kg, radius `radius` m, no spin) meeting the fixed wall
+    z = 0 at `v_n`, `v_t` (m/s), or (an export without `geometry="wall"`) two such spheres
+    at those relative speeds, first touch half a step away, NewtonIntegrator damping 0.
+    Returns `(e, e_t, omega)`: the normal and tangential restitution (of the centres'
+    relative velocity for two spheres) and the first sphere's spin after about y (rad/s,
+    positive rolling along +x on the wall)."""
     rho = m / (4.0 / 3.0 * math.pi * radius**3)
-    args = (parameters["material"], rho, radius, v_n, v_t, parameters["timestep"])
+    pair = parameters.get("geometry", "spheres") != "wall"
+    args = (parameters["material"], rho, radius, v_n, v_t, parameters["timestep"], pair)
     with tempfile.TemporaryDirectory() as folder:
         path = os.path.join(folder, "oblique.py")
         with open(path, "w") as handle:

@@ -26,13 +26,16 @@ from scipy.integrate import solve_ivp
 
 def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_star=None,
                    history="displacement", beta=0.0, rtol=1e-12, max_switches=40,
-                   share=0.0, b_tsuji=0.0):  # fmt: skip
+                   share=0.0, b_tsuji=0.0, kelvin_voigt=None, end="penetration"):  # fmt: skip
     """Returns dict(e, v_t_out, omega_out, T, switches). `beta` (Mindlin only): the damper
     `2 (5/6)^0.5 beta (m k_t)^0.5` on the slip while sticking, left out of Coulomb's test
     (LIGGGHTS' convention), so the switches are the undamped ones' formulas. `share` f: the
     tangential force acts inside the overlap `x`, lever arm `R - f x` in the slip and the
     torque (0: `R`). `b_tsuji`: Tsuji's damping `b x^0.25 v` added to the normal force
-    (N s/m^1.25), which pulls before the overlap closes."""
+    (N s/m^1.25), which pulls before the overlap closes. `kelvin_voigt=(k, b)`: the
+    normal force is `k x + b v` instead (N/m, N s/m; it starts at `b v_n`, so the contact
+    sticks at first touch); `end="force"`: contact ends where the normal force falls to 0
+    (else at x = 0)."""
     moment = inertia * m * R**2
     mindlin = G_star is not None
 
@@ -48,6 +51,10 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
     def normal(x, v):
         xp = max(x, 0.0)
         v = v if xp > 0 else 0.0  # outside the surface: no force, no rate
+        if kelvin_voigt is not None:
+            k_n, b_n = kelvin_voigt
+            f = k_n * xp + b_n * v if xp > 0 else 0.0
+            return f, k_n * v + b_n * (-f / m)
         f = c * xp**1.5 * (1.0 + 1.5 * a * v) + b_tsuji * xp**0.25 * v
         acc = -f / m
         df = 1.5 * c * math.sqrt(xp) * v * (1.0 + 1.5 * a * v) + c * xp**1.5 * 1.5 * a * acc
@@ -112,12 +119,13 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
         return s * u - mu * df / k
 
     # first touch at t0 (tiny): leading-order state
-    T_scale = (m**2 / (c**2 * v_n)) ** 0.2
+    T_scale = (m**2 / (c**2 * v_n)) ** 0.2 if kelvin_voigt is None else (m / kelvin_voigt[0]) ** 0.5
     t0 = 1e-9 * T_scale
     x0 = v_n * t0
     u0 = v_t - R * omega
     limit = mu * c * (1.0 + 1.5 * a * v_n) * v_n
-    if u0 == 0 or b_tsuji > 0:  # Tsuji's limit grows as t^0.25, faster than any spring
+    # Tsuji's limit grows as t^0.25, faster than any spring; Kelvin-Voigt's starts at b v_n
+    if u0 == 0 or b_tsuji > 0 or kelvin_voigt is not None:
         mode = "stick"
     elif not mindlin:
         mode = "slip"
@@ -139,7 +147,10 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
     t = t0
     switches = 0
     for _ in range(max_switches):
-        ev_sep = lambda t, y, *args: y[0]  # noqa: E731
+        if end == "force":
+            ev_sep = lambda t, y, *args: normal(y[0], y[1])[0] if y[0] > 0 else y[0]  # noqa: E731
+        else:
+            ev_sep = lambda t, y, *args: y[0]  # noqa: E731
         ev_sep.terminal, ev_sep.direction = True, -1
         if mode == "stick":
 
