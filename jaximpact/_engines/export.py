@@ -95,7 +95,9 @@ class Export:
       its continuous law) and of the given law (None when targets were given) over a range
       of speeds.
     - `warnings`: where the engine will not do what was asked, or only with care.
-    - With a tangential law (`export(tangential=...)`): `tangential`, and at `v0` from
+    - With a tangential law (`export(tangential=...)`): `tangential`, the engine's (as
+      `law`: the given one, its forces halved for two spheres of mass `m` as the normal
+      law's are, so that the pair moves as the law moves `m`), and at `v0` from
       `angles` (degrees from the normal) the tangential restitution `e_t_engine`, the
       spin after `omega_engine` (rad/s; of each sphere for two spheres, which turn alike,
       the sense that rolls a sphere on the wall along its tangential velocity) and the
@@ -106,7 +108,8 @@ class Export:
       continuous laws (LAMMPS: the real LAMMPS on a wall within 0.002 at the recommended
       step, two spheres within 0.01, whose line of centres turns during contact: a
       warning estimates by how much where it matters); and
-      `e_t_target`, the given law's with `tangential` (None from targets).
+      `e_t_target`, the given laws' at mass `m` (the pair's effective radius and inertia
+      for two spheres; None from targets).
     """
 
     engine: str
@@ -306,11 +309,14 @@ def export(
             warnings += [note] if note else []
     parameters, oblique = out.parameters, {}
     if tangential is not None:
-        parameters = chosen.with_tangential(parameters, tangential)
-        oblique = _oblique_promise(chosen, parameters, engine_law, out.separation, tangential,
-                                   source, m=m, v0=v0, radius=radius,
+        # the normal export moves the scene's mass (m/2 for two spheres) as the law moves
+        # m, its forces scaled by that ratio: the tangential law's forces alike
+        exported = tangential.forces_scaled(chosen.effective_mass(m, geometry) / m)
+        parameters = chosen.with_tangential(parameters, exported)
+        oblique = _oblique_promise(chosen, parameters, engine_law, out.separation, exported,
+                                   source, tangential, m=m, v0=v0, radius=radius,
                                    geometry=geometry)  # fmt: skip
-        warnings += chosen.tangential_changes(parameters, tangential)
+        warnings += chosen.tangential_changes(parameters, exported)
         if chosen.FRICTION is not None:
             warnings.append(_friction_note(chosen, tangential, oblique))
         elif source is not None and (departure := _departure(oblique))[0] > E_T_WARN:
@@ -348,15 +354,17 @@ E_T_WARN = 0.005
 TURN_WARN = 0.01
 
 
-def _oblique_promise(chosen, parameters, engine_law, separation, tangential, source, *, m,
-                     v0, radius, geometry):  # fmt: skip
+def _oblique_promise(chosen, parameters, engine_law, separation, tangential, source,
+                     given, *, m, v0, radius, geometry):  # fmt: skip
     """The oblique impacts at speed `v0` (m/s) from `OBLIQUE_ANGLES` (no spin before) that
     the engine realises with `parameters`: its own stepping where it is replicated
     (`chosen.oblique`, the mean over first-touch phases), else its continuous laws (its
     normal law `engine_law`, the exported `tangential` law) through `oblique_impact`; and
-    the tangential restitution of the given law `source` with `tangential` (None from
-    targets). A sphere of mass `m` (kg) and radius `radius` (m) on the wall, or the pair's
-    effective sphere (`two_spheres`) for two spheres."""
+    the tangential restitution of the given law `source` with the given tangential law
+    `given` (None from targets). A sphere of mass `m` (kg) and radius `radius` (m) on the
+    wall, or the pair's effective sphere (`two_spheres`) for two spheres; the given laws
+    move it at mass `m` (the normal export's convention: the law's e and T at `m`, realised
+    by the pair at `m/2` with its forces halved, the tangential ones too)."""
     import numpy as np
 
     from .._oblique import incidence, oblique_impact, two_spheres
@@ -367,10 +375,11 @@ def _oblique_promise(chosen, parameters, engine_law, separation, tangential, sou
         scene = dict(m=m, R=radius, inertia=0.4)
     v_n, v_t = (np.asarray(v, float) for v in incidence(v0, np.deg2rad(OBLIQUE_ANGLES)))
 
-    def continuous(normal_law, tangential_law, contact_point=0.0, ends=separation):
+    def continuous(normal_law, tangential_law, contact_point=0.0, ends=separation, body=None):
         # a soft spring sticks and slips many times (throw=False: a solve that still
         # fails is NaN in the promise, not an error of the export)
-        rows = [oblique_impact(normal_law, tangential_law, **scene, v_n=float(a), v_t=float(b),
+        body = scene if body is None else body
+        rows = [oblique_impact(normal_law, tangential_law, **body, v_n=float(a), v_t=float(b),
                                separation=ends, contact_point=contact_point,
                                max_segments=64, throw=False)
                 for a, b in zip(v_n, v_t, strict=True)]  # fmt: skip
@@ -387,9 +396,11 @@ def _oblique_promise(chosen, parameters, engine_law, separation, tangential, sou
     if chosen.TWO_SPHERES and geometry != "wall":
         # each sphere's spin: both turn alike, R* W* = R (w1 + w2) for the pair's slip
         omega = omega * scene["R"] / (2.0 * radius)
-    # the law's own: under the force criterion, as its e and T (`_targets`)
-    target = (None if source is None
-              else tuple(map(float, continuous(source, tangential, ends="force")[1])))  # fmt: skip
+    # the law's own: under the force criterion, as its e and T (`_targets`), at mass m
+    target = None
+    if source is not None:
+        at_m = dict(scene, m=m)
+        target = tuple(map(float, continuous(source, given, ends="force", body=at_m)[1]))
     return dict(tangential=tangential, angles=OBLIQUE_ANGLES, e_t_engine=tuple(map(float, e_t)),
                 omega_engine=tuple(map(float, omega)), e_n_engine=tuple(map(float, e_n)),
                 e_t_target=target)  # fmt: skip

@@ -39,6 +39,7 @@ Damping on the slip while sticking, in the two conventions the engines use:
 
 import abc
 import dataclasses
+from typing import ClassVar
 
 import equinox as eqx
 import jax.numpy as jnp
@@ -152,6 +153,8 @@ class AbstractTangentialLaw(eqx.Module):
     name: eqx.AbstractVar[str]
     spec: eqx.AbstractVar[TangentialSpec]
     params: eqx.AbstractVar[dict[str, Array]]
+    # the parameters a force is proportional to (`forces_scaled`)
+    FORCE_PARAMETERS: ClassVar[tuple[str, ...]] = ()
 
     @abc.abstractmethod
     def stiffness(self, x, *, R):
@@ -166,6 +169,14 @@ class AbstractTangentialLaw(eqx.Module):
     def mu(self) -> Array:
         """Coulomb's friction coefficient."""
         return self.params["mu"]
+
+    def forces_scaled(self, factor: float) -> "AbstractTangentialLaw":
+        """The law whose tangential force is `factor` times this one's in every state:
+        its stiffness and damper scaled (`FORCE_PARAMETERS`), `mu` and damping ratios
+        kept. With a normal force scaled alike it moves a body of mass `factor m` as this
+        law moves `m` (an export's two spheres of mass `m`: `factor` 1/2)."""
+        names = [k for k in self.FORCE_PARAMETERS if k in self.params]
+        return self.replace(**{k: self.params[k] * factor for k in names})
 
     def damping_scale(self, *, m, R) -> tuple[Array, float]:
         """`(D0, power)` of the damper on the slip while sticking, `D = D0 x^power` (N s/m at
@@ -230,6 +241,7 @@ class LinearHistoryLaw(AbstractTangentialLaw):
     """
 
     params: dict[str, Array]
+    FORCE_PARAMETERS: ClassVar[tuple[str, ...]] = ("kt", "ct")
 
     @property
     def name(self) -> str:
@@ -266,6 +278,7 @@ class MindlinLaw(AbstractTangentialLaw):
 
     name: str = eqx.field(static=True)
     params: dict[str, Array]
+    FORCE_PARAMETERS: ClassVar[tuple[str, ...]] = ("G_star",)  # beta is a ratio
 
     @property
     def spec(self) -> TangentialSpec:

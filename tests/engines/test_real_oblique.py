@@ -100,3 +100,22 @@ def test_the_clause_is_lammps_own():
     for key in ("pair_coeff", "fix_wall"):
         assert "tangential mindlin 1.08e+11 0 0.092" in x.parameters[key]
     assert x.to_dict()["tangential"]["name"] == "mindlin"
+
+
+def test_two_spheres_get_the_law_at_the_pair_s_mass_tangential_forces_halved():
+    """The normal export realises the law's e and T at mass `m` with two spheres of mass
+    `m` (effective mass m/2: its forces halved); the tangential law's forces are halved
+    alike (8 G* 1.08e11 -> 5.4e10), so the pair moves as the law moves `m`, and the law's
+    own e_t is computed so too (mass m, the pair's effective radius). The pair's promise
+    then departs from the law's e_t as the wall's does (0.0167 and 0.0154 at 5 degrees:
+    Tsuji's force under LAMMPS's end at x = 0 against the law's force criterion), where
+    before this stop, the spring not halved, the pair's departed by 0.24."""
+    wall, pair = (ji.export(LAW, "lammps", m=M, v0=3.9, radius=R, geometry=geometry,
+                            tangential=TANGENTIAL["mindlin"], curves=False)
+                  for geometry in ("wall", "spheres"))  # fmt: skip
+    assert "tangential mindlin 5.4e+10 0 0.092" in pair.parameters["pair_coeff"]
+    assert "tangential mindlin 1.08e+11 0 0.092" in wall.parameters["pair_coeff"]
+    assert pair.tangential.params["G_star"] == pytest.approx(6.75e9)  # the engine's, as `law`
+    gaps = [np.subtract(x.e_t_engine, x.e_t_target) for x in (wall, pair)]
+    assert np.abs(gaps[1] - gaps[0]).max() < 0.002, gaps
+    assert np.abs(gaps[1]).max() < 0.02, gaps

@@ -560,3 +560,23 @@ def test_a_spring_held_at_the_limit_that_sticks_until_the_end_of_contact():
         assert row["e"] == pytest.approx(o["e"], rel=1e-8), share
         assert row["v_t_out"] == pytest.approx(o["v_t_out"], rel=1e-7), share
         assert row["omega_out"] == pytest.approx(o["omega_out"], rel=1e-7), share
+
+
+@pytest.mark.slow
+def test_forces_scaled_move_a_lighter_body_alike():
+    """`forces_scaled(f)` with the normal force scaled by f moves a body of mass `f m` as
+    the unscaled laws move `m` (the export's two spheres): e, e_t and the spin agree to
+    1e-9, for a spring and for Mindlin, where the stick-slip switches are the same."""
+    law, half = ji.law("kelvin_voigt", c=2e5, b=3.0), ji.law("kelvin_voigt", c=1e5, b=1.5)
+    for tl in (tangential_law("linear_history", kt=1e5, mu=0.3),
+               tangential_law("mindlin", G_star=2e8, mu=0.2)):  # fmt: skip
+        scaled = tl.forces_scaled(0.5)
+        for degrees in (10.0, 45.0):
+            v_n, v_t = (float(v) for v in incidence(1.0, np.deg2rad(degrees)))
+            a = oblique_impact(law, tl, m=0.05, R=0.005, v_n=v_n, v_t=v_t, rtol=1e-12)
+            b = oblique_impact(half, scaled, m=0.025, R=0.005, v_n=v_n, v_t=v_t, rtol=1e-12)
+            assert int(a.num_switches) == int(b.num_switches)
+            for key in ("e", "e_t", "omega_out"):
+                assert float(b[key] if isinstance(b, dict) else getattr(b, key)) == (
+                    pytest.approx(float(getattr(a, key)), rel=1e-9, abs=1e-12)
+                ), (tl.name, degrees, key)
