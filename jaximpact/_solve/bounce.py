@@ -28,7 +28,7 @@ from .._curves.gravity import WithGravity
 from .._curves.shapes import curve_key
 from .._laws import AbstractLaw, shape_of
 from .._status import Status
-from .adjoint import auto_adjoint
+from .adjoint import auto_adjoint, by_forward_jacobian, reverse_only
 from .flight import Flight
 from .impact import CURVES_RTOL, SEPARATIONS, ImpactOptions, gravity_impact, similarity_reason
 from .options import adhesion_table_key
@@ -610,7 +610,11 @@ def bounce(
             raise ValueError(message)
     else:
         h0 = eqx.error_if(h0, resting, message)
-    if adjoint is None:
+    # jax.grad alone: the forward-mode Jacobian, transposed (`adjoint.by_forward_jacobian`)
+    by_forward = adjoint is None and reverse_only(law, m, h0, v_drop, g, drag, t_end)
+    if by_forward:
+        adjoint = dfx.ForwardMode()
+    elif adjoint is None:
         adjoint = auto_adjoint(law, m, h0, v_drop, g, drag, t_end)
     options = bounce_options(
         separation=separation,
@@ -626,7 +630,15 @@ def bounce(
         method=method,
     )
     start = (jnp.zeros(()), h0, -v_drop)
-    result = solve_bounce(law, m, g, drag, start, t_end, min_flight, options)
+    if by_forward:
+        # a force closing over a traced value: that value becomes an input
+        solve, closed = jax.closure_convert(
+            lambda *args: solve_bounce(*args, options), law, m, g, drag, start, t_end, min_flight
+        )
+        result = by_forward_jacobian((law, m, g, drag, start, t_end, min_flight, *closed),
+                                     fn=solve)  # fmt: skip
+    else:
+        result = solve_bounce(law, m, g, drag, start, t_end, min_flight, options)
     if throw:
         result = eqx.error_if(
             result,

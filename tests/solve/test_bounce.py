@@ -319,7 +319,18 @@ def test_euler_converges_to_the_penetration_criterion():
 
 
 @pytest.mark.slow
-def test_gradients_forward_reverse_and_finite_differences():
+def test_gradients_forward_reverse_and_finite_differences(monkeypatch):
+    """Reverse mode (jacrev) goes through the forward-mode Jacobian, transposed
+    (`adjoint.by_forward_jacobian`: a jitted grad of a user's law's third impact time took
+    1.2 ms against 10.6 ms through diffrax's reverse mode, its first call 16 s against
+    28 s, measured), and equals jacfwd and central differences."""
+    from jaximpact._solve import bounce as bounce_module
+
+    calls = []
+    wrapped = bounce_module.by_forward_jacobian
+    monkeypatch.setattr(bounce_module, "by_forward_jacobian",
+                        lambda *a, **k: calls.append(1) or wrapped(*a, **k))  # fmt: skip
+
     def f(p):
         b = bounce(ji.law("hertz_rate", c=p[0], b1=p[1]), m=M, h0=H0, t_end=1.5, max_impacts=8)
         return jnp.concatenate([b.impact_times[:4], b.e[:4]])
@@ -327,6 +338,7 @@ def test_gradients_forward_reverse_and_finite_differences():
     p = jnp.array([1e6, 1350.0])
     J_fwd = np.asarray(jax.jacfwd(f)(p))
     J_rev = np.asarray(jax.jacrev(f)(p))
+    assert calls, "jax.jacrev did not go through the forward Jacobian"
     scale = np.abs(J_fwd).max(axis=0)
     assert np.max(np.abs(J_fwd - J_rev) / scale) < 1e-10
     h = 1e-6
