@@ -562,7 +562,8 @@ def oblique_impact(
       user's law); `max_steps` per segment; `max_segments`: the most segments (one
       per tangential mode, one more at maximum compression for a law split there);
       `tau_max`, `rest_tol` as in `impact`.
-    - `adjoint`: default picks the cheapest diffrax adjoint for the transformation in use.
+    - `adjoint`: default picks the cheapest diffrax adjoint for the transformation in use
+      (under `jax.grad` alone, the forward-mode Jacobian transposed, as `impact`).
     - `land_events`: integrate each segment a second time to its event (`_land`), so that
       derivatives across the transitions use the vector field, not diffrax's interpolant
       (whose slope is 1e-5 off; a gradient through a stick-slip transition was 1e-4 off

@@ -565,7 +565,8 @@ def bounce(
       eager call whose sequence failed (a contact's solve ran out of steps or failed) warns,
       and keeps the contacts before the failed one (the failed one's fields are NaN).
     Differentiable (forward and reverse mode) in the law's parameters, `m`, `h0`, `v_drop`,
-    `g` and `drag`; works under `jax.vmap`.
+    `g` and `drag`; works under `jax.vmap`. Under `jax.grad` alone (no `adjoint` given) the
+    sequence's forward-mode Jacobian is transposed (`impact`'s rule).
 
     **Example**:
     ```python
