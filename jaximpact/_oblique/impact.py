@@ -16,7 +16,7 @@ import numpy as np
 
 from .._checks import check_nonnegative, check_positive, check_values, is_traced
 from .._laws import AbstractLaw
-from .._solve.adjoint import _tracer_kinds, auto_adjoint, by_forward_jacobian, reverse_only
+from .._solve.adjoint import _tracer_kinds, auto_adjoint, reverse_only, through_forward_jacobian
 from .._solve.impact import check_custom_law
 from .._solve.options import CUSTOM_RTOL, DEFAULT_RTOL
 from .._solve.phases import solve_broke
@@ -626,10 +626,10 @@ def oblique_impact(
     if adjoint is None and reverse_only(law, tangential, *values):
         # jax.grad: the forward-mode Jacobian, transposed (`adjoint.by_forward_jacobian`)
         forward = dataclasses.replace(options, adjoint=dfx.ForwardMode())
-        solve, closed = jax.closure_convert(
-            lambda *args: solve_oblique(*args, forward), law, tangential, *values
-        )
-        result = by_forward_jacobian((law, tangential, *values, *closed), fn=solve)
+        result = through_forward_jacobian(
+            lambda *args: solve_oblique(*args, forward), law, tangential, *values,
+            closes_over=law.spec is None,
+        )  # fmt: skip
     else:
         result = solve_oblique(law, tangential, *values, options)
     if throw is not False and not is_traced(result.status) and np.ndim(result.status) == 0:

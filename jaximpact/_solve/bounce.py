@@ -28,7 +28,7 @@ from .._curves.gravity import WithGravity
 from .._curves.shapes import curve_key
 from .._laws import AbstractLaw, shape_of
 from .._status import Status
-from .adjoint import auto_adjoint, by_forward_jacobian, reverse_only
+from .adjoint import auto_adjoint, reverse_only, through_forward_jacobian
 from .flight import Flight
 from .impact import CURVES_RTOL, SEPARATIONS, ImpactOptions, gravity_impact, similarity_reason
 from .options import adhesion_table_key
@@ -632,12 +632,10 @@ def bounce(
     )
     start = (jnp.zeros(()), h0, -v_drop)
     if by_forward:
-        # a force closing over a traced value: that value becomes an input
-        solve, closed = jax.closure_convert(
-            lambda *args: solve_bounce(*args, options), law, m, g, drag, start, t_end, min_flight
-        )
-        result = by_forward_jacobian((law, m, g, drag, start, t_end, min_flight, *closed),
-                                     fn=solve)  # fmt: skip
+        result = through_forward_jacobian(
+            lambda *args: solve_bounce(*args, options), law, m, g, drag, start, t_end,
+            min_flight, closes_over=law.spec is None,
+        )  # fmt: skip
     else:
         result = solve_bounce(law, m, g, drag, start, t_end, min_flight, options)
     if throw:

@@ -322,16 +322,15 @@ def impact(
     if path.integrates and adjoint is None and _reverse_only(law, m, v0, g, ts):
         import diffrax as dfx
 
-        from .adjoint import by_forward_jacobian
+        from .adjoint import through_forward_jacobian
 
         # jax.grad through the integration: the forward-mode Jacobian, transposed
         # (`adjoint.by_forward_jacobian`): 10x faster than a reverse solve, compiled sooner
         forward = dataclasses.replace(options, adjoint=dfx.ForwardMode())
-        # a user's force that closes over a traced value: that value becomes an input
-        solve, closed = jax.closure_convert(
-            lambda *args: solve_impact(*args, forward), law, m, v0, g, ts
-        )
-        result = by_forward_jacobian((law, m, v0, g, ts, *closed), fn=solve)
+        result = through_forward_jacobian(
+            lambda *args: solve_impact(*args, forward), law, m, v0, g, ts,
+            closes_over=law.spec is None,
+        )  # fmt: skip
     else:
         result = solve_impact(law, m, v0, g, ts, options)
     if path.name in ("gravity_table", "dry_table") and not is_traced(result.num_steps):

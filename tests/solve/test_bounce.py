@@ -327,8 +327,8 @@ def test_gradients_forward_reverse_and_finite_differences(monkeypatch):
     from jaximpact._solve import bounce as bounce_module
 
     calls = []
-    wrapped = bounce_module.by_forward_jacobian
-    monkeypatch.setattr(bounce_module, "by_forward_jacobian",
+    wrapped = bounce_module.through_forward_jacobian
+    monkeypatch.setattr(bounce_module, "through_forward_jacobian",
                         lambda *a, **k: calls.append(1) or wrapped(*a, **k))  # fmt: skip
 
     def f(p):
