@@ -427,8 +427,9 @@ def _turning_note(T: float, *, v0: float, radius: float) -> list[str]:
     (rad) during a contact of duration `T` (s), which a promise computed for one body
     against a fixed normal leaves out; their normal and tangential velocities then mix by
     about `tan(theta)` times that angle. A warning where that reaches 0.01 at the largest
-    angle (measured, LAMMPS and Yade: 0.008 at 45 degrees where it estimates 0.007; 0.23
-    in e at 75 degrees where it estimates 0.28)."""
+    angle. Measured at 75 degrees: Yade's soft pair (turn 0.075 rad, estimate 0.28) fell
+    0.23 in e and 0.036 in e_t; LAMMPS's Kharaz pair (turn 0.0096 rad, estimate 0.036)
+    0.0043 in e_t, 0.0077 at 45 degrees."""
     import numpy as np
 
     theta = np.deg2rad(max(OBLIQUE_ANGLES))
@@ -438,9 +439,10 @@ def _turning_note(T: float, *, v0: float, radius: float) -> list[str]:
         return []
     return [
         f"two spheres turn their line of centres by about {turn:.2g} rad during contact "
-        f"at {max(OBLIQUE_ANGLES):g} degrees (v_t T / 2R), which the promised e_t, spin and "
-        f"e hold fixed: the engine's may fall about {mixing:.2g} from them there (less at "
-        "smaller angles); a wall (geometry='wall') or a shorter contact keeps it small"
+        f"at {max(OBLIQUE_ANGLES):g} degrees (v_t T / 2R), which the promise holds fixed: "
+        f"the engine's e may fall up to about {mixing:.2g} below it there, its e_t and spin "
+        "by less (and all less at smaller angles); a wall (geometry='wall') or a shorter "
+        "contact keeps it small"
     ]
 
 
