@@ -255,7 +255,10 @@ def _run_export(args):
             lines.append(f"tangential {x.tangential.name}: what the engine realises at v0 "
                          "(no spin before)")  # fmt: skip
             law = x.e_t_target is not None
-            lines.append("  angle (deg)   e_t       spin after (rad/s)   e normal"
+            # two spheres: relative e_t and e, each sphere's spin (they turn alike)
+            pair = "two equal spheres" in x.scene
+            spin = "each spin (rad/s)" if pair else "spin after (rad/s)"
+            lines.append(f"  angle (deg)   e_t       {spin:<18}   e normal"
                          + ("   e_t law" if law else ""))  # fmt: skip
             rows = zip(x.angles, x.e_t_engine, x.omega_engine, x.e_n_engine, strict=True)
             for k, (angle, e_t, omega, e_n) in enumerate(rows):
