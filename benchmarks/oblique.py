@@ -136,6 +136,20 @@ def _rows(name, params, oracle_params):
     switches = f"{int(got1[0, 2])} switches" + ("" if same1 else " (oracle differs)")
     counts = np.bincount(got[:, 2].astype(int))
     spread = ", ".join(f"{k}: {n}" for k, n in enumerate(counts) if n)
+    # jax.grad of e_t by mu: the default (the forward-mode Jacobian, transposed) against
+    # diffrax's reverse mode through the same solve, and a central difference
+    import diffrax as dfx
+
+    def e_t(mu, adjoint=None):
+        r = ji.oblique_impact(law, tl.replace(mu=mu), m=m, R=R, v_n=v_n1, v_t=v_t1,
+                              adjoint=adjoint, land_events=True)  # fmt: skip
+        return r.e_t
+
+    grad = jax.jit(jax.grad(e_t))
+    grad_reverse = jax.jit(jax.grad(lambda mu: e_t(mu, dfx.RecursiveCheckpointAdjoint())))
+    d, d_reverse = float(grad(MU)), float(grad_reverse(MU))
+    d_fd = (float(e_t(MU * (1 + 1e-6))) - float(e_t(MU * (1 - 1e-6)))) / (2e-6 * MU)
+    t_grad, t_reverse = time_call(grad, MU)[0], time_call(grad_reverse, MU)[0]
     return [
         [
             f"{name}: one jitted impact, {THETA:g} degrees ({switches})",
@@ -149,6 +163,14 @@ def _rows(name, params, oracle_params):
             f"{t_many * 1e6:.0f} µs, max error {err:.1e}",
             f"DOP853 rtol {rtol:g}: {o_many * 1e6:.0f} µs, max error {oerr:.1e}",
             f"{o_many / t_many:.0f}x",
+        ],
+        [
+            f"{name}: one jitted `jax.grad` of e_t by mu, {THETA:g} degrees (default: the "
+            "forward Jacobian, transposed; against diffrax's reverse mode, not scipy)",
+            f"{t_grad * 1e6:.0f} µs, de_t/dmu {d:.7f}",
+            f"reverse mode: {t_reverse * 1e6:.0f} µs, {d_reverse:.7f}; central difference "
+            f"{d_fd:.7f}",
+            f"{t_reverse / t_grad:.1f}x",
         ],
     ], (compile_one, compile_many)
 
