@@ -674,14 +674,23 @@ def test_cli_fit_options_out_of_range(capsys, tmp_path, option):
     scale=st.floats(min_value=1e-3, max_value=1e3),
     v0=GOOD_SPEED,
 )
+@example(name="dmt", scale=696.0, v0=1.0)  # found locally: runs out of the default steps
 def test_every_law_impact_is_a_result_or_a_status(name, scale, v0):
     """Every law of the table, its damping scaled by any factor, at any ordinary speed: a
-    separated impact with 0 < e <= 1 and T > 0, or another status with e = 0; no NaN."""
+    separated impact with 0 < e <= 1 and T > 0, or another status with e = 0; no NaN. A
+    solve that runs out of steps (a heavily damped body creeping to rest, stiff for the
+    explicit solver: `dmt` with its damping x696 at 1 m/s needs 4,138 steps) raises the
+    failure rule's one line, and its advice, a larger `max_steps`, must then work."""
     law = _start(name)
     damping = ji.LAWS[name].damping
     if damping is not None and damping != "e_nominal":
         law = law.replace(**{damping: float(law.parameters[damping]) * scale})
-    r = ji.impact(law, m=1.0, v0=v0)
+    try:
+        r = ji.impact(law, m=1.0, v0=v0)
+    except RuntimeError as error:
+        _one_line(error)
+        assert "raise max_steps" in str(error), str(error)
+        r = ji.impact(law, m=1.0, v0=v0, max_steps=65_536)
     for key in ("e", "T", "x_max", "F_max", "dissipated"):
         assert math.isfinite(float(getattr(r, key))), (name, key)
     if int(r.status) == ji.Status.separated:
