@@ -64,6 +64,8 @@ FIRST_TOUCH = 1e-6
 # beyond its tangential condition before it counts as overtaken: the forces near the end
 # of contact carry the solve's error (1e-12 measured), which must not count
 OVERTAKEN = 1e-8
+# two mode changes this close in time (units of t*) are one instant: a ping-pong (`_segment`)
+PING_PONG = 1e-9
 
 
 class ObliqueOptions(eqx.Module):
@@ -94,7 +96,7 @@ def _conditions(dyn: ObliqueDynamics, separation: str, rest_tol: float):
     normal, size = dyn.normal, dyn.size
 
     def end(t, y, args, **kwargs):
-        _, _, compressing, mute = args
+        _, _, compressing, mute, _ = args
         y_n = y[:size]
         if separation == "force":
             gap = normal.force_gap(y_n, compressing)
@@ -103,24 +105,24 @@ def _conditions(dyn: ObliqueDynamics, separation: str, rest_tol: float):
         return jnp.where(mute, 1.0, jnp.where(compressing, normal.velocity(y_n), gap))
 
     def back_in(t, y, args, **kwargs):
-        _, _, compressing, mute = args
+        _, _, compressing, mute, _ = args
         return jnp.where(compressing | mute, 1.0, -normal.velocity(y[:size]))
 
     def at_rest(t, y, args, **kwargs):
-        _, _, compressing, mute = args
+        _, _, compressing, mute, _ = args
         y_n = y[:size]
         net = normal.force(y_n, compressing) - normal.gamma
         return jnp.where(mute, 1.0, jnp.abs(normal.velocity(y_n)) + jnp.abs(net) - rest_tol)
 
     def mode_ends(t, y, args, **kwargs):
-        mode, sense, compressing, _ = args
-        return dyn.switch(y, mode, sense, compressing)
+        mode, sense, compressing, _, pinned = args
+        return jnp.where(pinned, 1.0, dyn.switch(y, mode, sense, compressing))
 
     conditions = [end, back_in, at_rest]
     if separation == "force" and normal.surface_gap(normal.y0()) is not None:
 
         def surface(t, y, args, **kwargs):
-            _, _, compressing, mute = args
+            _, _, compressing, mute, _ = args
             return jnp.where(compressing | mute, 1.0, normal.surface_gap(y[:size]))
 
         conditions.append(surface)
@@ -224,8 +226,9 @@ def _segment(setup: _Setup, carry, _):
     dyn, options, conditions, event = setup.dyn, setup.options, setup.conditions, setup.event
     term, controller, has_surface = setup.term, setup.controller, setup.has_surface
     normal, size = dyn.normal, dyn.size
-    y, tau, mode, sense, compressing, mute, t_stop, alive, status, switches, steps = carry
-    args = (mode, sense, compressing, mute)
+    y, tau, mode, sense, compressing, mute, t_stop, alive, status, switches, steps, pin = carry
+    pinned, last_change = pin
+    args = (mode, sense, compressing, mute, pinned)
     t1 = jnp.where(alive, t_stop, tau)
     sol = dfx.diffeqsolve(
         term,
@@ -272,6 +275,7 @@ def _segment(setup: _Setup, carry, _):
         alive
         & ~switched
         & ~broke
+        & ~pinned
         & (dyn.switch(y1, mode, sense, compressing, sign) < -OVERTAKEN)
         & jnp.all(jnp.isfinite(y1))
     )
@@ -315,15 +319,22 @@ def _segment(setup: _Setup, carry, _):
     change = alive & ~done & ((switched & ~redo) | at_once)
     y_at = jnp.where(at_once, y, y1)
     tau_at = jnp.where(at_once, tau, tau1)
+    # a change at the instant of the previous one: neither mode holds there (the limit
+    # mu |F_n| falling to 0 near the contact's end, the spring at it, the sliding speed
+    # 0), and the modes would take turns for ever. The contact slides on at the limit
+    # (the force of a spring held there) with its tangential condition muted until the
+    # next normal event: `pinned`.
+    pinning = change & (jnp.abs(tau_at - last_change) <= PING_PONG)
     to_slip = change & (mode == STICK)
-    to_stick = change & (mode == SLIP)
+    to_stick = change & (mode == SLIP) & ~pinning
     y_next = jnp.where(to_stick, dyn.held(y_at, sense, compressing), y_at)
     y_next = jnp.where(redo, y, y_next)
     sense_next = jnp.where(to_slip, -jnp.sign(dyn.tested(y_at)), sense)
+    mode_next = jnp.where(pinning, SLIP, jnp.where(change, 1 - mode, mode))
     carry = (
         jnp.where(alive, y_next, y),
         jnp.where(alive & ~redo, tau_at, tau),
-        jnp.where(change, 1 - mode, mode),
+        mode_next,
         sense_next,
         compressing & ~(alive & at_max & ~overtaken),
         alive & redo,
@@ -332,6 +343,7 @@ def _segment(setup: _Setup, carry, _):
         jnp.where(alive & done, status_now, status).astype(jnp.int32),
         switches + change.astype(jnp.int32),
         steps + jnp.where(alive, sol.stats["num_steps"], 0),
+        (alive & pinning, jnp.where(change, tau_at, last_change)),
     )
     return carry, None
 
@@ -375,7 +387,7 @@ def _segments(dyn: ObliqueDynamics, y0, options: ObliqueOptions):
         FIRST_TOUCH,
         None,
         y0,
-        args=(mode, sense, compressing, jnp.asarray(False)),
+        args=(mode, sense, compressing, jnp.asarray(False), jnp.asarray(False)),
         stepsize_controller=dfx.PIDController(rtol=options.rtol, atol=1e-14),
         saveat=dfx.SaveAt(t1=True),
         adjoint=options.adjoint,
@@ -386,11 +398,11 @@ def _segments(dyn: ObliqueDynamics, y0, options: ObliqueOptions):
     tau0 = jnp.asarray(FIRST_TOUCH)
     no = jnp.asarray(False)
     carry = (y_in, tau0, mode, sense, compressing, no, tau_max, jnp.asarray(True), zero - 1,
-             zero, zero)  # fmt: skip
+             zero, zero, (no, -jnp.ones_like(tau0)))  # fmt: skip
     carry, _ = jax.lax.scan(
         functools.partial(_segment, setup), carry, None, length=options.max_segments
     )
-    y, tau, _, _, _, _, _, alive, status, switches, steps = carry
+    y, tau, _, _, _, _, _, alive, status, switches, steps, _ = carry
     # still going after max_segments solves: counted as out of steps
     status = jnp.where(alive, Status.out_of_steps, status).astype(jnp.int32)
     return y, tau, status, switches, steps
