@@ -321,7 +321,7 @@ def export(
             warnings.append(_friction_note(chosen, tangential, oblique))
         elif source is not None and (departure := _departure(oblique))[0] > E_T_WARN:
             warnings.append(departure[1] + _contact_point_note(chosen, geometry))
-        if chosen.TWO_SPHERES and geometry != "wall":
+        if _two_spheres(chosen, geometry):
             warnings += _turning_note(out.T, v0=v0, radius=radius)
     return Export(
         engine=engine,
@@ -369,7 +369,7 @@ def _oblique_promise(chosen, parameters, engine_law, separation, tangential, sou
 
     from .._oblique import incidence, oblique_impact, two_spheres
 
-    if chosen.TWO_SPHERES and geometry != "wall":
+    if _two_spheres(chosen, geometry):
         scene = two_spheres(m, radius, m, radius)
     else:
         scene = dict(m=m, R=radius, inertia=0.4)
@@ -393,7 +393,7 @@ def _oblique_promise(chosen, parameters, engine_law, separation, tangential, sou
         e_n, e_t, omega = continuous(engine_law, realised, _engine_share(chosen, geometry))
     else:
         e_n, e_t, omega = (np.asarray(a).mean(axis=-1) for a in stepped)
-    if chosen.TWO_SPHERES and geometry != "wall":
+    if _two_spheres(chosen, geometry):
         # each sphere's spin: both turn alike, R* W* = R (w1 + w2) for the pair's slip
         omega = omega * scene["R"] / (2.0 * radius)
     # the law's own: under the force criterion, as its e and T (`_targets`), at mass m
@@ -446,12 +446,17 @@ def _turning_note(T: float, *, v0: float, radius: float) -> list[str]:
     ]
 
 
+def _two_spheres(chosen, geometry) -> bool:
+    """Whether the export's scene is two equal spheres (a two-sphere engine, no wall)."""
+    return chosen.effective_mass(1.0, geometry) != 1.0
+
+
 def _engine_share(chosen, geometry) -> float:
     """`oblique_impact`'s `contact_point` for the engine's scene: each sphere's share of
     the overlap off its lever arm (`CONTACT_POINT`), halved for two equal spheres through
     their effective radius."""
     share = chosen.CONTACT_POINT[geometry]
-    return share / 2.0 if chosen.TWO_SPHERES and geometry != "wall" else share
+    return share / 2.0 if _two_spheres(chosen, geometry) else share
 
 
 def _contact_point_note(chosen, geometry) -> str:

@@ -16,7 +16,12 @@ import numpy as np
 
 from .._checks import check_nonnegative, check_positive, check_values, is_traced
 from .._laws import AbstractLaw
-from .._solve.adjoint import _tracer_kinds, auto_adjoint, reverse_only, through_forward_jacobian
+from .._solve.adjoint import (
+    auto_adjoint,
+    differentiation_kinds,
+    reverse_only,
+    through_forward_jacobian,
+)
 from .._solve.impact import check_custom_law
 from .._solve.options import CUSTOM_RTOL, DEFAULT_RTOL
 from .._solve.phases import solve_broke
@@ -471,10 +476,7 @@ def solve_oblique(law, tangential, m, R, v_n, v_t, omega, inertia, g, options: O
 
 def _differentiated(*trees) -> bool:
     """Whether any input is traced for differentiation (forward or reverse mode)."""
-    kinds: set = set()
-    for leaf in jax.tree_util.tree_leaves(trees):
-        _tracer_kinds(leaf, kinds)
-    return bool(kinds)
+    return bool(differentiation_kinds(*trees))
 
 
 def _finite(name, value, unit):

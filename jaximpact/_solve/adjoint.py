@@ -52,13 +52,19 @@ def _tracer_kinds(leaf, kinds: set):
     return kinds
 
 
-def reverse_only(*trees) -> bool:
-    """Whether the leaves of `trees` are traced by reverse-mode differentiation and no
-    forward mode (`jax.grad`, `jax.vjp`; through `vmap` too)."""
+def differentiation_kinds(*trees) -> set:
+    """The differentiation modes (`"forward"`, `"reverse"`) the leaves of `trees` are
+    traced under; empty where none is differentiated."""
     kinds: set = set()
     for leaf in jax.tree_util.tree_leaves(trees):
         _tracer_kinds(leaf, kinds)
-    return kinds == {"reverse"}
+    return kinds
+
+
+def reverse_only(*trees) -> bool:
+    """Whether the leaves of `trees` are traced by reverse-mode differentiation and no
+    forward mode (`jax.grad`, `jax.vjp`; through `vmap` too)."""
+    return differentiation_kinds(*trees) == {"reverse"}
 
 
 def _is_none(x) -> bool:
@@ -116,9 +122,7 @@ def auto_adjoint(*trees) -> dfx.AbstractAdjoint:
     to choose yourself (needed for `jax.jacfwd(jax.jit(f))`, where the solve is traced
     before the transformation is known).
     """
-    kinds: set = set()
-    for leaf in jax.tree_util.tree_leaves(trees):
-        _tracer_kinds(leaf, kinds)
+    kinds = differentiation_kinds(*trees)
     if kinds == {"forward"}:
         return dfx.ForwardMode()
     if "forward" in kinds:

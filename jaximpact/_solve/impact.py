@@ -207,15 +207,6 @@ def gravity_impact(dynamics, m, v0, g, options: ImpactOptions):
     return ImpactResult(**values, path="similarity"), x
 
 
-def _reverse_only(*inputs) -> bool:
-    """`adjoint.reverse_only`, without importing diffrax where nothing is traced."""
-    if not any(is_traced(leaf) for leaf in jax.tree_util.tree_leaves(inputs)):
-        return False
-    from .adjoint import reverse_only
-
-    return reverse_only(*inputs)
-
-
 def impact(
     law: AbstractLaw,
     *,
@@ -319,19 +310,21 @@ def impact(
         inputs=(law, m, v0, g, ts),
         gravity=not is_no_gravity(given_g),
     )
-    if path.integrates and adjoint is None and _reverse_only(law, m, v0, g, ts):
+    result = None
+    if path.integrates and adjoint is None:  # diffrax is imported there (`make_options`)
         import diffrax as dfx
 
-        from .adjoint import through_forward_jacobian
+        from .adjoint import reverse_only, through_forward_jacobian
 
-        # jax.grad through the integration: the forward-mode Jacobian, transposed
-        # (`adjoint.by_forward_jacobian`): 10x faster than a reverse solve, compiled sooner
-        forward = dataclasses.replace(options, adjoint=dfx.ForwardMode())
-        result = through_forward_jacobian(
-            lambda *args: solve_impact(*args, forward), law, m, v0, g, ts,
-            closes_over=law.spec is None,
-        )  # fmt: skip
-    else:
+        if reverse_only(law, m, v0, g, ts):
+            # jax.grad through the integration: the forward-mode Jacobian, transposed
+            # (`adjoint.by_forward_jacobian`): 10x faster than a reverse solve, compiled sooner
+            forward = dataclasses.replace(options, adjoint=dfx.ForwardMode())
+            result = through_forward_jacobian(
+                lambda *args: solve_impact(*args, forward), law, m, v0, g, ts,
+                closes_over=law.spec is None,
+            )  # fmt: skip
+    if result is None:
         result = solve_impact(law, m, v0, g, ts, options)
     if path.name in ("gravity_table", "dry_table") and not is_traced(result.num_steps):
         if int(result.num_steps) > 0:  # outside the table: integrated, and said so

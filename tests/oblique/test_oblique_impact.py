@@ -455,6 +455,21 @@ def test_float32_without_x64():
         assert row["e_t"] == pytest.approx(reference, abs=1e-4), degrees
 
 
+def _rows_without_xla_flags(script: str):
+    """The JSON rows `script` prints last, run in a Python process without the suite's
+    XLA flags (they round differently, and hid the cases these scripts hold)."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    env = {k: v for k, v in os.environ.items() if k != "XLA_FLAGS"}
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          env=env, timeout=600)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
 PULLING_SCRIPT = """
 import json, math
 import jax
@@ -489,16 +504,7 @@ def test_the_penetration_criterion_where_the_normal_force_pulls_before_the_end()
     with scipy's switches; e is the normal impact's (the tangential force does not act on
     it) to 1e-9, and v_t_out, omega_out lie within 1e-4 of scipy's, whose own e is 1.3e-5 off
     after its restarts near the x^0.25 end (measured; without friction it is not)."""
-    import json
-    import os
-    import subprocess
-    import sys
-
-    env = {k: v for k, v in os.environ.items() if k != "XLA_FLAGS"}
-    proc = subprocess.run([sys.executable, "-c", PULLING_SCRIPT], capture_output=True,
-                          text=True, env=env, timeout=300)  # fmt: skip
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    rows = json.loads(proc.stdout.strip().splitlines()[-1])
+    rows = _rows_without_xla_flags(PULLING_SCRIPT)
     law = ji.law("tsuji", c=4.2e9, b=15.0)
     for degrees, row in zip((20.0, 40.0, 45.0), rows, strict=True):
         v_n, v_t = (float(v) for v in incidence(3.9, np.deg2rad(degrees)))
@@ -540,16 +546,7 @@ def test_a_spring_held_at_the_limit_that_sticks_until_the_end_of_contact():
     A margin within roundoff of 0 now counts as armed: the segment is redone with the
     normal events muted and the slip found. In a process without the suite's XLA flags
     (they round differently); against scipy (the oracle with the force criterion's end)."""
-    import json
-    import os
-    import subprocess
-    import sys
-
-    env = {k: v for k, v in os.environ.items() if k != "XLA_FLAGS"}
-    proc = subprocess.run([sys.executable, "-c", RESTICK_SCRIPT], capture_output=True,
-                          text=True, env=env, timeout=300)  # fmt: skip
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    rows = json.loads(proc.stdout.strip().splitlines()[-1])
+    rows = _rows_without_xla_flags(RESTICK_SCRIPT)
     for share, row in zip((0.0, 0.25), rows, strict=True):
         o = oblique_oracle(c=1e5, kelvin_voigt=(100000.00000000003, 1.500000000000001),
                            end="force", m=0.025000000000000005, R=0.005, inertia=0.4,
@@ -617,16 +614,7 @@ def test_modes_that_take_turns_at_one_instant_slide_on_at_the_limit():
     separate; e is the head-on impact's (1e-9), and e_t and the spin agree between rtol
     1e-11 and 1e-12 to 1e-8 (the force left there is 1e-5 of the contact's scale). In a
     process without the suite's XLA flags, where the turns were found."""
-    import json
-    import os
-    import subprocess
-    import sys
-
-    env = {k: v for k, v in os.environ.items() if k != "XLA_FLAGS"}
-    proc = subprocess.run([sys.executable, "-c", PINNED_SCRIPT], capture_output=True,
-                          text=True, env=env, timeout=600)  # fmt: skip
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    for row in json.loads(proc.stdout.strip().splitlines()[-1]):
+    for row in _rows_without_xla_flags(PINNED_SCRIPT):
         loose, tight = row["1e-11"], row["1e-12"]
         assert loose["status"] == tight["status"] == ji.Status.separated, row
         assert loose["e"] == pytest.approx(row["head_on"], rel=1e-9)
