@@ -157,7 +157,8 @@ def jkr_impact(c, R, w, m, v0):
     s_end = jnp.where(separated, sf, jnp.clip(s_turn, sf, s0))
     t_in = _travel_time(s0, s_m, "hi", q, U0)
     t_out = _travel_time(s_end, s0, "lo", q, U0)
-    e = jnp.where(separated, jnp.sqrt(jnp.maximum(1.0 - 2.0 * loss, 0.0)), 0.0)
+    # the square root sees 1 where the body is held, so that its derivative stays finite
+    e = jnp.where(separated, jnp.sqrt(jnp.where(separated, 1.0 - 2.0 * loss, 1.0)), 0.0)
     status = jnp.where(separated, Status.separated, Status.captured).astype(jnp.int32)
     return dict(
         e=e,

@@ -137,7 +137,7 @@ def test_with_gravity_it_matches_scipy():
         assert float(getattr(r, key)) == pytest.approx(value, rel=1e-8), key
 
 
-@pytest.mark.parametrize("ratio", [1.2, 10.0])
+@pytest.mark.parametrize("ratio", [0.5, 1.2, 10.0])  # 0.5: held by the neck, e = 0
 def test_gradients_of_the_closed_form_match_central_differences(ratio):
     v0 = ratio * V_S
 
@@ -147,6 +147,7 @@ def test_gradients_of_the_closed_form_match_central_differences(ratio):
 
     p = jnp.array([C, W])
     jac = jax.jacfwd(outputs)(p)
+    np.testing.assert_allclose(jax.jacrev(outputs)(p), jac, rtol=1e-9)  # reverse mode too
     for k in range(2):
         h = p[k] * 1e-5
         step = jnp.zeros(2).at[k].set(h)
