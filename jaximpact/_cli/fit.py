@@ -15,7 +15,6 @@ import math
 from pathlib import Path
 
 from .._fit.recordings import parse_number, read_recording
-from .._format import format_number
 from .._plotting import new_figure, save_figure
 from .common import (
     CLIError,
@@ -182,80 +181,6 @@ def _fit_one(law, args, recording, name, data, length_scale, y_axis):
     return fit_bounces(law, t=t, y=y, length_scale=length_scale, y_axis=y_axis, **common)
 
 
-def _summary(fit) -> dict:
-    import numpy as np
-
-    data = dict(
-        kind=fit.kind,
-        law=fit.law.name,
-        params=fit.params,
-        stderr=fit.stderr,
-        free=list(fit.free),
-        undetermined=list(fit.undetermined),
-        nuisance=fit.nuisance,
-        e=fit.e,
-        e_stderr=fit.e_stderr,
-        impact_speeds=fit.impact_speeds,
-        impact_times=fit.impact_times,
-        T=fit.T,
-        sigma=fit.sigma,
-        dof=fit.dof,
-        loss=fit.loss,
-        converged=fit.converged,
-        iterations=fit.iterations,
-        dropped=fit.dropped,
-    )
-    if fit.kind == "impacts":
-        data.update(missed=fit.missed, used=int(np.size(fit.times)))
-    else:
-        data.update(used=int(np.size(fit.t)))
-    return data
-
-
-def _text(name, fit, units) -> str:
-    import numpy as np
-
-    lines = [
-        f"{name}: {fit.kind}, {'converged' if fit.converged else 'NOT converged'} "
-        f"after {fit.iterations} iterations, noise {format_number(fit.sigma, 3)} {units}"
-    ]
-    for key, value in fit.params.items():
-        if key in fit.undetermined:
-            shown = f"{format_number(value)}  (undetermined by these data: held, not estimated)"
-        elif key in fit.free:
-            shown = f"{format_number(value)} ± {format_number(fit.stderr[key], 2)}"
-        else:
-            shown = f"{format_number(value)}  (held)"
-        lines.append(f"  {key:<12} = {shown}")
-    q = fit.nuisance
-    lines.append(
-        f"  first impact at {q['t_impact']:.4f} s, {q['v_impact']:.4f} m/s "
-        f"(drop height {q['drop_height']:.4f} m)"
-    )
-    if "floor" in q:
-        lines.append(
-            f"  floor {format_number(q['floor'])}, scale {format_number(q['length_scale'])} "
-            f"{units}/m"
-        )
-    if "drag" in q:
-        lines.append(f"  drag {format_number(q['drag'])} 1/m")
-    if fit.kind == "impacts":
-        lines.append(
-            f"  used {np.size(fit.times)} detections; dropped {list(map(int, fit.dropped))}, "
-            f"missed impacts {list(map(int, fit.missed))}"
-        )
-    else:
-        lines.append(f"  used {np.size(fit.t)} samples; dropped {np.size(fit.dropped)}")
-    lines.append("  impact  speed (m/s)  e")
-    for k in range(min(fit.num_impacts, 12)):
-        lines.append(
-            f"  {k:>6}  {fit.impact_speeds[k]:11.4f}  {fit.e[k]:.4f} ± {fit.e_stderr[k]:.4f}"
-        )
-    if fit.num_impacts > 12:
-        lines.append(f"  ... {fit.num_impacts - 12} more")
-    return "\n".join(lines)
-
-
 def _plot(fits, recording, path):
     import numpy as np
 
@@ -322,13 +247,13 @@ def run_fit(args):
     payload = {
         "file": str(args.file),
         "kind": recording.kind,
-        "fits": {name: _summary(fit) for name, fit in fits.items()},
+        "fits": {name: fit.to_dict() for name, fit in fits.items()},
     }
     if args.plot is not None:
         payload["plot"] = str(args.plot)
 
     def text():
-        blocks = [_text(name, fit, units) for name, fit in fits.items()]
+        blocks = [fit.summary(units, title=name) for name, fit in fits.items()]
         if args.plot is not None:
             blocks.append(f"plot written to {args.plot}")
         return "\n\n".join(blocks)

@@ -8,9 +8,11 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
+from .._format import format_number, jsonable
 from .._laws import AbstractLaw
 from .._solve.bounce import BounceResult, bounce_options, solve_bounce
 from .bounce_model import BounceProblem, Stage, round_up
+from .calibrate import law_units
 from .parameters import law_with
 
 
@@ -74,6 +76,71 @@ class BounceFit(eqx.Module):
     g: float = eqx.field(static=True, default=9.81)
     separation: str = eqx.field(static=True, default="force")
     y_sign: float = eqx.field(static=True, default=1.0)
+
+    def summary(self, units: str | None = None, title: str | None = None) -> str:
+        """The fit as text: each parameter with its unit and standard error (or `held`,
+        or `undetermined`), the first impact, what was used and dropped, and `e` per
+        impact with its standard error. `units`: the data's (`s` for impact times, the
+        trajectory's own, `y units` if not given); `title`: the first words (the
+        law's name)."""
+        units = units or ("s" if self.kind == "impacts" else "y units")
+        converged = "converged" if self.converged else "NOT converged"
+        lines = [f"{title or self.law.name}: {self.kind}, {converged} after {self.iterations} "
+                 f"iterations, noise {format_number(self.sigma, 3)} {units}"]  # fmt: skip
+        law_unit = law_units(self.law)
+        for key, value in self.params.items():
+            unit = law_unit.get(key, "")
+            shown = format_number(value) + (f" {unit}" if unit else "")
+            if key in self.undetermined:
+                shown += "  (undetermined by these data: held, not estimated)"
+            elif key in self.free:
+                shown += f" ± {format_number(self.stderr[key], 2)}"
+            else:
+                shown += "  (held)"
+            lines.append(f"  {key:<12} = {shown}")
+        q = self.nuisance
+        lines.append(f"  first impact at {q['t_impact']:.4f} s, {q['v_impact']:.4f} m/s "
+                     f"(drop height {q['drop_height']:.4f} m)")  # fmt: skip
+        if "floor" in q:
+            lines.append(f"  floor {format_number(q['floor'])}, scale "
+                         f"{format_number(q['length_scale'])} {units}/m")  # fmt: skip
+        if "drag" in q:
+            lines.append(f"  drag {format_number(q['drag'])} 1/m")
+        if self.kind == "impacts":
+            lines.append(f"  used {np.size(self.times)} detections; dropped "
+                         f"{list(map(int, self.dropped))}, missed impacts "
+                         f"{list(map(int, self.missed))}")  # fmt: skip
+        else:
+            lines.append(f"  used {np.size(self.t)} samples; dropped {np.size(self.dropped)}")
+        lines.append("  impact  speed (m/s)  e")
+        for k in range(min(self.num_impacts, 12)):
+            lines.append(f"  {k:>6}  {self.impact_speeds[k]:11.4f}  {self.e[k]:.4f} ± "
+                         f"{self.e_stderr[k]:.4f}")  # fmt: skip
+        if self.num_impacts > 12:
+            lines.append(f"  ... {self.num_impacts - 12} more")
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict:
+        """The fit as plain numbers and lists (SI units; `sigma` and a trajectory's
+        `floor` in the data's units), NaN as None: `kind`, `law` (its name), `params`,
+        `stderr`, `free`, `undetermined`, `nuisance`, per modelled impact `e`, `e_stderr`,
+        `impact_speeds`, `impact_times`, `T`, and `sigma`, `dof`, `loss`, `converged`,
+        `iterations`, `dropped`, `used` (detections or samples), `missed` (impact fits)."""
+        data = dict(kind=self.kind, law=self.law.name, params=self.params, stderr=self.stderr,
+                    free=list(self.free), undetermined=list(self.undetermined),
+                    nuisance=self.nuisance, e=self.e, e_stderr=self.e_stderr,
+                    impact_speeds=self.impact_speeds, impact_times=self.impact_times,
+                    T=self.T, sigma=self.sigma, dof=self.dof, loss=self.loss,
+                    converged=self.converged, iterations=self.iterations,
+                    dropped=self.dropped)  # fmt: skip
+        if self.kind == "impacts":
+            data.update(missed=self.missed, used=int(np.size(self.times)))
+        else:
+            data.update(used=int(np.size(self.t)))
+        return jsonable(data)
+
+    def __repr__(self) -> str:
+        return self.summary()
 
     def bounce(self, t_end=None, max_impacts: int | None = None) -> BounceResult:
         """The fitted drop as a `BounceResult`, from the first modelled impact on (its

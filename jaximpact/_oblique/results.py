@@ -4,7 +4,7 @@ import equinox as eqx
 from jaxtyping import Array
 
 from .._format import format_fields, format_value, jsonable
-from .._solve.results import status_text
+from .._solve.results import status_names, status_text
 from .._status import Status
 
 # the fields as `summary()` shows them: name, unit ("" a pure number, None a count)
@@ -85,15 +85,10 @@ class ObliqueResult(eqx.Module):
     def to_dict(self) -> dict:
         """The fields as plain numbers and lists (SI units, radians), NaN as None,
         `status` as its name (a list of names for a batch)."""
-        import numpy as np
-
         out = {name: jsonable(getattr(self, name)) for name, _ in _SHOWN}
         for name in ("angle_in", "angle_in_contact"):
             out[name] = jsonable(getattr(self, name))
-        names = {int(s): s.name for s in Status}
-        codes = np.asarray(self.status)
-        out["status"] = (names.get(int(codes), int(codes)) if codes.ndim == 0
-                         else [names.get(int(c), int(c)) for c in codes.ravel()])  # fmt: skip
+        out["status"] = status_names(self.status)
         return out
 
     def __repr__(self) -> str:

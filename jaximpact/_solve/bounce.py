@@ -26,6 +26,7 @@ from jaxtyping import Array
 from .._checks import check_nonnegative, check_positive, check_values, is_traced
 from .._curves.gravity import WithGravity
 from .._curves.shapes import curve_key
+from .._format import format_fields, format_value, jsonable
 from .._laws import AbstractLaw, shape_of
 from .._status import Status
 from .adjoint import auto_adjoint, reverse_only, through_forward_jacobian
@@ -34,7 +35,7 @@ from .impact import CURVES_RTOL, SEPARATIONS, ImpactOptions, gravity_impact, sim
 from .options import adhesion_table_key
 from .phases import integrated_contact
 from .precision import resolvable_tolerances
-from .results import ImpactResult
+from .results import ImpactResult, status_names, status_text
 
 
 class BounceStatus(enum.IntEnum):
@@ -285,12 +286,65 @@ class BounceResult(eqx.Module):
     @property
     def mask(self) -> Array:
         """True for the entries of the per-contact arrays that are real contacts."""
-        return jnp.arange(self.e.shape[-1]) < self.num_impacts[..., None]
+        index = jnp.broadcast_to(jnp.arange(self.e.shape[-1]), self.e.shape)  # batches too
+        return index < self.num_impacts[..., None]
 
     @property
     def status_name(self) -> str:
         """The status as a word (for one drop, not a batch)."""
         return BounceStatus(int(self.status)).name
+
+    def summary(self, contacts: int = 6) -> str:
+        """The drop as text, every number with its unit: how it ended, the number of
+        contacts, when the ball came to rest, and one line per contact (time of first
+        touch, speed in, `e`, `T`; the first and last when there are more than `contacts`).
+        A batch of drops by the range of each field and the count of each status; inside
+        `jit` the shapes."""
+        rows = [("status", status_text(self.status, BounceStatus)),
+                ("num_impacts", format_value(self.num_impacts, None)),
+                ("t_rest", _at_rest_text(self.t_rest))]  # fmt: skip
+        traced = is_traced(self.e)
+        if traced or np.ndim(self.num_impacts) > 0:  # the real contacts of all the drops
+            for name, unit in (("e", ""), ("T", "s"), ("impact_speeds", "m/s")):
+                values = getattr(self, name)
+                real = values if traced else np.asarray(values)[np.asarray(self.mask)]
+                rows.append((name, format_value(real, unit)))
+            title = "BounceResult (SI units)" + ("" if traced else ", a batch of drops")
+            return format_fields(title, rows)
+        count = int(self.num_impacts)
+        shown = list(range(count))
+        if count > contacts:
+            shown = shown[: contacts - 2] + [None] + shown[-2:]
+        for k in shown:
+            if k is None:
+                rows.append(("...", f"{count - contacts} more contacts"))
+                continue
+            rows.append((f"contact {k + 1}",
+                         f"at {format_value(self.impact_times[k], 's')}, "
+                         f"{format_value(self.impact_speeds[k], 'm/s')} in, "
+                         f"e = {format_value(self.e[k])}, T = {format_value(self.T[k], 's')}, "
+                         f"{status_text(self.contact_status[k])}"))  # fmt: skip
+        return format_fields("BounceResult (SI units)", rows)
+
+    def to_dict(self) -> dict:
+        """The real contacts' fields as lists (SI units: s, m, m/s, N), NaN as None,
+        `status` and `contact_status` as names; for a batch of drops every entry
+        (padded contacts as None). Concrete results only (not inside `jit`)."""
+        single = np.ndim(self.num_impacts) == 0
+        count = int(self.num_impacts) if single else self.e.shape[-1]
+        out = {name: jsonable(getattr(self, name)[..., :count]) for name in _PER_CONTACT
+               if getattr(self, name) is not None}  # fmt: skip
+        if not single:
+            out = {k: jsonable(np.where(np.asarray(self.mask), np.asarray(v, dtype=float), np.nan))
+                   for k, v in ((k, getattr(self, k)) for k in out)}  # fmt: skip
+        out["contact_status"] = status_names(self.contact_status[..., :count])
+        out["status"] = status_names(self.status, BounceStatus)
+        out.update({name: jsonable(getattr(self, name)) for name in
+                    ("num_impacts", "t_rest", "drop_apex_time", "drop_apex_height")})  # fmt: skip
+        return out
+
+    def __repr__(self) -> str:
+        return self.summary()
 
     def trajectory(self, ts) -> tuple[Array, Array, Array]:
         """`(height, velocity, force)` at the times `ts` (s): m, m/s upward, N upward."""
@@ -316,6 +370,18 @@ class BounceResult(eqx.Module):
     def force(self, ts) -> Array:
         """Contact force on the ball (N, upward) at `ts` (s); `m g` once at rest."""
         return self.trajectory(ts)[2]
+
+
+def _at_rest_text(t_rest) -> str:
+    """`t_rest` as text: `-` for a drop that did not come to rest (NaN)."""
+    if not is_traced(t_rest) and np.ndim(t_rest) == 0 and not np.isfinite(t_rest):
+        return "- (not at rest)"
+    return format_value(t_rest, "s")
+
+
+# the per-contact arrays of `BounceResult.to_dict` (`contact_status` apart, as names)
+_PER_CONTACT = ("impact_times", "release_times", "impact_speeds", "rebound_speeds", "e", "T",
+                "release_heights", "apex_times", "apex_heights", "F_max", "x_max")  # fmt: skip
 
 
 @eqx.filter_jit

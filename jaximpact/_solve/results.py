@@ -83,12 +83,7 @@ class ImpactResult(eqx.Module):
         `status` as its name (a list of names for a batch), `path`; the time histories
         only when they were asked for. Concrete results only (not inside `jit`)."""
         out = {name: jsonable(getattr(self, name)) for name, _ in _SHOWN}
-        import numpy as np
-
-        names = {int(s): s.name for s in Status}
-        codes = np.asarray(self.status)
-        out["status"] = (names.get(int(codes), int(codes)) if codes.ndim == 0
-                         else [names.get(int(c), int(c)) for c in codes.ravel()])  # fmt: skip
+        out["status"] = status_names(self.status)
         out["path"] = self.path
         out.update({k: jsonable(getattr(self, k)) for k in _HISTORIES
                     if getattr(self, k) is not None})  # fmt: skip
@@ -98,17 +93,29 @@ class ImpactResult(eqx.Module):
         return self.summary()
 
 
-def status_text(status) -> str:
+def status_text(status, kinds=Status) -> str:
     """A status array as words: `separated`, or for a batch the count of each status
-    (`separated 9, stuck 1`); inside `jit` its shape."""
+    (`separated 9, stuck 1`); inside `jit` its shape. `kinds`: the enum of the codes
+    (`Status`, or `BounceStatus` for a drop)."""
     if is_traced(status):
         return format_value(status)
     import numpy as np
 
     codes = np.asarray(status).ravel()
-    names = {int(s): s.name for s in Status}
+    names = {int(s): s.name for s in kinds}
     if np.ndim(status) == 0:
         return names.get(int(codes[0]), str(int(codes[0])))
     found, counts = np.unique(codes, return_counts=True)
     return ", ".join(f"{names.get(int(c), str(int(c)))} {n}" for c, n in
                      zip(found, counts, strict=True))  # fmt: skip
+
+
+def status_names(status, kinds=Status):
+    """A concrete status array as its names: one word, or a list of words for a batch."""
+    import numpy as np
+
+    names = {int(s): s.name for s in kinds}
+    codes = np.asarray(status)
+    if codes.ndim == 0:
+        return names.get(int(codes), int(codes))
+    return [names.get(int(c), int(c)) for c in codes.ravel()]

@@ -102,6 +102,19 @@ def test_impact_times_round_trip_recovers_e_within_its_uncertainty():
     assert fit.params["c"] == 5.5e7  # held
 
 
+def test_a_bounce_fit_prints_numbers_with_units():
+    fit = golf_fit()
+    text = repr(fit)
+    assert text == fit.summary() and "f64[" not in text and "Array(" not in text
+    assert text.startswith("hertz_rate: impacts, converged") and "noise" in text
+    assert " N s/m^1.5 ± " in text and "N/m^1.5  (held)" in text  # b1 fitted, c held
+    assert "dropped [4], missed impacts [5]" in text
+    d = fit.to_dict()
+    assert d["law"] == "hertz_rate" and d["missed"] == [5] and d["used"] == len(fit.times)
+    assert d["e"] == pytest.approx(fit.e.tolist()) and d["free"] == ["b1"]
+    json.dumps(d, allow_nan=False)
+
+
 def test_fit_model_chain_matches_bounce():
     """The fitted drop, re-run from its first impact, gives the fitted impact times."""
     fit = golf_fit()

@@ -7,6 +7,7 @@ criterion, `MAX_IMPACTS` contacts) and its history; other laws and transformatio
 """
 
 import functools
+import json
 import math
 
 import jax
@@ -219,6 +220,34 @@ def test_reports_running_out_of_impacts():
             max_impacts=MAX_IMPACTS,
             throw=True,
         )
+
+
+def test_a_drop_prints_its_contacts_with_units():
+    b = drop()  # comes to rest
+    n = int(b.num_impacts)
+    text = repr(b)
+    assert text == b.summary() and "f64[" not in text and "Array(" not in text
+    assert "status      = at_rest" in text and f"num_impacts = {n}" in text
+    assert f"e = {float(b.e[0]):.4g}, T = " in text and "ms," in text and "m/s in" in text
+    assert text.rstrip().endswith("captured")  # the last contact: gravity held the ball
+    d = b.to_dict()
+    assert len(d["e"]) == n and d["contact_status"][-1] == "captured"
+    assert d["status"] == "at_rest" and d["t_rest"] == pytest.approx(float(b.t_rest))
+    json.dumps(d, allow_nan=False)
+    many = drop(t_end=10.0, c=1e6, b1=100.0)  # 16 contacts: the first 4 and the last 2
+    text = repr(many)
+    assert "contact 4 " in text and "contact 5 " not in text and "contact 16" in text
+    assert "10 more contacts" in text and "- (not at rest)" in text
+
+
+def test_a_batch_of_drops_prints_the_real_contacts():
+    both = jax.tree.map(lambda *xs: jnp.stack(xs), drop(), drop(t_end=1.0))
+    text = repr(both)
+    assert "a batch of drops" in text and "t_end 1, at_rest 1" in text
+    assert "not finite" not in text  # the padding after the last contact is not shown
+    d = both.to_dict()
+    assert d["status"] == ["at_rest", "t_end"] and len(d["e"]) == 2
+    json.dumps(d, allow_nan=False)
 
 
 def test_zeno_cut_at_min_flight():
