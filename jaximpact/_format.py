@@ -26,7 +26,7 @@ def format_quantity(value, unit: str, digits: int = 4) -> str:
     prefixes = [(s, p) for s, p in _PREFIXES if s <= 1.0 or unit in _MULTIPLE_UNITS]
     threshold = 1 - 0.5 * 10.0**-digits  # 0.99996 s rounds to 1 s, not 1000 ms
     scale, prefix = next(((s, p) for s, p in prefixes if abs(value) >= s * threshold), prefixes[-1])
-    return f"{value / scale:.{digits}g} {prefix}{unit}"
+    return f"{format_number(value / scale, digits)} {prefix}{unit}"
 
 
 def jsonable(value):
@@ -131,3 +131,30 @@ def concrete_units(spec, params: dict | None = None) -> dict[str, str]:
         elif unit == "N s/m^(p+1)" and p is not None:
             units[name] = power("N s/m", float(p) + 1)
     return units
+
+
+class PrintedFields:
+    """`summary()`, `to_dict()` and `repr` for a result whose class lists `_SHOWN`, the
+    fields a reader wants as `(name, unit)` (`unit`: "" a pure number, None a word or a
+    count; a callable: the unit read off the result, e.g. a law's), under `_TITLE`.
+    `to_dict()` gives every field (`_SHOWN` first), NaN as None."""
+
+    _TITLE = "result (SI units)"
+    _SHOWN: tuple = ()
+
+    def summary(self) -> str:
+        rows = []
+        for name, unit in self._SHOWN:
+            unit = unit(self) if callable(unit) else unit
+            rows.append((name, format_value(getattr(self, name), unit)))
+        return format_fields(self._TITLE, rows)
+
+    def to_dict(self) -> dict:
+        import dataclasses
+
+        names = [n for n, _ in self._SHOWN]
+        names += [f.name for f in dataclasses.fields(self) if f.name not in names]
+        return {name: jsonable(getattr(self, name)) for name in names}
+
+    def __repr__(self) -> str:
+        return self.summary()

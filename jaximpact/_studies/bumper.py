@@ -13,11 +13,12 @@ import numpy as np
 import optax
 from jaxtyping import Array
 
+from .._format import PrintedFields
 from .._laws import law as make_law
 from .._solve.impact import impact
 
 
-class BumperDesign(eqx.Module):
+class BumperDesign(PrintedFields, eqx.Module):
     """The result of `bumper_design` (SI units). With several bounds, every array has a
     leading axis over the pairs `(x_max_bound, e_target)`.
 
@@ -30,6 +31,11 @@ class BumperDesign(eqx.Module):
     - `F_ideal` (N): the lower bound `m v_max^2 / (2 x_max_bound)` of any force law with
       that stroke (a constant force over the whole stroke).
     """
+
+    _TITLE = "BumperDesign (SI units; the hertz_rate law that meets the bounds)"
+    _SHOWN = (("c", "N/m^1.5"), ("b1", "N s/m^1.5"), ("feasible", None), ("F_peak", "N"),
+              ("F_ideal", "N"), ("speeds", "m/s"), ("m", "kg"), ("x_max_bound", "m"),
+              ("x_max", "m"), ("e_target", ""), ("e", ""))  # fmt: skip
 
     c: Array
     b1: Array

@@ -10,9 +10,10 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._fit.least_squares import levenberg_marquardt
+from .._format import PrintedFields
 
 
-class DropDesign(eqx.Module):
+class DropDesign(PrintedFields, eqx.Module):
     """The result of `drop_design` (SI units).
 
     - `h0` (m), `m` (kg): the drop height and mass found.
@@ -22,6 +23,10 @@ class DropDesign(eqx.Module):
       (`_fit.least_squares`).
     - `iterations`; `history`: the loss at each accepted iterate.
     """
+
+    _TITLE = "DropDesign (SI units)"
+    _SHOWN = (("h0", "m"), ("m", "kg"), ("target", "m"), ("apexes", "m"), ("loss", ""),
+              ("converged", None), ("iterations", None))  # fmt: skip
 
     h0: float
     m: float

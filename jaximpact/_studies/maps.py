@@ -10,6 +10,7 @@ import equinox as eqx
 import numpy as np
 
 from .._batch import batch_path, impact_batch
+from .._format import PrintedFields, concrete_units
 from .._laws import LAW_NAMES, LAWS, law
 from .._laws.closed_forms import exact_batch
 from .._progress import AbstractMeter
@@ -19,7 +20,7 @@ from .._status import Status
 C_RANGE = (2e6, 2e7)
 
 
-class RestitutionMap(eqx.Module):
+class RestitutionMap(PrintedFields, eqx.Module):
     """`e` and `T` of one law over a grid: rows follow `damping`, columns follow `c`.
 
     - `law`: the law's name; `damping_name`: the parameter along the first axis.
@@ -29,6 +30,12 @@ class RestitutionMap(eqx.Module):
     - `m` (kg), `v0` (m/s), `separation`, `fixed` (the other parameters), `path`: how the
       values were computed (`"integrated"` or `"closed_form"`).
     """
+
+    _TITLE = "RestitutionMap (SI units; rows follow damping, columns c)"
+    _SHOWN = (("law", None), ("damping_name", None), ("c", lambda r: axis_unit(r, "c")),
+              ("damping", lambda r: axis_unit(r, r.damping_name)),
+              ("e", ""), ("T", "s"), ("m", "kg"), ("v0", "m/s"), ("separation", None),
+              ("path", None))  # fmt: skip
 
     law: str = eqx.field(static=True)
     damping_name: str = eqx.field(static=True)
@@ -42,6 +49,12 @@ class RestitutionMap(eqx.Module):
     separation: str = eqx.field(static=True)
     fixed: dict
     path: str = eqx.field(static=True)
+
+
+def axis_unit(result, name: str) -> str:
+    """The unit of a map's axis `name` (a parameter of the law `result.law`)."""
+    unit = concrete_units(LAWS[result.law], result.fixed).get(name, "-")
+    return "" if unit == "-" else unit
 
 
 def held_fixed(spec, fixed, damping_name) -> dict:

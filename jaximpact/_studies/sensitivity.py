@@ -10,10 +10,11 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._batch import build_law, cost_key, prepare_rows, run_batch
+from .._format import PrintedFields
 from .._laws import LAWS
 from .._progress import AbstractMeter
 from .._solve.impact import impact
-from .maps import C_RANGE, axis, held_fixed
+from .maps import C_RANGE, axis, axis_unit, held_fixed
 
 
 @functools.lru_cache(maxsize=32)
@@ -85,13 +86,19 @@ def jacobian_batch(
     )
 
 
-class SensitivityMap(eqx.Module):
+class SensitivityMap(PrintedFields, eqx.Module):
     """`e`, `T` and their derivatives over a grid (rows: `damping`, columns: `c`).
 
     `de_dc`, `de_ddamping`, `dT_dc`, `dT_ddamping` in SI units; `elasticity(which)` gives
     the dimensionless `d ln y / d ln p` (the relative change of `y` per relative change of
     `p`), e.g. `elasticity("e", "c")`.
     """
+
+    _TITLE = "SensitivityMap (SI units; rows follow damping, columns c)"
+    _SHOWN = (("law", None), ("damping_name", None), ("c", lambda r: axis_unit(r, "c")),
+              ("damping", lambda r: axis_unit(r, r.damping_name)), ("e", ""),
+              ("T", "s"), ("de_dc", ""), ("de_ddamping", ""), ("dT_dc", ""),
+              ("dT_ddamping", ""), ("m", "kg"), ("v0", "m/s"))  # fmt: skip
 
     law: str = eqx.field(static=True)
     damping_name: str = eqx.field(static=True)

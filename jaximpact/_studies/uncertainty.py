@@ -7,12 +7,13 @@ import equinox as eqx
 import numpy as np
 
 from .._batch import prepare_rows
+from .._format import PrintedFields
 from .._progress import AbstractMeter
 from .._status import Status
 from .sensitivity import jacobian_batch
 
 
-class Uncertainty(eqx.Module):
+class Uncertainty(PrintedFields, eqx.Module):
     """First-order and Monte Carlo spread of `e` and `T` (index 0: `e`, 1: `T` in s).
 
     - `nominal`: `(e, T)` at the nominal parameters; `names`, `sigma`: the scattered inputs
@@ -25,6 +26,11 @@ class Uncertainty(eqx.Module):
     - `separated_fraction`: Monte Carlo samples whose impact ended in separation.
     - `samples`: the sampled `(e, T)`, shape `(2, n_samples)`.
     """
+
+    _TITLE = "Uncertainty of (e, T in s)"
+    _SHOWN = (("names", None), ("sigma", ""), ("nominal", ""), ("std_linear", ""),
+              ("std_mc", ""), ("std_mc_error", ""), ("z_std", ""), ("n_samples", None),
+              ("separated_fraction", ""))  # fmt: skip
 
     names: tuple = eqx.field(static=True)
     nominal: np.ndarray

@@ -7,6 +7,8 @@ blocks of 64 rows); the Jacobians, the sensitivity map and the Monte Carlo throu
 compiled `jacobian_batch` (with respect to c and b1, blocks of 64 rows).
 """
 
+import json
+
 import numpy as np
 import pytest
 from helpers import assert_rel
@@ -62,6 +64,9 @@ def test_first_order_uncertainty_agrees_with_monte_carlo():
     assert np.all(np.abs(u.z_std) < 3), (u.std_linear, u.std_mc, u.std_mc_error)
     assert_rel(u.std_linear, u.std_mc, 0.05, "linear vs Monte Carlo spread")
     assert np.all(np.abs(u.mean_mc - u.nominal) < 5 * u.mean_mc_error + 1e-3 * u.std_mc)
+    text = repr(u)
+    assert "n_samples          = 4095" in text and "f64[" not in text
+    json.dumps(u.to_dict(), allow_nan=False)
 
 
 def test_sensitivity_map_elasticities():
@@ -72,6 +77,9 @@ def test_sensitivity_map_elasticities():
     # law 14's e depends on beta = b1 x*^1.5 / (m v0) with x* ~ c^-0.4: d ln e/d ln c is
     # exactly -0.6 d ln e/d ln b1 (the similarity law)
     assert_rel(s.elasticity("e", "c"), -0.6 * s.elasticity("e", "damping"), 1e-6, "similarity")
+    text = repr(s)
+    assert text.startswith("SensitivityMap") and "N s/m^1.5" in text and "f64[" not in text
+    json.dumps(s.to_dict(), allow_nan=False)
 
 
 def test_uncertainty_rejects_bad_scatter():
@@ -103,6 +111,9 @@ def test_bumper_design_meets_the_constraints_and_scales():
     assert_rel(d.c[1], d.c[0] * 2**-2.5, 1e-2, "c scaling")
     # a binding restitution target costs peak force; no design beats the constant force
     assert d.F_peak[2] > d.F_peak[0]
+    text = repr(d)  # three designs: each field as a list with its unit
+    assert text.startswith("BumperDesign") and "N/m^1.5" in text and "feasible    = [True" in text
+    json.dumps(d.to_dict(), allow_nan=False)
     assert np.all(d.F_peak > d.F_ideal)
     # the designed law reproduces the reported response
     check = ji.impact(d.law(0), m=1.0, v0=3.0, rtol=1e-10)
@@ -123,5 +134,7 @@ def test_drop_design_recovers_height_and_mass():
     assert d.converged and d.loss < 1e-18
     assert_rel([d.h0, d.m], [h0, m], 1e-6, "h0, m")
     assert_rel(d.apexes, target, 1e-8, "apexes")
+    assert "h0         = 600 mm" in repr(d) and "converged  = True" in repr(d)
+    json.dumps(d.to_dict(), allow_nan=False)
     with pytest.raises(ValueError, match="decrease"):
         drop_design(law, apexes=[0.1, 0.2], h0_guess=1.0, m_guess=0.3)

@@ -4,6 +4,8 @@ The integrated map shares its compiled batch with test_batch.py (hertz_rate, e a
 of 64 rows: an 8 x 8 grid); maps of other integrated laws are slow.
 """
 
+import json
+
 import matplotlib
 import numpy as np
 import pytest
@@ -45,6 +47,10 @@ def test_curves_map_matches_scipy():
     rmap = restitution_map("hertz_rate", **GRID)
     assert rmap.path == "similarity" and rmap.damping_name == "b1" and rmap.e.shape == (8, 8)
     assert np.all(np.diff(rmap.e, axis=0) < 0)  # more b1, less restitution
+    text = repr(rmap)  # numbers with units, the axes in the law's own
+    assert "N/m^1.5" in text and "N s/m^1.5" in text and "64 values" in text
+    assert "f64[" not in text and "Array(" not in text
+    json.dumps(rmap.to_dict(), allow_nan=False)
     for i, j in ((0, 0), (3, 5), (7, 7)):
         ref = reference_impact(
             "hertz_rate", dict(c=rmap.c[j], b1=rmap.damping[i]), m=1.0, v0=2.5, rtol=1e-12
