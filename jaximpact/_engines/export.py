@@ -526,7 +526,7 @@ def _targets(law_or_fit, *, e, T, m: float, v0: float, speeds=None):
     if int(result.status) != 0:
         below = ""
         # an adhesive law with a closed-form sticking speed (jkr; dmt's has none)
-        if source.spec is not None and source.spec.captures and source.spec.state is not None:
+        if hasattr(source, "sticking_speed"):
             below = f", below its sticking speed {float(source.sticking_speed(m)):.4g} m/s"
         raise ValueError(
             f"the law does not separate at this m and v0 (e = 0{below}): no engine target"
@@ -606,7 +606,10 @@ def _nearest(chosen: AbstractEngine, source, fields: dict, target_e: float, *, f
     gaps = [abs(a - b) for a, b in zip(mine, law, strict=True)]
     worst = int(np.argmax(gaps))
     nearest = chosen.NEAREST or f"its {chosen.LAW} law"
-    lacked = f"{source.name} law ({source.spec.equation}; e(v) from a contact state)"
+    lacked = f"no {source.name} law ({source.spec.equation}; e(v) from a contact state)"
+    if source.name in chosen.UNEXPORTED:
+        lacked = (f"{chosen.UNEXPORTED[source.name]}, but jaximpact does not export to it "
+                  "yet")  # fmt: skip
     how = (
         f"set to e = {target_e:.3g} (the middle of the law's {min(law):.3g} to "
         f"{max(law):.3g}) and the law's T at {v0:.3g} m/s"
@@ -615,7 +618,7 @@ def _nearest(chosen: AbstractEngine, source, fields: dict, target_e: float, *, f
     )
     tail = "" if fitted else "; pass v0=[...] (m/s) to fit e over the speeds you need"
     return (
-        f"{chosen.LABEL} has no {lacked}; the nearest is {nearest}, {how}: from "
+        f"{chosen.LABEL} has {lacked}; the nearest is {nearest}, {how}: from "
         f"{speeds[0]:.3g} to {speeds[-1]:.3g} m/s its e departs from the law's by up to "
         f"{gaps[worst]:.3g} (|de| at {speeds[worst]:.3g} m/s){tail}"
     )

@@ -162,6 +162,10 @@ class Lammps(AbstractEngine):
     )
     CONTINUOUS_PLANT = False
     TANGENTIAL = tuple(TANGENTIAL_MODELS)
+    UNEXPORTED = {
+        "jkr_viscoelastic": "this law's force as its jkr normal model with damping "
+        "viscoelastic (damp = b / (m_eff Reff^0.5)), its neck broken at the least force",
+    }
 
     def with_tangential(self, parameters, tangential):
         return with_tangential(parameters, tangential)

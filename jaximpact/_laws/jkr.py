@@ -198,11 +198,14 @@ def jkr_closed_form(separation):
 
 
 class JKRDynamics(AbstractDynamics):
-    """The JKR contact in Hertz units: state `(X, V)`, force `sigma^6 - 1.5 q sigma^3` at
-    `sigma = radius_at(X, q)` from first touch (the snap-in force `-q^2/2` at `X = 0`)
-    until pull-off `X_f = -3/4 q (q/4)^(1/3)`, where contact ends under either criterion."""
+    """The JKR contact in Hertz units: state `(X, V)`, force `sigma^6 - 1.5 q sigma^3
+    + beta sigma^2 V` at `sigma = radius_at(X, q)` from first touch (the snap-in force
+    `-q^2/2` at `X = 0`) until pull-off `X_f = -3/4 q (q/4)^(1/3)`, where contact ends under
+    either criterion. `beta = b x*^1.5 / (m v0)`: LAMMPS's viscoelastic damping
+    `b a / R^0.5 v` (`jkr_viscoelastic`; 0 for `jkr`)."""
 
     q: Array
+    beta: Array
     gamma: Array
     x_star: Array
     t_star: Array
@@ -226,7 +229,7 @@ class JKRDynamics(AbstractDynamics):
 
     def force(self, y, compressing):
         sigma = radius_at(y[0], self.q)
-        return sigma**6 - 1.5 * self.q * sigma**3
+        return sigma**6 - 1.5 * self.q * sigma**3 + self.beta * sigma**2 * y[1]
 
     def rhs(self, y, compressing):
         return jnp.stack([y[1], -self.force(y, compressing) + self.gamma])
@@ -238,7 +241,57 @@ class JKRDynamics(AbstractDynamics):
         return y[0] - self._pull_off()
 
 
-class JKRLaw(AbstractLaw):
+class _NeckLaw(AbstractLaw):
+    """What the JKR rows share: the parameters `c` (N/m^1.5, the Hertz stiffness
+    `4/3 E* R^0.5`), `R` (m, the effective radius), `w` (J/m^2, the work of adhesion,
+    twice a surface energy for like surfaces: `jaximpact.work_of_adhesion`), and with
+    `jkr_viscoelastic` the damping `b` (N s/m^1.5). Its force depends on whether the neck
+    has formed, a state of the contact: `force(x, v, attached=...)`."""
+
+    params: dict[str, Array]
+    has_state: ClassVar[bool] = True
+    ROW: ClassVar[LawSpec]
+
+    @property
+    def name(self) -> str:
+        return self.ROW.name
+
+    @property
+    def spec(self) -> LawSpec:
+        return self.ROW
+
+    def replace(self, **params):
+        self._refuse_unknown(params)
+        return type(self)(checked_parameters(self.ROW, {**self.params, **params}))
+
+    def dynamics(self, *, m, v0, g):
+        p = self.params
+        x_star = (m * v0**2 / p["c"]) ** 0.4
+        return JKRDynamics(
+            q=adhesion_group(p["c"], p["R"], p["w"], m, v0),
+            beta=p.get("b", 0.0) * x_star**1.5 / (m * v0) + jnp.zeros_like(x_star),
+            gamma=g * x_star / v0**2 + jnp.zeros_like(x_star),
+            x_star=x_star,
+            t_star=x_star / v0,
+            mass=m + jnp.zeros_like(x_star),
+        )
+
+    def force(self, x, v, *, attached=True, v0=None):
+        """The force (N) at overlap `x` (m) and speed `v` (m/s, into the surface) with the
+        neck formed (`attached`, from first touch until pull-off, down to `x_f < 0`), or 0
+        where it is not (`x < 0`). It does not depend on the impact speed `v0` (accepted as
+        every law's `force` takes it)."""
+        p = self.params
+        E_star = 0.75 * p["c"] / jnp.sqrt(p["R"])
+        k = jnp.sqrt(2.0 * jnp.pi * p["w"] / E_star)
+        q = k * p["R"] ** 0.25  # the group and the units at x* = 1 m (force unit: c)
+        x = jnp.asarray(x, dtype=float)
+        sigma = radius_at(x, q)  # sigma^2 = a / R^0.5 at x* = 1 m
+        force = p["c"] * (sigma**6 - 1.5 * q * sigma**3) + p.get("b", 0.0) * sigma**2 * v
+        return jnp.where(attached | (x >= 0), force, 0.0)
+
+
+class JKRLaw(_NeckLaw):
     """The JKR adhesive elastic contact, built by `jaximpact.law("jkr", c=..., R=..., w=...)`
     (c in N/m^1.5, the Hertz stiffness `4/3 E* R^0.5`; R in m, the effective radius; w in
     J/m^2, the work of adhesion, twice a surface energy for like surfaces:
@@ -248,50 +301,23 @@ class JKRLaw(AbstractLaw):
     **Example**: `jaximpact.law("jkr", c=2.8e3, R=2.45e-6, w=0.4)`.
     """
 
-    params: dict[str, Array]
-    has_state: ClassVar[bool] = True
-
-    @property
-    def name(self) -> str:
-        return JKR.name
-
-    @property
-    def spec(self) -> LawSpec:
-        return JKR
-
-    def replace(self, **params):
-        self._refuse_unknown(params)
-        return JKRLaw(checked_parameters(JKR, {**self.params, **params}))
-
     def sticking_speed(self, m):
         """The speed (m/s) below which a body of mass `m` (kg) sticks: `sticking_speed`."""
         p = self.params
         return sticking_speed(p["c"], p["R"], p["w"], m)
 
-    def dynamics(self, *, m, v0, g):
-        p = self.params
-        x_star = (m * v0**2 / p["c"]) ** 0.4
-        return JKRDynamics(
-            q=adhesion_group(p["c"], p["R"], p["w"], m, v0),
-            gamma=g * x_star / v0**2 + jnp.zeros_like(x_star),
-            x_star=x_star,
-            t_star=x_star / v0,
-            mass=m + jnp.zeros_like(x_star),
-        )
 
-    def force(self, x, v, *, attached=True, v0=None):
-        """The force (N) at overlap `x` (m) with the neck formed (`attached`, from first
-        touch until pull-off, down to `x_f < 0`), or 0 where it is not (`x < 0`). It
-        depends on neither `v` nor the impact speed `v0` (accepted as every law's `force`
-        takes it)."""
-        p = self.params
-        E_star = 0.75 * p["c"] / jnp.sqrt(p["R"])
-        k = jnp.sqrt(2.0 * jnp.pi * p["w"] / E_star)
-        q = k * p["R"] ** 0.25  # the group and the units at x* = 1 m (force unit: c)
-        x = jnp.asarray(x, dtype=float)
-        sigma = radius_at(x, q)
-        force = p["c"] * (sigma**6 - 1.5 * q * sigma**3)
-        return jnp.where(attached | (x >= 0), force, 0.0)
+class JKRViscoelasticLaw(_NeckLaw):
+    """JKR with LAMMPS's viscoelastic damping (`pair_style granular ... jkr ... damping
+    viscoelastic`): `F = F_JKR(a) + b a / R^0.5 v`, `a` the JKR contact radius (so that
+    without adhesion it is `c x^1.5 + b x^0.5 v`, the `dmt` law's damping), built by
+    `jaximpact.law("jkr_viscoelastic", c=..., b=..., R=..., w=...)` (b in N s/m^1.5; the
+    others as `jkr`'s). Integrated: the damping takes energy in both phases, so `e(v)`
+    has no closed form; below a speed that the damping raises the neck holds the body
+    (`captured`, `e = 0`).
+
+    **Example**: `jaximpact.law("jkr_viscoelastic", c=2.8e3, b=1e-4, R=2.45e-6, w=0.4)`.
+    """
 
 
 JKR = LawSpec(
@@ -313,3 +339,40 @@ JKR = LawSpec(
     start=jkr_start,
     kind="adhesive",
 )
+
+
+def jkr_viscoelastic_start(*, m, v0, e, T, R):
+    """Start values for a fit at radius `R` (m): the loss `1 - e^2` split evenly between
+    the neck (`w`, as `jkr_start` for the `e` that half the loss gives) and the damping
+    (`b` from the damping ratio of that `e`, `b = 2 zeta m v0 / x_h^1.5`)."""
+    import math
+
+    e_half = math.sqrt(1.0 - 0.5 * (1.0 - e**2)) if e > 0 else 0.0
+    start = jkr_start(m=m, v0=v0, e=e_half, T=T, R=R)
+    x_h = (m * v0**2 / start["c"]) ** 0.4
+    log_e = math.log(min(max(e_half, 0.05), 0.999999))
+    zeta = -log_e / math.sqrt(math.pi**2 + log_e**2)
+    return dict(start, b=2.0 * zeta * m * v0 / x_h**1.5)
+
+
+JKR_VISCOELASTIC = LawSpec(
+    name="jkr_viscoelastic",
+    equation="JKR + LAMMPS",
+    formula="4 E* a^3 / (3 R) - (8 pi w E* a^3)^0.5 + b a / R^0.5 v at x = a^2/R - "
+    "(2 pi w a / E*)^0.5, E* = 3 c / (4 R^0.5); snap-in at x = 0, pull-off at least x",
+    parameters=("c", "b", "R", "w"),
+    units={"c": "N/m^1.5", "b": "N s/m^1.5", "R": "m", "w": "J/m^2"},
+    reference="Johnson, Kendall & Roberts, Proc. R. Soc. A 324:301 (1971); LAMMPS pair "
+    "granular jkr with damping viscoelastic (eta = damp m_eff a)",
+    state=JKRViscoelasticLaw,
+    positive=("c", "R"),
+    damping="b",
+    map_range=(0.0, 2000.0),
+    map_fixed={"w": 0.1},  # a surface energy of 0.1 J/m^2, as dmt's map
+    captures=True,  # below a sticking speed: e = 0, captured
+    geometry=("R",),
+    start=jkr_viscoelastic_start,
+    kind="adhesive",
+)
+JKRViscoelasticLaw.ROW = JKR_VISCOELASTIC
+JKRLaw.ROW = JKR

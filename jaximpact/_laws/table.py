@@ -15,7 +15,7 @@ from .closed_forms import (
     bingham_compression_closed_form,
     kelvin_voigt_closed_form,
 )
-from .jkr import JKR
+from .jkr import JKR, JKR_VISCOELASTIC
 from .maxwell import MAXWELL
 from .thornton import THORNTON
 
@@ -337,7 +337,7 @@ _SPECS += [
 ]
 
 # laws with a contact state beyond the seed paper: plastic (thornton.py), adhesive (jkr.py)
-_SPECS += [THORNTON, JKR]
+_SPECS += [THORNTON, JKR, JKR_VISCOELASTIC]
 
 LAWS: dict[str, LawSpec] = {spec.name: spec for spec in _SPECS}
 LAW_NAMES: tuple[str, ...] = tuple(LAWS)

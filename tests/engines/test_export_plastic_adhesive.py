@@ -184,6 +184,19 @@ def test_jkr_to_an_engine_without_it_names_the_nearest_law():
     assert _worst(x.warnings[0]) == pytest.approx(gaps.max(), abs=1e-3)
 
 
+def test_damped_jkr_to_lammps_says_that_lammps_has_it_but_it_is_not_exported():
+    """LAMMPS's jkr with damping viscoelastic is `jkr_viscoelastic`'s force; its export is
+    not built, so the export goes to the nearest law it has, and says both in one line."""
+    law = ji.law("jkr_viscoelastic", c=2e5, b=30.0, R=0.02, w=0.5)
+    x = ji.export(law, "lammps", m=1e-3, v0=[0.1, 0.2, 0.4], radius=0.02)
+    line = x.warnings[0]
+    assert line.startswith("LAMMPS has this law's force as its jkr normal model with damping "
+                           "viscoelastic") and "not export to it yet" in line  # fmt: skip
+    assert "\n" not in line and "hertz/material" in line
+    gaps = np.abs(np.array(x.e_engine) - np.array(x.e_target))
+    assert _worst(line) == pytest.approx(gaps.max(), abs=1e-3)
+
+
 def _dmt_law():
     """The rubber-like sphere on a flat with DMT adhesion (w = 30 J/m^2) and law 14's damping:
     it sticks below about 0.04 m/s."""

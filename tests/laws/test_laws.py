@@ -37,6 +37,7 @@ OTHER_LAWS = {
     # laws with a contact state: plastic, adhesive
     "thornton": dict(c=2e6, x_y=1e-3),
     "jkr": dict(c=2e6, R=0.01, w=200.0),
+    "jkr_viscoelastic": dict(c=2e6, b=800.0, R=0.01, w=200.0),
     "dmt": dict(c=2e6, b=800.0, R=0.01, w=200.0),
 }
 # laws whose every term carries a fractional power of x: no force at all outside contact
