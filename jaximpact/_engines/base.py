@@ -107,9 +107,6 @@ class AbstractEngine(abc.ABC):
     - `CONTINUOUS_PLANT`: a time step of 0 runs a continuous, error-controlled plant.
     - `NEAREST` (optional, default None: its `LAW` law): how the engine's nearest law to
       one it lacks (a plastic or adhesive law) is named in an export's warning.
-    - `UNEXPORTED` (optional, default none): laws the engine has as a model of its own
-      whose export is not built, by law name: that model, in words (an export's warning
-      says so instead of saying that the engine lacks the law).
 
     - `TANGENTIAL` (optional, default none): the tangential laws (`tangential_law` names)
       the engine takes exactly, with `with_tangential`.
@@ -142,7 +139,6 @@ class AbstractEngine(abc.ABC):
     STEPPING: ClassVar[str]
     CONTINUOUS_PLANT: ClassVar[bool]
     NEAREST: ClassVar[str | None] = None
-    UNEXPORTED: ClassVar[Mapping[str, str]] = {}
     TANGENTIAL: ClassVar[tuple[str, ...]] = ()
     FRICTION: ClassVar[str | None] = None
     CONTACT_POINT: ClassVar[Mapping[str, float]] = {"wall": 0.0, "spheres": 0.0}

@@ -606,10 +606,7 @@ def _nearest(chosen: AbstractEngine, source, fields: dict, target_e: float, *, f
     gaps = [abs(a - b) for a, b in zip(mine, law, strict=True)]
     worst = int(np.argmax(gaps))
     nearest = chosen.NEAREST or f"its {chosen.LAW} law"
-    lacked = f"no {source.name} law ({source.spec.equation}; e(v) from a contact state)"
-    if source.name in chosen.UNEXPORTED:
-        lacked = (f"{chosen.UNEXPORTED[source.name]}, but jaximpact does not export to it "
-                  "yet")  # fmt: skip
+    lacked = f"{source.name} law ({source.spec.equation}; e(v) from a contact state)"
     how = (
         f"set to e = {target_e:.3g} (the middle of the law's {min(law):.3g} to "
         f"{max(law):.3g}) and the law's T at {v0:.3g} m/s"
@@ -618,7 +615,7 @@ def _nearest(chosen: AbstractEngine, source, fields: dict, target_e: float, *, f
     )
     tail = "" if fitted else "; pass v0=[...] (m/s) to fit e over the speeds you need"
     return (
-        f"{chosen.LABEL} has {lacked}; the nearest is {nearest}, {how}: from "
+        f"{chosen.LABEL} has no {lacked}; the nearest is {nearest}, {how}: from "
         f"{speeds[0]:.3g} to {speeds[-1]:.3g} m/s its e departs from the law's by up to "
         f"{gaps[worst]:.3g} (|de| at {speeds[worst]:.3g} m/s){tail}"
     )

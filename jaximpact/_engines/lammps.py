@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from . import _stepping, lammps_dmt, lammps_jkr, lammps_script
+from . import _stepping, lammps_dmt, lammps_jkr, lammps_jkr_viscoelastic, lammps_script
 from .base import AbstractEngine, Design, Key, Stepping
 from .lammps_tangential import NO_TANGENTIAL, TANGENTIAL_MODELS, with_tangential
 from .materials import check_poisson, check_positive, check_restitution, hertz_stiffness
@@ -162,10 +162,6 @@ class Lammps(AbstractEngine):
     )
     CONTINUOUS_PLANT = False
     TANGENTIAL = tuple(TANGENTIAL_MODELS)
-    UNEXPORTED = {
-        "jkr_viscoelastic": "this law's force as its jkr normal model with damping "
-        "viscoelastic (damp = b / (m_eff Reff^0.5)), its neck broken at the least force",
-    }
 
     def with_tangential(self, parameters, tangential):
         return with_tangential(parameters, tangential)
@@ -232,6 +228,8 @@ class Lammps(AbstractEngine):
         the law) for a `dmt` law, else None."""
         if law.name == lammps_dmt.LammpsDMT.LAW:
             return lammps_dmt.LammpsDMT(law)
+        if law.name == _JKR_VISCOELASTIC.LAW:
+            return lammps_jkr_viscoelastic.LammpsJKRViscoelastic(law)
         return _JKR if law.name == _JKR.LAW else None
 
     def law(self, parameters, m):
@@ -284,13 +282,17 @@ class Lammps(AbstractEngine):
 
 
 _JKR = lammps_jkr.LammpsJKR()
+_JKR_VISCOELASTIC = lammps_jkr_viscoelastic.LammpsJKRViscoelastic()
 _DMT = lammps_dmt.LammpsDMT()
 
 
 def _cohesive_model(parameters) -> AbstractEngine | None:
-    """LAMMPS's cohesive normal model that `parameters` are for: `dmt` (a `cohesion` with a
+    """LAMMPS's cohesive normal model that `parameters` are for: `jkr` with damping
+    viscoelastic (a `cohesion` and a `damp` with `normal` "jkr"), `dmt` (a `cohesion` with a
     viscoelastic `damp`, or `normal` "dmt"), `jkr` (a `cohesion` alone), or None (the
     Hertz design)."""
     if "cohesion" not in parameters:
         return None
+    if parameters.get("normal") == _JKR.LAW and "damp" in parameters:
+        return _JKR_VISCOELASTIC
     return _DMT if parameters.get("normal") == _DMT.LAW or "damp" in parameters else _JKR

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import jaximpact as ji
-from jaximpact._engines import lammps_jkr
+from jaximpact._engines import lammps_jkr, lammps_jkr_viscoelastic
 from jaximpact._engines.export import UnrealisedExport, engine_response, stepped_response
 from jaximpact._laws.jkr import adhesion_group
 
@@ -184,17 +184,51 @@ def test_jkr_to_an_engine_without_it_names_the_nearest_law():
     assert _worst(x.warnings[0]) == pytest.approx(gaps.max(), abs=1e-3)
 
 
-def test_damped_jkr_to_lammps_says_that_lammps_has_it_but_it_is_not_exported():
-    """LAMMPS's jkr with damping viscoelastic is `jkr_viscoelastic`'s force; its export is
-    not built, so the export goes to the nearest law it has, and says both in one line."""
-    law = ji.law("jkr_viscoelastic", c=2e5, b=30.0, R=0.02, w=0.5)
-    x = ji.export(law, "lammps", m=1e-3, v0=[0.1, 0.2, 0.4], radius=0.02)
-    line = x.warnings[0]
-    assert line.startswith("LAMMPS has this law's force as its jkr normal model with damping "
-                           "viscoelastic") and "not export to it yet" in line  # fmt: skip
-    assert "\n" not in line and "hertz/material" in line
-    gaps = np.abs(np.array(x.e_engine) - np.array(x.e_target))
-    assert _worst(line) == pytest.approx(gaps.max(), abs=1e-3)
+def _damped_law(geometry):
+    """The rubber-like sphere with JKR adhesion (w = 10 J/m^2) and LAMMPS's viscoelastic
+    damping (b = 3 N s/m^1.5): it sticks below about 0.05 m/s."""
+    R2, R_eff = (None, R) if geometry == "wall" else (R, R / 2)
+    c = ji.hertz_stiffness(E=E, nu=NU, R=R, R2=R2)
+    return ji.law("jkr_viscoelastic", c=c, b=3.0, R=R_eff, w=10.0)
+
+
+@pytest.mark.parametrize("e", [0.3, 0.8, 0.97])
+def test_damped_lammps_impact_without_damping_is_the_closed_form(e):
+    """`lammps_jkr_viscoelastic.lammps_impact` (scipy's DOP853 through LAMMPS's damped JKR)
+    at beta = 0 against `lammps_jkr`'s energy closed form and quadrature: q for e, and the
+    duration, to 1e-9."""
+    q = lammps_jkr.group_for(e)
+    assert lammps_jkr_viscoelastic.group_for(e, 0.0) == pytest.approx(q, rel=1e-9)
+    e_damped, tau_damped = lammps_jkr_viscoelastic.lammps_impact(q, 0.0)
+    assert e_damped == pytest.approx(e, rel=1e-9)
+    assert tau_damped == pytest.approx(lammps_jkr.lammps_impact(q)[1], rel=1e-9)
+    assert lammps_jkr_viscoelastic.lammps_impact(q, 0.1)[0] < e  # damping takes energy
+
+
+@pytest.mark.parametrize("geometry", ["wall", "spheres"])
+def test_damped_jkr_export_to_lammps_realises_the_law_at_v0(geometry):
+    """`jkr_viscoelastic` goes to LAMMPS's `jkr` with `damping viscoelastic`: the law's
+    damping group kept at v0, the cohesion set so that LAMMPS's continuous impact (scipy) has
+    the law's e there, E its T. The replica (velocity Verlet, independent of scipy) at an
+    eighth of the export's step is the law's e and T within 2e-4; at the export's step
+    within the 0.5 % the export holds it to; below the sticking speed both hold the body."""
+    law = _damped_law(geometry)
+    v0 = 0.3
+    x = ji.export(law, "lammps", m=M, v0=v0, radius=R, geometry=geometry)
+    exact = ji.impact(law, m=M, v0=v0)
+    assert (
+        "jkr" in x.parameters["pair_coeff"] and "damping viscoelastic" in x.parameters["pair_coeff"]
+    )
+    assert abs(x.e / float(exact.e) - 1) < 5e-3 and abs(x.T / float(exact.T) - 1) < 5e-3
+    fine = {**x.parameters, "timestep": x.timestep / 8}
+    es, Ts = lammps_jkr_viscoelastic.replica(fine, M, v0)
+    assert es.mean() == pytest.approx(float(exact.e), rel=2e-4)
+    assert Ts.mean() == pytest.approx(float(exact.T), rel=2e-4)
+    stuck, _ = lammps_jkr_viscoelastic.replica({**x.parameters, "timestep": x.timestep}, M, 0.02)
+    assert float(ji.impact(law, m=M, v0=0.02).e) == 0.0 and np.all(stuck == 0.0)
+    assert x.e_engine[0] == 0.0 and x.e_target[0] == 0.0  # 0.03 m/s: stuck in both
+    with pytest.raises(ValueError, match="limit_damping"):
+        ji.export(law, "lammps", m=M, v0=v0, radius=R, geometry=geometry, limit_damping=True)
 
 
 def _dmt_law():

