@@ -103,6 +103,11 @@ def _with(tangential, free, theta):
     return eqx.tree_at(lambda item: item.params, tangential, params)
 
 
+# the friction coefficients of the start grid when mu is free (log-spaced, a decade either
+# side of the start)
+_MU_SCAN = 5
+
+
 @eqx.filter_jit
 def _fit(law, tangential, m, R, inertia, g, data, free, options, max_steps, tol, scan):
     v_n, v_t, omega, e_t, omega_out, s_e, s_w, has_e, has_w = data
@@ -135,13 +140,21 @@ def _fit(law, tangential, m, R, inertia, g, data, free, options, max_steps, tol,
         # minimum per phase: the best of a log grid, a decade either side, is a second start
         # beside the given one (the best grid point can lie in a shallower minimum: Kharaz's
         # e_t and spin from G* = 13.5 GPa gave 9.9 GPa with loss 0.0066 unscanned, 1.3 GPa
-        # with loss 0.039 from the grid's best)
+        # with loss 0.039 from the grid's best). With mu free too the grid spans mu as well
+        # (five values, a decade either side), and the best two points are starts: with mu
+        # held at its start the stiffness's best point can be another phase's (data made
+        # with kt = 1e7, mu = 0.092 from kt = 3e6, mu = 0.2: 3.4e6, 0.096, rms e_t 0.017)
         k = free.index(stiffness)
-        grid = theta0[k] + jnp.log(10.0) * jnp.linspace(-1.0, 1.0, scan)
-        thetas = jnp.broadcast_to(theta0, (scan, len(free))).at[:, k].set(grid)
+        axes = [theta0[i][None] for i in range(len(free))]
+        axes[k] = theta0[k] + jnp.log(10.0) * jnp.linspace(-1.0, 1.0, scan)
+        if "mu" in free:
+            j = free.index("mu")
+            axes[j] = theta0[j] + jnp.log(10.0) * jnp.linspace(-1.0, 1.0, _MU_SCAN)
+        thetas = jnp.stack(jnp.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, len(free))
         losses = jax.vmap(lambda t: jnp.sum(residuals(t, None) ** 2))(thetas)
-        best = thetas[jnp.argmin(jnp.where(jnp.isfinite(losses), losses, jnp.inf))]
-        starts = jnp.stack([theta0, best])
+        order = jnp.argsort(jnp.where(jnp.isfinite(losses), losses, jnp.inf))
+        best = thetas[order[: 2 if "mu" in free else 1]]
+        starts = jnp.concatenate([theta0[None], best])
 
     def solve(start):
         solution = optx.least_squares(
@@ -208,7 +221,9 @@ def fit_oblique(
     `tangential` itself and the best of `start_scan` stiffnesses (`kt` or `G_star`, when
     free) spread over a decade either side of it (the stiffness sets the phase of the
     tangential oscillation in a sticking contact, and the loss has one minimum per phase:
-    from kt = 2e7 N/m a fit of data made with 5e7 stopped at 1.2e7 without the scan);
+    from kt = 2e7 N/m a fit of data made with 5e7 stopped at 1.2e7 without the scan); with
+    `mu` free too, over five friction coefficients as well, and the best two grid points
+    are starts (three in all);
     `start_scan=0` starts from `tangential` alone. The impacts are
     solved with forward-mode derivatives and landed events (`oblique_impact(...,
     land_events=True)`), so the Jacobian is exact across the stick-slip transitions. A

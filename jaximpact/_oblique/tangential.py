@@ -363,9 +363,15 @@ def shear_modulus_star(G, nu, G2=None, nu2=0.0):
     return 1.0 / compliance
 
 
+# Poisson's ratio taken where a shear modulus comes without one (with a warning), as the
+# engines' exports take it (`poisson=0.3`)
+POISSON_DEFAULT = 0.3
+
+
 def _mindlin_parameters(name, given):
     """`G_star` and `mu` from what the user gave: `G_star` itself, or `G` and `nu` (and
-    `G2`, `nu2` for a second body)."""
+    `G2`, `nu2` for a second body); a modulus without its Poisson's ratio takes
+    `POISSON_DEFAULT`, and says so in a warning."""
     if "G_star" in given:
         extra = sorted(set(given) & {"G", "nu", "G2", "nu2"})
         if extra:
@@ -374,21 +380,32 @@ def _mindlin_parameters(name, given):
                 f"(got G_star and {', '.join(extra)})"
             )
         return {"G_star": given["G_star"]}
-    if "G" not in given or "nu" not in given:
+    if "G" not in given:
         raise ValueError(
             f"tangential law {name!r} needs G (Pa) and nu, or G_star (Pa); "
             f"got {', '.join(sorted(given)) or 'nothing'}"
         )
     check_positive(f"{name}: shear modulus G", given["G"], "Pa")
-    _check_poisson(name, "nu", given["nu"])
     G2 = given.get("G2")
     if G2 is not None:
         check_positive(f"{name}: shear modulus G2", G2, "Pa")
-    nu2 = given.get("nu2", 0.0)
-    _check_poisson(name, "nu2", nu2)
     if "nu2" in given and G2 is None:
         raise ValueError(f"tangential law {name!r}: nu2 without G2 (the second body's modulus)")
-    return {"G_star": shear_modulus_star(given["G"], given["nu"], G2, nu2)}
+    assumed = [k for k, modulus in (("nu", "G"), ("nu2", "G2"))
+               if given.get(modulus) is not None and k not in given]  # fmt: skip
+    if assumed:
+        import warnings
+
+        warnings.warn(
+            f"tangential law {name!r}: {' and '.join(assumed)} not given, taken as "
+            f"{POISSON_DEFAULT} (G* = 1 / ((2 - nu)/G + ...)); give "
+            f"{' and '.join(assumed)}, or G_star, to set it",
+            stacklevel=3,
+        )
+    nu, nu2 = given.get("nu", POISSON_DEFAULT), given.get("nu2", POISSON_DEFAULT)
+    _check_poisson(name, "nu", nu)
+    _check_poisson(name, "nu2", nu2)
+    return {"G_star": shear_modulus_star(given["G"], nu, G2, nu2)}
 
 
 def _check_poisson(name, key, value):
@@ -407,8 +424,9 @@ def tangential_law(name: str, **params) -> AbstractTangentialLaw:
     - `"linear_history"`: `kt` (N/m, > 0), `mu` (>= 0), `ct` (N s/m, >= 0, default 0).
     - `"mindlin"`, `"mindlin_force"`: `mu` and either `G_star` (Pa) or the sphere's shear
       modulus `G` (Pa) and Poisson's ratio `nu` (and `G2`, `nu2` of a second body; a rigid
-      plane without them); `beta` (>= 0, default 0), the damper of EDEM's and LIGGGHTS'
-      Hertz-Mindlin (module docstring).
+      plane without them; a Poisson's ratio not given is taken as 0.3, with a warning);
+      `beta` (>= 0, default 0), the damper of EDEM's and LIGGGHTS' Hertz-Mindlin (module
+      docstring).
 
     **Example**: `tangential_law("linear_history", kt=1e7, mu=0.3)`.
     """

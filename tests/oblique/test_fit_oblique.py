@@ -53,6 +53,25 @@ def test_recovers_linear_history():
 
 
 @pytest.mark.slow
+def test_recovers_linear_history_from_e_t_alone_with_both_starts_off():
+    """DESIGN.md's call, from e_t alone at five tangential speeds (kt = 1e7 N/m, mu = 0.092
+    on law 14), starting at kt = 3e6, mu = 0.2: with the stiffness scanned at the start's
+    mu only, the fit stopped in another phase's minimum (kt 3.4e6, mu 0.096, rms e_t 0.017);
+    the grid over mu too finds the truth to 1e-7."""
+    law = ji.law("hertz_rate", c=4.2e9, b1=1e4)
+    truth = tangential_law("linear_history", kt=1e7, mu=0.092)
+    v_t = np.linspace(0.3, 3.0, 5)
+    e_t = np.array([float(oblique_impact(law, truth, m=2.6e-4, R=2.5e-3, v_n=3.0, v_t=v).e_t)
+                    for v in v_t])  # fmt: skip
+    start = tangential_law("linear_history", kt=3e6, mu=0.2)
+    fit = fit_oblique(law, start, m=2.6e-4, R=2.5e-3, v_n=np.full(5, 3.0), v_t=v_t, e_t=e_t,
+                      free=("kt", "mu"))  # fmt: skip
+    assert bool(fit.converged) and float(fit.rms_e_t) < 1e-8
+    assert float(fit.params["kt"]) == pytest.approx(1e7, rel=1e-7)
+    assert float(fit.params["mu"]) == pytest.approx(0.092, rel=1e-7)
+
+
+@pytest.mark.slow
 def test_recovers_mindlin_with_noise():
     """G* and mu of a Mindlin law from e_t alone with noise 0.003 (given as sigma_e_t):
     the truth within three standard errors (measured: 0.9 and 1.3), which the noise sets."""

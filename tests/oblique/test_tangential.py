@@ -87,7 +87,6 @@ def test_dynamics_scales():
         ("linear_history", dict(mu=0.1), "needs kt"),
         ("linear_history", dict(kt=1e7), "needs mu"),
         ("mindlin", dict(mu=0.1), "needs G .* and nu, or G_star"),
-        ("mindlin", dict(G=1e9, mu=0.1), "needs G .* and nu, or G_star"),
         ("mindlin", dict(G_star=1e9, G=1e9, nu=0.3, mu=0.1), "give G_star or G and nu"),
         ("mindlin", dict(G=1e9, nu=0.7, mu=0.1), r"Poisson's ratio nu must lie in \(-1, 0.5\)"),
         ("mindlin", dict(G=-1e9, nu=0.3, mu=0.1), "shear modulus G must be a finite number > 0"),
@@ -99,6 +98,17 @@ def test_bad_input_is_one_line(name, params, match):
     with pytest.raises(ValueError, match=match) as info:
         tangential_law(name, **params)
     assert "\n" not in str(info.value)
+
+
+def test_a_modulus_without_its_poisson_ratio_takes_0_3_and_says_so():
+    """DESIGN.md's call `tangential_law("mindlin", G=3e10, mu=0.3)`: G* = G / (2 - 0.3), a
+    warning naming nu; with a second body each ratio not given alike."""
+    with pytest.warns(UserWarning, match="nu not given, taken as 0.3"):
+        tl = tangential_law("mindlin", G=3e10, mu=0.3)
+    assert float(tl.params["G_star"]) == pytest.approx(3e10 / 1.7, rel=1e-15)
+    with pytest.warns(UserWarning, match="nu2 not given"):
+        two = tangential_law("mindlin", G=3e10, nu=0.25, G2=7e10, mu=0.3)
+    assert float(two.params["G_star"]) == pytest.approx(1 / (1.75 / 3e10 + 1.7 / 7e10), rel=1e-14)
 
 
 def test_bad_types_and_replace():
