@@ -194,26 +194,14 @@ class Lammps(AbstractEngine):
             step="timestep",
         )
         model = _model(E, coefficient, poisson, limit_damping)
-        parameters = {
-            "pair_style": "pair_style granular",
-            "pair_coeff": f"pair_coeff * * {model}",
-            "timestep": f"timestep {h:.6g}",
-            "timestep_s": h,
-            "youngs_modulus": E,
-            "coeff_restitution": coefficient,
-            "poisson": poisson,
-            "k": c,
-            "b": b,
-            "limit_damping": limit_damping,
-            "units": "units si",
-        }
+        parameters = lammps_script.granular_parameters(
+            model, h, E=E, poisson=poisson, wall=wall, coeff_restitution=coefficient, k=c,
+            b=b, limit_damping=limit_damping,
+        )  # fmt: skip
         stepping = dict(E=E, coeff_restitution=coefficient, poisson=poisson,
                         limit_damping=limit_damping, timestep=h)  # fmt: skip
-        if wall:
-            # the wall at z = 0, the sphere above it: the same model as the pair's (one
-            # material)
-            parameters["fix_wall"] = f"fix wall all wall/gran granular {model} zplane 0.0 NULL"
-            parameters["geometry"] = stepping["geometry"] = "wall"
+        if wall:  # the wall at z = 0, the sphere above it: the pair's model (one material)
+            stepping["geometry"] = "wall"
         return Design(
             parameters=parameters,
             **_stepping.realised(es, Ts, h),

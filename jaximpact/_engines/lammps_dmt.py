@@ -160,22 +160,10 @@ class LammpsDMT(AbstractEngine):
         )
         stepping["timestep"] = h
         text = model(E, damp, poisson, cohesion)
-        parameters = {
-            "pair_style": "pair_style granular",
-            "pair_coeff": f"pair_coeff * * {text}",
-            "timestep": f"timestep {h:.6g}",
-            "timestep_s": h,
-            "youngs_modulus": E,
-            "poisson": poisson,
-            "damp": damp,
-            "cohesion": cohesion,
-            "R_eff": R_eff,
-            "normal": "dmt",
-            "units": "units si",
-        }
-        if wall:
-            parameters["fix_wall"] = f"fix wall all wall/gran granular {text} zplane 0.0 NULL"
-            parameters["geometry"] = "wall"
+        parameters = lammps_script.granular_parameters(
+            text, h, E=E, poisson=poisson, R_eff=R_eff, wall=wall, damp=damp,
+            cohesion=cohesion, normal="dmt",
+        )  # fmt: skip
         return Design(
             parameters=parameters,
             **_stepping.realised(es, Ts, h),

@@ -235,23 +235,11 @@ class LammpsJKRViscoelastic(AbstractEngine):
             "the export's e(v) is the replica's, beside the law's"
         )
         text = model(E, damp, poisson, cohesion)
-        parameters = {
-            "pair_style": "pair_style granular",
-            "pair_coeff": f"pair_coeff * * {text}",
-            "timestep": f"timestep {h:.6g}",
-            "timestep_s": h,
-            "youngs_modulus": E,
-            "poisson": poisson,
-            "cohesion": cohesion,
-            "damp": damp,
-            "R_eff": R_eff,
-            "normal": "jkr",
-            "pulloff_distance": float(pulloff_distance(R_eff, cohesion, E_mix)),
-            "units": "units si",
-        }
-        if wall:
-            parameters["fix_wall"] = f"fix wall all wall/gran granular {text} zplane 0.0 NULL"
-            parameters["geometry"] = "wall"
+        parameters = lammps_script.granular_parameters(
+            text, h, E=E, poisson=poisson, R_eff=R_eff, wall=wall, cohesion=cohesion,
+            damp=damp, normal="jkr",
+            pulloff_distance=float(pulloff_distance(R_eff, cohesion, E_mix)),
+        )  # fmt: skip
         return Design(
             parameters=parameters,
             **_stepping.realised(es, Ts, h),

@@ -1,6 +1,7 @@
-"""What LAMMPS's three exported models (`lammps`: hertz/material; `lammps_jkr`; `lammps_dmt`)
-share: the script of an export's scene (`snippet`), and the effective radius of its contact
-(`with_effective_radius`)."""
+"""What LAMMPS's exported models (`lammps`: hertz/material; `lammps_jkr`,
+`lammps_jkr_viscoelastic`, `lammps_dmt`) share: the script of an export's scene
+(`snippet`), the effective radius of its contact (`with_effective_radius`), and the
+parameters of a `pair_style granular` design (`granular_parameters`)."""
 
 from .materials import check_positive
 
@@ -34,3 +35,26 @@ def with_effective_radius(parameters, radius) -> dict:
         raise ValueError(f"lammps needs the {what} radius: pass radius= (m)")
     radius = check_positive("radius", radius, "m")
     return {**parameters, "R_eff": radius if wall else radius / 2.0}
+
+
+def granular_parameters(text: str, h: float, *, E: float, poisson: float, wall: bool,
+                        R_eff: float | None = None, **model) -> dict:  # fmt: skip
+    """An export's `parameters` for LAMMPS's `pair_style granular` with the model `text`
+    (what follows `pair_coeff * *`) at time step `h` (s): the commands, Young's modulus
+    `E` (Pa), `poisson`, `R_eff` (m, where the model has one), the model's own values
+    (`model`, SI units), and with `wall` the `fix wall/gran` on the plane z = 0."""
+    parameters = {
+        "pair_style": "pair_style granular",
+        "pair_coeff": f"pair_coeff * * {text}",
+        "timestep": f"timestep {h:.6g}",
+        "timestep_s": h,
+        "youngs_modulus": E,
+        "poisson": poisson,
+        **model,
+        **({} if R_eff is None else {"R_eff": R_eff}),
+        "units": "units si",
+    }
+    if wall:
+        parameters["fix_wall"] = f"fix wall all wall/gran granular {text} zplane 0.0 NULL"
+        parameters["geometry"] = "wall"
+    return parameters

@@ -237,6 +237,7 @@ def _dmt_law():
     return ji.law("dmt", c=ji.hertz_stiffness(E=E, nu=NU, R=R), b=3.0, R=R, w=30.0)
 
 
+@pytest.mark.slow  # moved from the fast suite to keep it near 3 minutes
 @pytest.mark.parametrize("geometry", ["wall", "spheres"])
 def test_dmt_export_to_lammps_is_the_law_itself(geometry):
     """LAMMPS's `dmt` with `damping viscoelastic` is the `dmt` law: the export's engine law

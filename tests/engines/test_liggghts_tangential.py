@@ -58,6 +58,7 @@ def test_poisson_s_ratio_gives_the_law_s_shear_modulus():
     assert poisson_for(0.3) == 0.0 and poisson_for(0.1) == 0.4999  # clamped
 
 
+@pytest.mark.slow  # moved from the fast suite to keep it near 3 minutes
 def test_the_undamped_law_is_liggghts_own():
     x = _export("undamped")
     p = x.parameters

@@ -100,6 +100,7 @@ def test_the_export_to_mujoco_takes_mu_and_says_how_far_it_falls():
     assert tuple(x.to_dict()["e_n_engine"]) == x.e_n_engine
 
 
+@pytest.mark.slow  # moved from the fast suite to keep it near 3 minutes
 def test_mujoco_without_friction_is_the_frictionless_contact():
     frictionless = ji.tangential_law("linear_history", kt=1e6, mu=0.0)
     x = ji.export(LAW, "mujoco", m=M, v0=3.9, radius=R, tangential=frictionless, curves=False)

@@ -82,6 +82,7 @@ def test_other_engines_and_a_damped_spring_are_refused_in_one_line():
         ji.export(LAW, "lammps", m=M, v0=3.9, radius=R, tangential=beta)
 
 
+@pytest.mark.slow  # moved from the fast suite to keep it near 3 minutes
 def test_the_clause_is_lammps_own():
     """k = kt for linear_history, 8 G* for Mindlin (LAMMPS multiplies it by the contact
     radius), no tangential damping; in pair_coeff and fix wall/gran alike."""

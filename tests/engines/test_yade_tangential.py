@@ -46,6 +46,7 @@ def test_yade_realises_the_tangential_promise_on_a_wall(name):
         assert e == pytest.approx(x.e_n_engine[k], rel=1e-3)
 
 
+@pytest.mark.slow  # moved from the fast suite to keep it near 3 minutes
 def test_the_material_is_explicit_and_the_normal_contact_unchanged():
     x = _export("stiff")
     p = x.parameters
@@ -103,6 +104,7 @@ def test_yade_realises_the_tangential_promise_between_two_spheres(name):
         assert e == pytest.approx(promise[0], abs=0.01)
 
 
+@pytest.mark.slow  # moved from the fast suite to keep it near 3 minutes
 def test_two_soft_spheres_are_warned_of_their_turning_line_of_centres():
     """The wall test's soft contact between two spheres (T = 1.6 ms, R = 1 cm): the line of
     centres turns by 0.075 rad at 75 degrees, and real Yade's e there is 0.72 against the

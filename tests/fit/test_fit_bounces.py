@@ -100,10 +100,7 @@ def test_impact_times_round_trip_recovers_e_within_its_uncertainty():
     assert abs(fit.nuisance["drop_height"] - 0.9) < 0.05
     assert abs(fit.nuisance["t_impact"] - (golf_drop()[0][0] + 1.234)) < 3e-3
     assert fit.params["c"] == 5.5e7  # held
-
-
-def test_a_bounce_fit_prints_numbers_with_units():
-    fit = golf_fit()
+    # the fit prints as numbers with units (repr, summary, to_dict)
     text = repr(fit)
     assert text == fit.summary() and "f64[" not in text and "Array(" not in text
     assert text.startswith("hertz_rate: impacts, converged") and "noise" in text

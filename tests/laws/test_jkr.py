@@ -241,6 +241,7 @@ def test_damped_impact_matches_an_independent_scipy_integration(ratio):
         assert float(r.e) < math.sqrt(1 - ratio**-2)  # the damping takes energy too
 
 
+@pytest.mark.slow  # moved from the fast suite to keep it near 3 minutes
 def test_damped_gradients_match_central_differences():
     """The force has a square-root branch at pull-off (`a(x)` turns there), so the solve's
     derivatives converge slowly with rtol: de/db is 3e-3 off at rtol 1e-10, 3e-4 at 1e-12
