@@ -120,7 +120,8 @@ def add_export(subparsers):
     parser.add_argument(
         "--tangential", metavar="NAME",
         help=f"{_labels(lambda e: bool(e.TANGENTIAL or e.FRICTION))}: also export the "
-        "tangential law NAME (linear_history, mindlin, mindlin_force; MuJoCo and Drake take "
+        "tangential law NAME (linear_history, mindlin, mindlin_force, mindlin_rescale, "
+        "mindlin_rescale_force; MuJoCo and Drake take "
         "its mu alone) with --tparam, and print the e_t, spin and normal e the engine "
         "realises from 5 to 75 degrees, beside the law's e_t",
     )  # fmt: skip

@@ -60,7 +60,13 @@ def add_fit_oblique(subparsers):
     parser.add_argument(
         "--tangential",
         required=True,
-        choices=("mindlin", "mindlin_force", "linear_history"),
+        choices=(
+            "mindlin",
+            "mindlin_force",
+            "mindlin_rescale",
+            "mindlin_rescale_force",
+            "linear_history",
+        ),  # jaximpact.TANGENTIAL_LAW_NAMES (no JAX import here)
         help="the tangential law to fit",
     )
     parser.add_argument(

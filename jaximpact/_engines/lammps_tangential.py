@@ -5,9 +5,12 @@ and the JKR normal models (`lammps.py`, `lammps_jkr.py`).
 LAMMPS doc pair_granular; src/GRANULAR/gran_sub_mod_tangential.cpp (release 22Jul2025):
 `linear_history` is a spring with displacement history `F_t = -k xi`; `mindlin`,
 `F_t = -k a xi` with the contact radius `a = (R x)^0.5`; `mindlin/force`, the force history
-`dF_t = -k a dxi`; each capped at `mu |F_n|` (the normal force with its damping), the
-history rescaled to the cap while sliding. These are the equations of jaximpact's
-`linear_history`, `mindlin` and `mindlin_force` (`k = kt`, or `k = 8 G*`), whose spring is
+`dF_t = -k a dxi`; `mindlin_rescale` and `mindlin_rescale/force` the same with the history
+scaled by `a_new / a_old` at each step where the contact radius shrinks; each capped at
+`mu |F_n|` (the normal force with its damping), the history rescaled to the cap while
+sliding. These are the equations of jaximpact's `linear_history`, `mindlin`,
+`mindlin_force`, `mindlin_rescale` and `mindlin_rescale_force` (`k = kt`, or `k = 8 G*`),
+whose spring is
 set to the limit it was held at when it sticks again. LAMMPS's own `k = NULL` for a wall
 is `8 E / (4 (2 - nu)(1 + nu))`, the G* of a sphere on a wall of its own material; the
 export writes `k` itself, so any G* goes.
@@ -16,7 +19,8 @@ export writes `k` itself, so any G* goes.
 NO_TANGENTIAL = "tangential linear_nohistory 0 0"
 # jaximpact tangential law -> LAMMPS tangential model
 TANGENTIAL_MODELS = {"linear_history": "linear_history", "mindlin": "mindlin",
-                     "mindlin_force": "mindlin/force"}  # fmt: skip
+                     "mindlin_force": "mindlin/force", "mindlin_rescale": "mindlin_rescale",
+                     "mindlin_rescale_force": "mindlin_rescale/force"}  # fmt: skip
 
 
 def tangential_clause(tangential) -> str:

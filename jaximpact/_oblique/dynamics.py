@@ -78,7 +78,8 @@ class ObliqueDynamics(eqx.Module):
     def rhs(self, y, mode, sense, compressing):
         y_n, q, _, _ = self.parts(y)
         force = self.tangential_force(y, mode, sense, compressing)
-        stick_rate = self.tangential.stick_rate(q, self.normal.position(y_n), self.slip(y))
+        x, v = self.normal.position(y_n), self.normal.velocity(y_n)
+        stick_rate = self.tangential.stick_rate(q, x, self.slip(y), v)
         return jnp.concatenate(
             [
                 self.normal.rhs(y_n, compressing),

@@ -20,8 +20,12 @@ names them):
   Thornton et al. 2011's "no-slip" model). Its first-touch stick criterion is Maw, Barber
   & Fawcett's: the contact starts sticking where `psi_1 < 1` (notes/contact-physics.md 4.1).
 
-Neither rescales the history on unloading (LAMMPS `mindlin_rescale`,
-`mindlin_rescale/force`: not built here).
+Each Mindlin history also comes rescaled on unloading (LAMMPS `mindlin_rescale`,
+`mindlin_rescale/force`: gran_sub_mod_tangential.cpp scales the history by `a_new / a_old`
+at each step where the contact radius `a` shrinks): while sticking, `Q' = (rate above) +
+Q a'/a` where `a' < 0`, `a'/a = x'/(2x)` for Mindlin's `a = (R x)^0.5`. The stretch then
+shrinks with the contact, so a displacement history no longer makes elastic energy as
+`k_t` falls.
 
 Damping on the slip while sticking, in the two conventions the engines use:
 
@@ -61,7 +65,8 @@ class TangentialSpec:
     damper (LAMMPS's convention), else the spring alone (LIGGGHTS', EDEM's). `history`:
     `"displacement"` or `"force"` (module docstring); `power`: the exponent of the overlap
     in the stiffness, `k_t = k0 x^power` (0 for a constant spring, 0.5 for Mindlin's
-    `8 G* sqrt(R x)`); `engines`: where the same variant is found.
+    `8 G* sqrt(R x)`); `rescaled`: the history shrinks with the contact radius on
+    unloading (module docstring); `engines`: where the same variant is found.
     """
 
     name: str
@@ -76,10 +81,16 @@ class TangentialSpec:
     defaults: dict[str, float] = dataclasses.field(default_factory=dict)
     inputs: tuple[str, ...] = ()
     damper_tested: bool = True
+    rescaled: bool = False
 
     def __post_init__(self):
         if self.history not in HISTORIES:
             raise ValueError(f"row {self.name!r}: history must be one of {HISTORIES}")
+
+
+# the overlap (units of x*) below which a rescaled history shrinks no faster
+# (`TangentialDynamics.stick_rate`)
+RESCALE_FLOOR = 1e-9
 
 
 class TangentialDynamics(eqx.Module):
@@ -98,6 +109,7 @@ class TangentialDynamics(eqx.Module):
     history: str = eqx.field(static=True)
     damping_power: float = eqx.field(static=True, default=0.0)
     damper_tested: bool = eqx.field(static=True, default=True)
+    rescaled: bool = eqx.field(static=True, default=False)
 
     def damper(self, x):
         """`D(X)`: 0 outside the surface where it grows with the overlap."""
@@ -123,9 +135,18 @@ class TangentialDynamics(eqx.Module):
         """The force Coulomb's limit caps: the trial force, or the spring's alone."""
         return self.trial(q, x, u) if self.damper_tested else self.elastic(q, x)
 
-    def stick_rate(self, q, x, u):
-        """`dQ/dtau` while sticking."""
-        return u if self.history == "displacement" else -self.stiffness(x) * u
+    def stick_rate(self, q, x, u, v):
+        """`dQ/dtau` while sticking, at overlap `x` closing at `v` (`X' = v`): rescaled,
+        `Q` shrinks as the contact radius, `Q v / (2x)` where `v < 0`."""
+        rate = u if self.history == "displacement" else -self.stiffness(x) * u
+        if not self.rescaled:
+            return rate
+        # the shrinking rate, `v/(2x)`, grows without bound as the overlap closes, which
+        # no explicit step outruns where the contact sticks to the end: it is held at its
+        # value at `RESCALE_FLOOR x*`, where the spring carries less than 1e-9 of its force
+        inside = x > 0
+        shrink = jnp.minimum(v, 0.0) / (2.0 * jnp.maximum(x, RESCALE_FLOOR))
+        return rate + jnp.where(inside, q * shrink, 0.0)
 
     def held(self, sense, cap, x, u):
         """The spring state that puts the tested force at the limit, `tested = -sense cap`
@@ -212,6 +233,7 @@ class AbstractTangentialLaw(eqx.Module):
             history=self.spec.history,
             damping_power=damping_power,
             damper_tested=self.spec.damper_tested,
+            rescaled=self.spec.rescaled,
         )
 
     def _refuse_unknown(self, params):
@@ -346,11 +368,30 @@ MINDLIN_FORCE = dataclasses.replace(
     "Law2_ScGeom_MindlinPhys_Mindlin (incremental shear force)",
 )
 
+MINDLIN_RESCALE = dataclasses.replace(
+    MINDLIN,
+    name="mindlin_rescale",
+    formula="F_t = -8 G* sqrt(R x) delta - 2 sqrt(5/6) beta sqrt(m k_t) u, delta' = u + "
+    "delta min(x', 0)/(2x) while sticking; |8 G* sqrt(R x) delta| <= mu |F_n|",
+    rescaled=True,
+    engines="LAMMPS pair granular tangential mindlin_rescale",
+)
+MINDLIN_RESCALE_FORCE = dataclasses.replace(
+    MINDLIN_FORCE,
+    name="mindlin_rescale_force",
+    formula="F_t = S - 2 sqrt(5/6) beta sqrt(m k_t) u, S' = -8 G* sqrt(R x) u + S min(x', "
+    "0)/(2x) while sticking; |S| <= mu |F_n|",
+    rescaled=True,
+    engines="LAMMPS pair granular tangential mindlin_rescale/force",
+)
+
 TANGENTIAL_LAWS: dict[str, TangentialSpec] = {
-    spec.name: spec for spec in (LINEAR_HISTORY, MINDLIN, MINDLIN_FORCE)
+    spec.name: spec
+    for spec in (LINEAR_HISTORY, MINDLIN, MINDLIN_FORCE, MINDLIN_RESCALE, MINDLIN_RESCALE_FORCE)
 }
 TANGENTIAL_LAW_NAMES: tuple[str, ...] = tuple(TANGENTIAL_LAWS)
-_CLASSES = {"linear_history": LinearHistoryLaw, "mindlin": MindlinLaw, "mindlin_force": MindlinLaw}
+_CLASSES = {name: LinearHistoryLaw if name == "linear_history" else MindlinLaw
+            for name in TANGENTIAL_LAW_NAMES}  # fmt: skip
 
 
 def shear_modulus_star(G, nu, G2=None, nu2=0.0):

@@ -2,7 +2,8 @@
 wheel): at the recommended step its tangential restitution and spin after impact are the
 export's promise (the continuous laws through `oblique_impact`) from 5 to 75 degrees, in
 stick, micro-slip and gross sliding, for each of LAMMPS's models that jaximpact's
-tangential laws are (linear_history, mindlin, mindlin/force). The harness is in
+tangential laws are (linear_history, mindlin, mindlin/force, mindlin_rescale,
+mindlin_rescale/force). The harness is in
 `harness.py`; docs/oblique.md ("To the engines") has the measured table."""
 
 import math
@@ -21,6 +22,8 @@ TANGENTIAL = {
     "linear_history": ji.tangential_law("linear_history", kt=1e6, mu=0.092),
     "mindlin": ji.tangential_law("mindlin", G_star=1.35e10, mu=0.092),
     "mindlin_force": ji.tangential_law("mindlin_force", G_star=1.35e10, mu=0.092),
+    "mindlin_rescale": ji.tangential_law("mindlin_rescale", G_star=1.35e10, mu=0.092),
+    "mindlin_rescale_force": ji.tangential_law("mindlin_rescale_force", G_star=1.35e10, mu=0.092),
 }
 ANGLES = (5.0, 20.0, 45.0, 75.0)  # a subset of OBLIQUE_ANGLES
 

@@ -26,7 +26,8 @@ from scipy.integrate import solve_ivp
 
 def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_star=None,
                    history="displacement", beta=0.0, rtol=1e-12, max_switches=40,
-                   share=0.0, b_tsuji=0.0, kelvin_voigt=None, end="penetration"):  # fmt: skip
+                   share=0.0, b_tsuji=0.0, kelvin_voigt=None, end="penetration",
+                   rescale=False):  # fmt: skip
     """Returns dict(e, v_t_out, omega_out, T, switches). `beta` (Mindlin only): the damper
     `2 (5/6)^0.5 beta (m k_t)^0.5` on the slip while sticking, left out of Coulomb's test
     (LIGGGHTS' convention), so the switches are the undamped ones' formulas. `share` f: the
@@ -35,7 +36,9 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
     (N s/m^1.25), which pulls before the overlap closes. `kelvin_voigt=(k, b)`: the
     normal force is `k x + b v` instead (N/m, N s/m; it starts at `b v_n`, so the contact
     sticks at first touch); `end="force"`: contact ends where the normal force falls to 0
-    (else at x = 0)."""
+    (else at x = 0). `rescale` (Mindlin): LAMMPS's `mindlin_rescale` rule, the history
+    scaled by `a_new / a_old` wherever the contact radius `a = (R x)^0.5` shrinks: while
+    sticking `q' += q min(x', 0) / (2x)`."""
     moment = inertia * m * R**2
     mindlin = G_star is not None
 
@@ -91,7 +94,12 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
         dq = 0.0
         if mode == "stick":
             dq = u if history == "displacement" else -k * u
+            dq += shrink(x, v) * q
         return [v, -f / m, dq, ft / m, -lever(x) * ft / moment]
+
+    def shrink(x, v):
+        """`a'/a` where the contact radius shrinks (rescaled histories), else 0."""
+        return 0.5 * min(v, 0.0) / x if rescale and x > 0 else 0.0
 
     def held(state, s):
         x, v, q, vt, w = state
@@ -115,8 +123,9 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
         f, df = abs(f), math.copysign(1.0, f) * df
         if history == "displacement":
             dheld = s * mu * (df * k - f * dk) / k**2
-            return s * (u - dheld)
-        return s * u - mu * df / k
+            # the spring held at s mu f / k, shrunk as the contact radius where rescaled
+            return s * (u + shrink(x, v) * s * mu * f / k - dheld)
+        return s * u + shrink(x, v) * mu * f / k - mu * df / k
 
     # first touch at t0 (tiny): leading-order state
     T_scale = (m**2 / (c**2 * v_n)) ** 0.2 if kelvin_voigt is None else (m / kelvin_voigt[0]) ** 0.5

@@ -222,6 +222,13 @@ ORACLE_CASES = [
         dict(G_star=G_STAR, beta=0.2),
         dict(G_star=G_STAR, history="force", beta=0.2),
     ),
+    # LAMMPS's mindlin_rescale and mindlin_rescale/force: the history shrinks on unloading
+    ("mindlin_rescale", dict(G_star=G_STAR), dict(G_star=G_STAR, rescale=True)),
+    (
+        "mindlin_rescale_force",
+        dict(G_star=G_STAR),
+        dict(G_star=G_STAR, history="force", rescale=True),
+    ),
 ]
 
 
@@ -516,6 +523,26 @@ def test_the_penetration_criterion_where_the_normal_force_pulls_before_the_end()
         assert row["e"] == pytest.approx(float(head_on.e), rel=1e-9), degrees
         assert row["v_t_out"] == pytest.approx(o["v_t_out"], rel=1e-4), degrees
         assert row["omega_out"] == pytest.approx(o["omega_out"], rel=1e-4), degrees
+
+
+@pytest.mark.slow
+def test_a_rescaled_history_that_sticks_to_the_end_separates():
+    """LAMMPS's `mindlin_rescale` under Tsuji's pulling damping (Kharaz's sphere, 75
+    degrees, penetration end): the contact slides, then sticks until x = 0 while the
+    history shrinks as the contact radius, `v/(2x)` without bound. That once ran out of
+    steps (a promise of NaN in the LAMMPS export); with the rate held below 1e-9 x* it
+    separates with scipy's switches, and e_t and the spin agree with scipy's (which has no
+    such hold) to 1e-9; the hold's value (1e-7 to 1e-11) moved e_t by 1e-16 (measured)."""
+    law = ji.law("tsuji", c=4.2e9, b=15.0)
+    tl = tangential_law("mindlin_rescale", G_star=1.35e10, mu=0.092)
+    v_n, v_t = (float(v) for v in incidence(3.9, np.deg2rad(75.0)))
+    r = oblique_impact(law, tl, m=M, R=R, v_n=v_n, v_t=v_t, separation="penetration",
+                       rtol=1e-12)  # fmt: skip
+    o = oblique_oracle(c=4.2e9, b_tsuji=15.0, m=M, R=R, inertia=0.4, v_n=v_n, v_t=v_t,
+                       omega=0.0, mu=0.092, G_star=1.35e10, rescale=True)  # fmt: skip
+    assert r.status_name == "separated" and int(r.num_switches) == o["switches"] == 2
+    assert float(r.v_t_out) == pytest.approx(o["v_t_out"], rel=1e-9)
+    assert float(r.omega_out) == pytest.approx(o["omega_out"], rel=1e-9)
 
 
 RESTICK_SCRIPT = """

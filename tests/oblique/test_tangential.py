@@ -19,12 +19,36 @@ from jaximpact._oblique import (
 
 
 def test_table_names_and_histories():
-    assert TANGENTIAL_LAW_NAMES == ("linear_history", "mindlin", "mindlin_force")
+    assert TANGENTIAL_LAW_NAMES == ("linear_history", "mindlin", "mindlin_force",
+                                    "mindlin_rescale", "mindlin_rescale_force")  # fmt: skip
     assert TANGENTIAL_LAWS["linear_history"].history == "displacement"
     assert TANGENTIAL_LAWS["mindlin"].history == "displacement"
     assert TANGENTIAL_LAWS["mindlin_force"].history == "force"
+    assert TANGENTIAL_LAWS["mindlin_rescale"].history == "displacement"
+    assert TANGENTIAL_LAWS["mindlin_rescale_force"].history == "force"
+    assert [n for n, spec in TANGENTIAL_LAWS.items() if spec.rescaled] == [
+        "mindlin_rescale", "mindlin_rescale_force"]  # fmt: skip
     for spec in TANGENTIAL_LAWS.values():
         assert "mu" in spec.parameters and spec.engines and spec.reference
+
+
+def test_a_rescaled_history_shrinks_with_the_contact_radius_on_unloading():
+    """`stick_rate` adds `Q v / (2x)` where the overlap closes (`v < 0`), nothing while it
+    opens, and each rescaled Mindlin law exports to LAMMPS's own model."""
+    from jaximpact._engines.lammps_tangential import tangential_clause
+
+    for name, history in (("mindlin_rescale", "displacement"), ("mindlin_rescale_force", "force")):
+        tl = tangential_law(name, G_star=1e10, mu=0.2)
+        plain = tangential_law(name.replace("_rescale", ""), G_star=1e10, mu=0.2)
+        dyn = tl.dynamics(m=1e-3, R=1e-3, inertia=0.4, x_star=1e-6, v_n=1.0)
+        base = plain.dynamics(m=1e-3, R=1e-3, inertia=0.4, x_star=1e-6, v_n=1.0)
+        assert dyn.history == base.history == history
+        q, x, u = 0.3, 0.25, 0.1
+        assert float(dyn.stick_rate(q, x, u, 0.5)) == float(base.stick_rate(q, x, u, 0.5))
+        shrink = float(dyn.stick_rate(q, x, u, -0.5) - base.stick_rate(q, x, u, -0.5))
+        assert shrink == pytest.approx(q * -0.5 / (2 * x), rel=1e-15)
+        lammps = "mindlin_rescale" if history == "displacement" else "mindlin_rescale/force"
+        assert tangential_clause(tl) == f"tangential {lammps} 8e+10 0 0.2"
 
 
 def test_linear_history_fields_are_fit_parameters():
