@@ -84,7 +84,8 @@ def _refused(name: str, key: str, value: float) -> bool:
     Thornton's yield overlap and the adhesive laws' radius > 0."""
     if not math.isfinite(value):
         return True
-    positive = {"maxwell": ("b",), "thornton": ("x_y",), "jkr": ("R",), "dmt": ("R",)}.get(name, ())
+    positive = {"maxwell": ("b",), "thornton": ("x_y",), "jkr": ("R",), "dmt": ("R",),
+                "jkr_viscoelastic": ("R",)}.get(name, ())  # fmt: skip
     if key in ("c", "n") or key in positive:
         return value <= 0
     if key == "e_nominal":
