@@ -88,8 +88,8 @@ class TangentialSpec:
             raise ValueError(f"row {self.name!r}: history must be one of {HISTORIES}")
 
 
-# the overlap (units of x*) below which a rescaled history shrinks no faster
-# (`TangentialDynamics.stick_rate`)
+# the overlap (units of x*) below which a rescaled history's shrink is taken in closed form
+# (`TangentialDynamics.stick_rate`, `owed`)
 RESCALE_FLOOR = 1e-9
 
 
@@ -123,9 +123,18 @@ class TangentialDynamics(eqx.Module):
             return self.k0 + jnp.zeros_like(x)
         return self.k0 * safe_pow(x, self.power)
 
+    def owed(self, x):
+        """The shrink a rescaled history still owes below `RESCALE_FLOOR x*`, where its
+        state no longer follows the contact radius: `(x / floor)^0.5` there, else 1 (and 1
+        for a history that is not rescaled)."""
+        if not self.rescaled:
+            return 1.0
+        return jnp.sqrt(jnp.clip(x / RESCALE_FLOOR, 0.0, 1.0))
+
     def elastic(self, q, x):
         """The spring's force on the body."""
-        return -self.stiffness(x) * q if self.history == "displacement" else q
+        force = -self.stiffness(x) * q if self.history == "displacement" else q
+        return force * self.owed(x)
 
     def trial(self, q, x, u):
         """The force the contact would carry if it stuck: spring plus damper."""
@@ -142,21 +151,27 @@ class TangentialDynamics(eqx.Module):
         if not self.rescaled:
             return rate
         # the shrinking rate, `v/(2x)`, grows without bound as the overlap closes, which
-        # no explicit step outruns where the contact sticks to the end: it is held at its
-        # value at `RESCALE_FLOOR x*`, where the spring carries less than 1e-9 of its force
-        inside = x > 0
-        shrink = jnp.minimum(v, 0.0) / (2.0 * jnp.maximum(x, RESCALE_FLOOR))
-        return rate + jnp.where(inside, q * shrink, 0.0)
+        # no explicit step outruns where the contact sticks to the end (it ran out of
+        # steps): below `RESCALE_FLOOR x*` the state stops shrinking and the force takes
+        # the shrink still owed, `(x / floor)^0.5`, in closed form (`owed`), so that it
+        # falls to 0 with the contact as the limit does (a state merely held there kept
+        # a residue above the limit, 0 at the surface, and such contacts failed)
+        above = x >= RESCALE_FLOOR
+        shrink = jnp.minimum(v, 0.0) / (2.0 * jnp.where(above, x, 1.0))
+        return rate + jnp.where(above, q * shrink, 0.0)
 
     def held(self, sense, cap, x, u):
         """The spring state that puts the tested force at the limit, `tested = -sense cap`
         (where sliding stops, the spring resumes from there). Displacement history:
         `(sense cap - D u) / K` (the damper tested; else `sense cap / K`), 0 where `K = 0`
-        (outside the surface)."""
+        (outside the surface); a rescaled history's over the shrink it still owes."""
         damped = self.damper(x) * u if self.damper_tested else jnp.zeros_like(u)
+        owed = self.owed(x) + jnp.zeros_like(x)
         if self.history == "force":
-            return -sense * cap + damped
-        k = self.stiffness(x)
+            state = -sense * cap + damped
+            inside = owed > 0
+            return jnp.where(inside, state / jnp.where(inside, owed, 1.0), 0.0)
+        k = self.stiffness(x) * owed
         inside = k > 0
         return jnp.where(inside, (sense * cap - damped) / jnp.where(inside, k, 1.0), 0.0)
 

@@ -530,9 +530,10 @@ def test_a_rescaled_history_that_sticks_to_the_end_separates():
     """LAMMPS's `mindlin_rescale` under Tsuji's pulling damping (Kharaz's sphere, 75
     degrees, penetration end): the contact slides, then sticks until x = 0 while the
     history shrinks as the contact radius, `v/(2x)` without bound. That once ran out of
-    steps (a promise of NaN in the LAMMPS export); with the rate held below 1e-9 x* it
-    separates with scipy's switches, and e_t and the spin agree with scipy's (which has no
-    such hold) to 1e-9; the hold's value (1e-7 to 1e-11) moved e_t by 1e-16 (measured)."""
+    steps (a promise of NaN in the LAMMPS export); with the shrink below 1e-9 x* in closed
+    form it separates with scipy's switches, and e_t and the spin agree with scipy's (which
+    has no such floor) to 1e-9; the floor's value (1e-7 to 1e-11) moved e_t by 1e-16
+    (measured)."""
     law = ji.law("tsuji", c=4.2e9, b=15.0)
     tl = tangential_law("mindlin_rescale", G_star=1.35e10, mu=0.092)
     v_n, v_t = (float(v) for v in incidence(3.9, np.deg2rad(75.0)))

@@ -47,6 +47,16 @@ def test_a_rescaled_history_shrinks_with_the_contact_radius_on_unloading():
         assert float(dyn.stick_rate(q, x, u, 0.5)) == float(base.stick_rate(q, x, u, 0.5))
         shrink = float(dyn.stick_rate(q, x, u, -0.5) - base.stick_rate(q, x, u, -0.5))
         assert shrink == pytest.approx(q * -0.5 / (2 * x), rel=1e-15)
+        # below RESCALE_FLOOR x* the state stops shrinking and the force takes what it owes
+        from jaximpact._oblique.tangential import RESCALE_FLOOR
+
+        tiny = 0.25 * RESCALE_FLOOR
+        assert float(dyn.stick_rate(q, tiny, u, -0.5)) == float(base.stick_rate(q, tiny, u, -0.5))
+        ratio = float(dyn.elastic(q, tiny)) / float(base.elastic(q, tiny))
+        assert ratio == pytest.approx(0.5, rel=1e-14)  # (x / floor)^0.5
+        assert float(dyn.elastic(q, x)) == float(base.elastic(q, x))  # above it, all of it
+        held = dyn.held(1.0, 1e-6, tiny, 0.0)
+        assert float(dyn.elastic(held, tiny)) == pytest.approx(-1e-6, rel=1e-12)
         lammps = "mindlin_rescale" if history == "displacement" else "mindlin_rescale/force"
         assert tangential_clause(tl) == f"tangential {lammps} 8e+10 0 0.2"
 
