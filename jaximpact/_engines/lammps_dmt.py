@@ -132,11 +132,7 @@ class LammpsDMT(AbstractEngine):
         docstring), two spheres of mass `m` (kg) and radius `radius` (m) or with
         `geometry="wall"` one on `fix wall/gran`; `e` and `T` (s), the law's at `v0` (m/s),
         are what the replica's mean over start phases is held to."""
-        if limit_damping:
-            raise ValueError(
-                "LAMMPS refuses limit_damping with its dmt model (a cohesive normal model): "
-                "drop limit_damping"
-            )
+        lammps_script.refuse_limit_damping(limit_damping, "dmt")
         if self.source is None:
             raise ValueError("LAMMPS's dmt model is exported from a dmt law: pass the law")
         wall = geometry == "wall"
@@ -147,18 +143,10 @@ class LammpsDMT(AbstractEngine):
         E = 0.75 * c / math.sqrt(R_eff) * 2.0 * (1.0 - poisson) * (1.0 + poisson)
         damp = b / (m_eff * math.sqrt(R_eff))
         cohesion = pull / (4.0 * math.pi * R_eff)
-        stepping = dict(E=E, poisson=poisson, cohesion=cohesion, damp=damp, R_eff=R_eff)
-        if wall:
-            stepping["geometry"] = "wall"
-        h, es, Ts, warnings = _stepping.step_and_response(
-            lambda h: replica({**stepping, "timestep": h}, m, v0),
-            e,
-            T,
-            timestep,
-            engine=self.LABEL,
-            step="timestep",
-        )
-        stepping["timestep"] = h
+        stepping, h, es, Ts, warnings = lammps_script.cohesive_stepping(
+            replica, dict(E=E, poisson=poisson, cohesion=cohesion, damp=damp, R_eff=R_eff),
+            wall=wall, m=m, v0=v0, e=e, T=T, timestep=timestep,
+        )  # fmt: skip
         text = model(E, damp, poisson, cohesion)
         parameters = lammps_script.granular_parameters(
             text, h, E=E, poisson=poisson, R_eff=R_eff, wall=wall, damp=damp,

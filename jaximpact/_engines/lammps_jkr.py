@@ -247,11 +247,7 @@ class LammpsJKR(AbstractEngine):
         such sphere on `fix wall/gran`. `cohesion` from `e` (LAMMPS's energy loss
         `C_LAMMPS q^(10/3) m_eff v0^2`), `E` from `T` (its continuous impact's duration);
         `e` and `T` of the design are the replica's mean over start phases."""
-        if limit_damping:
-            raise ValueError(
-                "LAMMPS refuses limit_damping with its jkr model (a cohesive normal model): "
-                "drop limit_damping"
-            )
+        lammps_script.refuse_limit_damping(limit_damping, "jkr")
         if not 0.0 < e < 1.0:
             raise ValueError(f"a JKR impact has 0 < e < 1; got e = {e:g}")
         wall = geometry == "wall"
@@ -263,18 +259,10 @@ class LammpsJKR(AbstractEngine):
         E_mix = 0.75 * c / math.sqrt(R_eff)
         E = E_mix * 2.0 * (1.0 - poisson) * (1.0 + poisson)
         cohesion = 0.5 * q**2 * x_star**1.5 * E_mix / (2.0 * math.pi * math.sqrt(R_eff))
-        stepping = dict(E=E, poisson=poisson, cohesion=cohesion, R_eff=R_eff)
-        if wall:
-            stepping["geometry"] = "wall"
-        h, es, Ts, warnings = _stepping.step_and_response(
-            lambda h: replica({**stepping, "timestep": h}, m, v0),
-            e,
-            T,
-            timestep,
-            engine=self.LABEL,
-            step="timestep",
-        )
-        stepping["timestep"] = h
+        stepping, h, es, Ts, warnings = lammps_script.cohesive_stepping(
+            replica, dict(E=E, poisson=poisson, cohesion=cohesion, R_eff=R_eff),
+            wall=wall, m=m, v0=v0, e=e, T=T, timestep=timestep,
+        )  # fmt: skip
         warnings.append(
             f"LAMMPS's jkr breaks the neck at the least force (-F_c), before JKR's pull-off "
             f"(the least overlap): it takes {ENERGY_RATIO:.1%} of the energy, so with a law's "

@@ -192,11 +192,7 @@ class LammpsJKRViscoelastic(AbstractEngine):
         restitution `e` and duration `T` (s) (the module's docstring): two spheres of mass
         `m` (kg) and radius `radius` (m), or with `geometry="wall"` one on `fix wall/gran`;
         `e` and `T` of the design are the replica's mean over start phases."""
-        if limit_damping:
-            raise ValueError(
-                "LAMMPS refuses limit_damping with its jkr model (a cohesive normal model): "
-                "drop limit_damping"
-            )
+        lammps_script.refuse_limit_damping(limit_damping, "jkr")
         if self.source is None:
             raise ValueError(
                 "LAMMPS's damped jkr model is exported from a jkr_viscoelastic law: pass the law"
@@ -216,18 +212,10 @@ class LammpsJKRViscoelastic(AbstractEngine):
         E = E_mix * 2.0 * (1.0 - poisson) * (1.0 + poisson)
         cohesion = 0.5 * q**2 * x_star**1.5 * E_mix / (2.0 * math.pi * math.sqrt(R_eff))
         damp = beta * v0 / (x_star**1.5 * math.sqrt(R_eff))  # b = beta meff v0 / x*^1.5
-        stepping = dict(E=E, poisson=poisson, cohesion=cohesion, damp=damp, R_eff=R_eff)
-        if wall:
-            stepping["geometry"] = "wall"
-        h, es, Ts, warnings = _stepping.step_and_response(
-            lambda h: replica({**stepping, "timestep": h}, m, v0),
-            e,
-            T,
-            timestep,
-            engine=self.LABEL,
-            step="timestep",
-        )
-        stepping["timestep"] = h
+        stepping, h, es, Ts, warnings = lammps_script.cohesive_stepping(
+            replica, dict(E=E, poisson=poisson, cohesion=cohesion, damp=damp, R_eff=R_eff),
+            wall=wall, m=m, v0=v0, e=e, T=T, timestep=timestep,
+        )  # fmt: skip
         warnings.append(
             "LAMMPS's jkr breaks the neck at the least force (-F_c), before JKR's pull-off "
             f"(the least overlap): this cohesion ({cohesion:.4g} J/m^2) gives the law's e at "

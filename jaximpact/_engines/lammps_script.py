@@ -1,8 +1,11 @@
 """What LAMMPS's exported models (`lammps`: hertz/material; `lammps_jkr`,
 `lammps_jkr_viscoelastic`, `lammps_dmt`) share: the script of an export's scene
-(`snippet`), the effective radius of its contact (`with_effective_radius`), and the
-parameters of a `pair_style granular` design (`granular_parameters`)."""
+(`snippet`), the effective radius of its contact (`with_effective_radius`), the
+parameters of a `pair_style granular` design (`granular_parameters`), and for the cohesive
+models the refusal of `limit_damping` and the stepped design (`refuse_limit_damping`,
+`cohesive_stepping`)."""
 
+from . import _stepping
 from .materials import check_positive
 
 
@@ -58,3 +61,27 @@ def granular_parameters(text: str, h: float, *, E: float, poisson: float, wall: 
         parameters["fix_wall"] = f"fix wall all wall/gran granular {text} zplane 0.0 NULL"
         parameters["geometry"] = "wall"
     return parameters
+
+
+def refuse_limit_damping(limit_damping: bool, model: str) -> None:
+    """A one-line ValueError where `limit_damping` is asked of a cohesive `model` (`jkr`,
+    `dmt`): LAMMPS refuses it with them."""
+    if limit_damping:
+        raise ValueError(
+            f"LAMMPS refuses limit_damping with its {model} model (a cohesive normal model): "
+            "drop limit_damping"
+        )
+
+
+def cohesive_stepping(replica, stepping: dict, *, wall: bool, m: float, v0: float, e: float,
+                      T: float, timestep):  # fmt: skip
+    """`(stepping, h, es, Ts, warnings)` of a cohesive model's design (`jkr`, damped `jkr`,
+    `dmt`): the replica's `stepping` parameters (with the wall's geometry) at the time step
+    `h` (s) that realises `e` and `T` (s) at `v0` (m/s), or at the `timestep` given
+    (`_stepping.step_and_response`), and the replica's `e` and `T` per start phase."""
+    stepping = {**stepping, **({"geometry": "wall"} if wall else {})}
+    h, es, Ts, warnings = _stepping.step_and_response(
+        lambda h: replica({**stepping, "timestep": h}, m, v0),
+        e, T, timestep, engine="LAMMPS", step="timestep",
+    )  # fmt: skip
+    return {**stepping, "timestep": h}, h, es, Ts, warnings
