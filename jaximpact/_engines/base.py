@@ -116,6 +116,9 @@ class AbstractEngine(abc.ABC):
     - `FRICTION` (optional, default None): where the engine has no tangential law of
       jaximpact's but friction alone, what it makes of a tangential law (its nearest), in
       words; `with_tangential` then takes any tangential law's `mu`.
+    - `REFUSES_LIMIT_DAMPING` (optional, default None): the engine's model that refuses
+      `export(limit_damping=True)` (LAMMPS's cohesive `jkr` and `dmt`), refused before any
+      work (`check_limit_damping`).
 
     **Optional methods**: `native(law)`, the engine (its own model) that exports `law`
     where the engine has that law itself (LAMMPS's `jkr`), else None;
@@ -142,6 +145,16 @@ class AbstractEngine(abc.ABC):
     TANGENTIAL: ClassVar[tuple[str, ...]] = ()
     FRICTION: ClassVar[str | None] = None
     CONTACT_POINT: ClassVar[Mapping[str, float]] = {"wall": 0.0, "spheres": 0.0}
+    REFUSES_LIMIT_DAMPING: ClassVar[str | None] = None
+
+    def check_limit_damping(self, limit_damping: bool) -> None:
+        """A one-line ValueError where `limit_damping` is asked of a model that refuses it
+        (`REFUSES_LIMIT_DAMPING`), before any work."""
+        if limit_damping and self.REFUSES_LIMIT_DAMPING is not None:
+            raise ValueError(
+                f"{self.LABEL} refuses limit_damping with its {self.REFUSES_LIMIT_DAMPING} "
+                "model (a cohesive normal model): drop limit_damping"
+            )
 
     def check_tangential(self, tangential, *, radius, timestep) -> None:
         """A one-line ValueError where the engine cannot take `tangential` (before any

@@ -253,20 +253,15 @@ def export(
     geometry = chosen.geometry(geometry)
     m_given = m is not None
     chosen, lacked = _native(chosen, None if law_or_fit is None else _law_of(law_or_fit))
+    chosen.check_limit_damping(limit_damping)  # refused before the law's e and T
     v0, speeds = _speeds(v0, lacked, chosen)
     m, v0, timestep, poisson = _inputs(chosen, law_or_fit, m, v0, timestep, poisson)
-    source, target_e, target_T = _targets(law_or_fit, e=e, T=T, m=m, v0=v0, speeds=speeds)
-    if target_T is not None:
-        _check_scales(m, v0, target_T)
+    # what is refused without the law's impact comes first (a law's e and T compile)
     if chosen.TWO_SPHERES:
         if radius is None:
             what = "sphere's" if geometry == "wall" else "spheres'"
             raise ValueError(f"{engine} needs the {what} radius: pass radius= (m)")
         radius = check_positive("radius", radius, "m")
-        if target_T is None:
-            raise ValueError(f"{engine} needs a contact duration: pass T= (s) or a law")
-    options = dict(m=m, v0=v0, radius=radius, poisson=0.3 if poisson is None else poisson,
-                   limit_damping=limit_damping, geometry=geometry)  # fmt: skip
     if tangential is not None:  # refused before any work by an engine without it
         if radius is None:  # a two-sphere engine asked for it above
             raise ValueError(
@@ -274,6 +269,13 @@ def export(
                 "lever arm and inertia): pass radius= (m)"
             )
         chosen.check_tangential(tangential, radius=radius, timestep=timestep)
+    source, target_e, target_T = _targets(law_or_fit, e=e, T=T, m=m, v0=v0, speeds=speeds)
+    if target_T is not None:
+        _check_scales(m, v0, target_T)
+    if chosen.TWO_SPHERES and target_T is None:
+        raise ValueError(f"{engine} needs a contact duration: pass T= (s) or a law")
+    options = dict(m=m, v0=v0, radius=radius, poisson=0.3 if poisson is None else poisson,
+                   limit_damping=limit_damping, geometry=geometry)  # fmt: skip
     out = chosen.design(target_e, target_T, timestep=timestep, **options)
     if tangential is not None:  # an engine whose tangential law ties to its normal options
         tied = chosen.tangential_options(out, tangential, options)

@@ -117,6 +117,7 @@ class LammpsDMT(AbstractEngine):
         "overlap: replicated"
     )
     CONTINUOUS_PLANT = False
+    REFUSES_LIMIT_DAMPING = "dmt"
     TANGENTIAL = tuple(TANGENTIAL_MODELS)
 
     def __init__(self, source=None):
@@ -132,7 +133,7 @@ class LammpsDMT(AbstractEngine):
         docstring), two spheres of mass `m` (kg) and radius `radius` (m) or with
         `geometry="wall"` one on `fix wall/gran`; `e` and `T` (s), the law's at `v0` (m/s),
         are what the replica's mean over start phases is held to."""
-        lammps_script.refuse_limit_damping(limit_damping, "dmt")
+        self.check_limit_damping(limit_damping)
         if self.source is None:
             raise ValueError("LAMMPS's dmt model is exported from a dmt law: pass the law")
         wall = geometry == "wall"

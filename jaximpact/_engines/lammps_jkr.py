@@ -234,6 +234,7 @@ class LammpsJKR(AbstractEngine):
         "zero overlap, break at the least force): replicated"
     )
     CONTINUOUS_PLANT = False
+    REFUSES_LIMIT_DAMPING = "jkr"
     TANGENTIAL = tuple(TANGENTIAL_MODELS)
 
     def with_tangential(self, parameters, tangential):
@@ -247,7 +248,7 @@ class LammpsJKR(AbstractEngine):
         such sphere on `fix wall/gran`. `cohesion` from `e` (LAMMPS's energy loss
         `C_LAMMPS q^(10/3) m_eff v0^2`), `E` from `T` (its continuous impact's duration);
         `e` and `T` of the design are the replica's mean over start phases."""
-        lammps_script.refuse_limit_damping(limit_damping, "jkr")
+        self.check_limit_damping(limit_damping)
         if not 0.0 < e < 1.0:
             raise ValueError(f"a JKR impact has 0 < e < 1; got e = {e:g}")
         wall = geometry == "wall"

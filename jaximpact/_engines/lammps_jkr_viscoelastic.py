@@ -157,6 +157,7 @@ class LammpsJKRViscoelastic(AbstractEngine):
     LABEL = "LAMMPS"
     TWO_SPHERES = True
     CONTINUOUS_PLANT = False
+    REFUSES_LIMIT_DAMPING = "jkr"
     TANGENTIAL = tuple(TANGENTIAL_MODELS)
     SCENES = {
         "spheres": "two equal spheres, each of mass m and radius `radius`, colliding head-on at "
@@ -192,7 +193,7 @@ class LammpsJKRViscoelastic(AbstractEngine):
         restitution `e` and duration `T` (s) (the module's docstring): two spheres of mass
         `m` (kg) and radius `radius` (m), or with `geometry="wall"` one on `fix wall/gran`;
         `e` and `T` of the design are the replica's mean over start phases."""
-        lammps_script.refuse_limit_damping(limit_damping, "jkr")
+        self.check_limit_damping(limit_damping)
         if self.source is None:
             raise ValueError(
                 "LAMMPS's damped jkr model is exported from a jkr_viscoelastic law: pass the law"

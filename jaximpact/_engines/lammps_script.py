@@ -2,8 +2,8 @@
 `lammps_jkr_viscoelastic`, `lammps_dmt`) share: the script of an export's scene
 (`snippet`), the effective radius of its contact (`with_effective_radius`), the
 parameters of a `pair_style granular` design (`granular_parameters`), and for the cohesive
-models the refusal of `limit_damping` and the stepped design (`refuse_limit_damping`,
-`cohesive_stepping`)."""
+models the stepped design (`cohesive_stepping`; their refusal of `limit_damping` is
+`AbstractEngine.REFUSES_LIMIT_DAMPING`)."""
 
 from . import _stepping
 from .materials import check_positive
@@ -61,16 +61,6 @@ def granular_parameters(text: str, h: float, *, E: float, poisson: float, wall: 
         parameters["fix_wall"] = f"fix wall all wall/gran granular {text} zplane 0.0 NULL"
         parameters["geometry"] = "wall"
     return parameters
-
-
-def refuse_limit_damping(limit_damping: bool, model: str) -> None:
-    """A one-line ValueError where `limit_damping` is asked of a cohesive `model` (`jkr`,
-    `dmt`): LAMMPS refuses it with them."""
-    if limit_damping:
-        raise ValueError(
-            f"LAMMPS refuses limit_damping with its {model} model (a cohesive normal model): "
-            "drop limit_damping"
-        )
 
 
 def cohesive_stepping(replica, stepping: dict, *, wall: bool, m: float, v0: float, e: float,

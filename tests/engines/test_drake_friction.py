@@ -38,6 +38,7 @@ def test_drake_realises_the_exports_promise(exported, angle):
     assert omega * R / v_t == pytest.approx(exported.omega_engine[k] * R / v_t, abs=1e-8)
 
 
+@pytest.mark.slow  # 6 s: the export's e_t(theta) (the fast suite: 3 minutes)
 def test_the_export_to_drake_takes_mu_and_says_how_far_it_falls(exported):
     """Drake's friction has no spring: it brings the slip to rest (rolling, e_t near 5/7 for
     a solid sphere) where the Cundall-Strack spring gives the slip back (e_t 0.48-0.54);

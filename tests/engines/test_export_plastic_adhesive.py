@@ -272,6 +272,11 @@ def test_dmt_export_refusals_are_one_line():
     with pytest.raises(ValueError, match="limit_damping") as error:
         ji.export(law, "lammps", m=M, v0=0.3, radius=R, limit_damping=True)
     assert "\n" not in str(error.value)
+    # refused before any work: before the law's impact at v0 (which would not separate)
+    with pytest.raises(ValueError, match="refuses limit_damping with its dmt model"):
+        ji.export(law, "lammps", m=M, v0=0.02, radius=R, limit_damping=True)
+    with pytest.raises(ValueError, match="needs the spheres' radius"):
+        ji.export(law, "lammps", m=M, v0=0.02)
     with pytest.raises(ValueError, match="does not separate") as error:
         ji.export(law, "lammps", m=M, v0=0.02, radius=R)
     assert "\n" not in str(error.value)

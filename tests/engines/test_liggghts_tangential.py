@@ -71,6 +71,7 @@ def test_the_undamped_law_is_liggghts_own():
     assert x.e == pytest.approx(x.target_e, rel=5e-3)  # the normal contact unchanged
 
 
+@pytest.mark.slow  # 9 s of compiling the damped e_t(theta); the fast suite: 3 minutes
 def test_a_damped_law_gets_liggghts_damper_and_says_so():
     x = _export("damped")
     assert "tangential_damping" not in x.parameters["pair_style"]  # on: LIGGGHTS's default

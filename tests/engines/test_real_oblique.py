@@ -106,6 +106,7 @@ def test_the_clause_is_lammps_own():
     assert x.to_dict()["tangential"]["name"] == "mindlin"
 
 
+@pytest.mark.slow  # 5 s of compiling (the fast suite: 3 minutes)
 def test_two_spheres_get_the_law_at_the_pair_s_mass_tangential_forces_halved():
     """The normal export realises the law's e and T at mass `m` with two spheres of mass
     `m` (effective mass m/2: its forces halved); the tangential law's forces are halved

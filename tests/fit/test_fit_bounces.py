@@ -112,6 +112,7 @@ def test_impact_times_round_trip_recovers_e_within_its_uncertainty():
     json.dumps(d, allow_nan=False)
 
 
+@pytest.mark.slow  # 9 s: the fit and the bounce at rtol 1e-10 (the fast suite: 3 minutes)
 def test_fit_model_chain_matches_bounce():
     """The fitted drop, re-run from its first impact, gives the fitted impact times."""
     fit = golf_fit()

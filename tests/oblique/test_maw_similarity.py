@@ -36,7 +36,8 @@ def _scene(scale_m, scale_v, scale_mu, scale_c, scale_R, psi, name="mindlin_forc
 SCALES = [(1, 1, 1, 1, 1), (3.0, 0.25, 2.0, 0.2, 4.0), (0.1, 5.0, 0.5, 7.0, 0.3)]
 
 
-@pytest.mark.parametrize("name", ["mindlin", "mindlin_force"])
+# mindlin_force in the slow group: 5 s of compiling (the fast suite: 3 minutes)
+@pytest.mark.parametrize("name", ["mindlin", pytest.param("mindlin_force", marks=pytest.mark.slow)])
 @pytest.mark.parametrize("psi", [0.4, 1.5, 4.0])
 def test_the_impact_depends_on_the_groups_alone(name, psi):
     """Three scenes of one `psi`, `k0/c`, `kappa`, `a v_n` (masses 0.1-3x, speeds 0.25-5x,
@@ -52,6 +53,7 @@ def test_the_impact_depends_on_the_groups_alone(name, psi):
         assert float(r.T) / t_star == pytest.approx(float(base.T) / t_base, rel=1e-8)
 
 
+@pytest.mark.slow  # 5 s of compiling linear_history (the fast suite: 3 minutes)
 def test_a_constant_spring_has_no_such_group():
     """`linear_history` at one `psi`: its e_t moves with the normal speed (the groups of the
     Mindlin spring do not hold)."""
