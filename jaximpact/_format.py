@@ -5,7 +5,8 @@ the library's tables and reports, the results' `repr`, `summary()` and `to_dict(
 import math
 
 _MULTIPLE_UNITS = {"N", "Pa", "W"}
-_PREFIXES = [(1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, ""), (1e-3, "m"), (1e-6, "µ"), (1e-9, "n")]
+_PREFIXES = [(1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, ""), (1e-3, "m"), (1e-6, "µ"), (1e-9, "n"),
+             (1e-12, "p"), (1e-15, "f")]  # fmt: skip
 
 
 def format_number(value, digits: int = 6) -> str:
@@ -97,6 +98,17 @@ def format_value(value, unit: str | None = "", digits: int = 4) -> str:
     if shown.size:
         text += f", {one(shown.min())} to {one(shown.max())}"
     return text + (f" ({missing} not finite)" if missing else "")
+
+
+def call_text(call: str, first: str, params: dict, units: dict) -> str:
+    """A law as the call that builds it, with its values in their units:
+    `law('thornton', c=2.176e10 N/m^1.5, x_y=598.6 nm)` (`first`: the call's first argument,
+    as written; a unit `-` or missing: a pure number; a traced value: its shape)."""
+    shown = [first]
+    for name, value in params.items():
+        unit = units.get(name, "-")
+        shown.append(f"{name}={format_value(value, '' if unit == '-' else unit)}")
+    return f"{call}({', '.join(shown)})"
 
 
 def format_fields(title: str, rows) -> str:

@@ -428,6 +428,40 @@ def test_a_fit_and_a_ranking_print_numbers_with_units():
     json.dumps(ranking.to_dict(), allow_nan=False)
 
 
+def test_a_law_prints_as_the_call_that_builds_it_with_its_units():
+    """A law printed as an equinox pytree showed `c=f64[]`: no value. It now prints as the
+    call that builds it, in SI units: a row of the table, a law with a state, a user's law
+    (no row, no units), a tangential law, a batch of laws and a traced one."""
+    assert repr(ji.law("hertz_rate", c=2e6, b1=800.0)) == (
+        "law('hertz_rate', c=2e6 N/m^1.5, b1=800 N s/m^1.5)"
+    )
+    assert repr(ji.law("thornton", c=2.176e10, x_y=5.986e-7)) == (
+        "law('thornton', c=2.176e10 N/m^1.5, x_y=598.6 nm)"
+    )
+    assert str(ji.law("jkr", c=1e9, R=2.45e-6, w=0.2)) == (
+        "law('jkr', c=1e9 N/m^1.5, R=2.45 µm, w=200 mJ/m^2)"
+    )
+
+    def kelvin_voigt(x, v, p):
+        return p["c"] * x + p["b"] * v
+
+    assert (
+        repr(ji.custom_law(kelvin_voigt, c=2e6, b=40.0)) == "custom_law(kelvin_voigt, c=2e6, b=40)"
+    )
+    assert repr(ji.tangential_law("mindlin", G_star=1.35e10, mu=0.3)) == (
+        "tangential_law('mindlin', G_star=13.5 GPa, mu=0.3, beta=0)"
+    )
+    batch = ji.law("hertz_rate", c=jnp.array([1e6, 2e6]), b1=800.0)
+    assert repr(batch) == "law('hertz_rate', c=[1e6 N/m^1.5, 2e6 N/m^1.5], b1=800 N s/m^1.5)"
+    shown = []
+    jax.vmap(lambda c: shown.append(repr(ji.law("hertz_rate", c=c, b1=800.0))) or c)(
+        jnp.array([1e6, 2e6])
+    )
+    assert shown == ["law('hertz_rate', c=traced f64[], b1=800 N s/m^1.5)"]
+    # a JKR microsphere's energies are femtojoules
+    assert ji._format.format_quantity(3.742e-15, "J") == "3.742 fJ"
+
+
 # --------------------------------------------------------------- 6. the package's namespace
 
 

@@ -130,6 +130,18 @@ class AbstractLaw(eqx.Module):
     def replace(self, **params) -> "AbstractLaw":
         """The same law with some parameters changed."""
 
+    def __repr__(self):
+        """The call that builds the law, with its values in SI units:
+        `law('hertz_rate', c=2e6 N/m^1.5, b1=800 s/m)`; a user's law as
+        `custom_law(fn, c=2e6, b=40)` (no units: it has no row of the table)."""
+        from .._format import call_text, concrete_units
+
+        if self.spec is None:
+            name = getattr(getattr(self, "fn", None), "__name__", self.name)
+            return call_text("custom_law", name, self.params, {})
+        return call_text("law", repr(self.name), self.params,
+                         concrete_units(self.spec, self.params))  # fmt: skip
+
     def _refuse_unknown(self, params: dict, who: str | None = None):
         """A one-line `ValueError` for names in `params` that are not the law's parameters
         (what every `replace` checks first)."""

@@ -192,6 +192,13 @@ class AbstractTangentialLaw(eqx.Module):
     # the parameters a force is proportional to (`forces_scaled`)
     FORCE_PARAMETERS: ClassVar[tuple[str, ...]] = ()
 
+    def __repr__(self):
+        """The call that builds the law, with its values in SI units:
+        `tangential_law('mindlin', G_star=1.35e10 Pa, mu=0.3, beta=0)`."""
+        from .._format import call_text
+
+        return call_text("tangential_law", repr(self.name), self.params, self.spec.units)
+
     @abc.abstractmethod
     def stiffness(self, x, *, R):
         """The tangential stiffness `k_t` (N/m) at overlap `x` (m) of a sphere of radius
