@@ -107,9 +107,8 @@ def _check_against_scipy(separation, count):
             assert error < TOL, f"{field} at beta={beta:.3g}, pi={pi:.3g}: {error:.2e}"
 
 
-@pytest.mark.parametrize(
-    "separation", ["force", pytest.param("penetration", marks=pytest.mark.slow)]
-)
+@pytest.mark.slow  # 4.5 s each (the fast suite: 3 minutes)
+@pytest.mark.parametrize("separation", SEPARATIONS)
 def test_table_matches_scipy(separation):
     _check_against_scipy(separation, 6 if separation == "force" else 4)
 

@@ -82,6 +82,7 @@ def test_head_on_the_corrected_cone_is_the_frictionless_contact(mu):
     assert head_on_factor(1.0) == pytest.approx(1.0, abs=1e-15)  # mu^2 (1 + mu^2) = 2
 
 
+@pytest.mark.slow  # 5.5 s: the export's e_t(theta) (the fast suite: 3 minutes)
 def test_the_export_to_mujoco_takes_mu_and_says_how_far_it_falls():
     """Kharaz's sphere: MuJoCo's stiff, nearly elastic contact (e = 0.98) lasts about 12 us,
     while its friction acts at the rate of its damping (about 3e3 /s): e_t stays near 0.99

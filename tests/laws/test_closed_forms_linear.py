@@ -353,6 +353,7 @@ def test_maxwell_with_gravity_is_exact_too():
     assert made.closed_form("force", g_is_zero=True) is not None
 
 
+@pytest.mark.slow  # 8.5 s of compiling (the fast suite: 3 minutes)
 def test_impact_fields_dissipated_energy_and_vmap():
     """`impact` (vmapped over c and P) returns the closed form's fields, with `dissipated =
     m v0^2 (1 - e^2)/2 + m g x_end`, `v_out = -e v0` and no steps, stuck and separated

@@ -28,7 +28,10 @@ def _no_persistent_cache(monkeypatch):
     monkeypatch.setenv("JAXIMPACT_CACHE_DIR", "")
 
 
-@pytest.mark.parametrize("name", LAWS)
+# dmt in the slow group: 5 s (the fast suite: 3 minutes)
+@pytest.mark.parametrize(
+    "name", [n if n != "dmt" else pytest.param(n, marks=pytest.mark.slow) for n in LAWS]
+)
 def test_a_batch_equals_the_impacts_one_by_one(name):
     law = LAWS[name]
     units = {"thornton": lambda: law.yield_speed(M), "jkr": lambda: law.sticking_speed(M)}

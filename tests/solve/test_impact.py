@@ -356,6 +356,7 @@ def test_vmap_over_stiffness_equals_the_loop():
             assert_rel(batched[key][i], one[key], 1e-12, f"vmap {key} at c={c}")
 
 
+@pytest.mark.slow  # 7 s: bingham's integrated path under vmap (the fast suite: 3 minutes)
 def test_vmap_over_speed_equals_the_loop_with_stuck_members():
     """One stuck member (small v0: the dry force holds it) must not spoil the batch."""
     v0s = jnp.array([0.1, 0.3, 1.0, 2.5, 10.0])
