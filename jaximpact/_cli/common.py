@@ -84,6 +84,41 @@ def add_law_arguments(parser, *, required: bool = True):
     )
 
 
+# jaximpact.TANGENTIAL_LAW_NAMES (no JAX import here; tests/cli checks they agree)
+TANGENTIAL_CHOICES = (
+    "mindlin",
+    "mindlin_force",
+    "mindlin_rescale",
+    "mindlin_rescale_force",
+    "linear_history",
+)
+
+
+def add_tangential_arguments(parser, *, required: bool, help: str, tparam_help: str):
+    """`--tangential NAME` (one of `TANGENTIAL_CHOICES`) and `--tparam NAME=VALUE ...`,
+    a tangential law and its parameters (SI units); `tangential_from_args` builds it."""
+    parser.add_argument(
+        "--tangential", required=required, choices=TANGENTIAL_CHOICES, metavar="NAME",
+        help=f"{help} (one of {', '.join(TANGENTIAL_CHOICES)})",
+    )  # fmt: skip
+    parser.add_argument(
+        "--tparam", action="extend", nargs="+", default=[], metavar="NAME=VALUE",
+        help=tparam_help,
+    )  # fmt: skip
+
+
+def tangential_from_args(args):
+    """The tangential law of `--tangential` and `--tparam`, or None without them (a
+    `CLIError` for `--tparam` alone)."""
+    if args.tangential is None:
+        if args.tparam:
+            raise CLIError("--tparam needs --tangential NAME")
+        return None
+    from .._oblique import tangential_law
+
+    return tangential_law(args.tangential, **parse_params(args.tparam, "--tparam"))
+
+
 def add_impact_arguments(parser):
     """`--mass`, `--v0`, `--separation` and `--gravity`, the conditions of one impact."""
     parser.add_argument(

@@ -9,9 +9,11 @@ from .._format import format_number
 from .common import (
     CLIError,
     add_output_arguments,
+    add_tangential_arguments,
     command_parser,
     emit,
     parse_params,
+    tangential_from_args,
 )
 
 
@@ -117,17 +119,14 @@ def add_export(subparsers):
         "--mass and --radius hitting a fixed flat wall at --v0 (the drop test), instead of "
         "two spheres",
     )  # fmt: skip
-    parser.add_argument(
-        "--tangential", metavar="NAME",
+    add_tangential_arguments(
+        parser, required=False,
         help=f"{_labels(lambda e: bool(e.TANGENTIAL or e.FRICTION))}: also export the "
-        "tangential law NAME (linear_history, mindlin, mindlin_force, mindlin_rescale, "
-        "mindlin_rescale_force; MuJoCo and Drake take "
-        "its mu alone) with --tparam, and print the e_t, spin and normal e the engine "
-        "realises from 5 to 75 degrees, beside the law's e_t",
-    )  # fmt: skip
-    parser.add_argument(
-        "--tparam", action="extend", nargs="+", default=[], metavar="NAME=VALUE",
-        help="the tangential law's parameters, SI units, e.g. --tparam G_star=1.35e10 mu=0.092",
+        "tangential law NAME with --tparam (MuJoCo and Drake take its mu alone), and print "
+        "the e_t, spin and normal e the engine realises from 5 to 75 degrees, beside the "
+        "law's e_t",
+        tparam_help="the tangential law's parameters, SI units, e.g. --tparam "
+        "G_star=1.35e10 mu=0.092",
     )  # fmt: skip
     parser.add_argument(
         "--no-strict", dest="strict", action="store_false",
@@ -199,13 +198,7 @@ def _run_export(args):
         from .._laws import law
 
         source = law(name, **params)
-    tangential = None
-    if args.tangential is not None:
-        from .._oblique import tangential_law
-
-        tangential = tangential_law(args.tangential, **parse_params(args.tparam, "--tparam"))
-    elif args.tparam:
-        raise CLIError("--tparam needs --tangential NAME")
+    tangential = tangential_from_args(args)
     try:  # with --no-strict, the refusal comes as a warning (one line on stderr)
         x = export(
             source,

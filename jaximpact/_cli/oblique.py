@@ -18,13 +18,14 @@ from .common import (
     CLIError,
     add_law_arguments,
     add_output_arguments,
+    add_tangential_arguments,
     check_plot_path,
     command_parser,
     emit,
     free_names,
     law_from_args,
-    parse_params,
     read_table,
+    tangential_from_args,
 )
 
 INCIDENCE = ("theta_deg", "v_n", "v_t", "omega")
@@ -57,26 +58,12 @@ def add_fit_oblique(subparsers):
     )
     parser.add_argument("file", type=Path, metavar="FILE.csv", help="the measured rebounds")
     add_law_arguments(parser)
-    parser.add_argument(
-        "--tangential",
+    add_tangential_arguments(
+        parser,
         required=True,
-        choices=(
-            "mindlin",
-            "mindlin_force",
-            "mindlin_rescale",
-            "mindlin_rescale_force",
-            "linear_history",
-        ),  # jaximpact.TANGENTIAL_LAW_NAMES (no JAX import here)
         help="the tangential law to fit",
-    )
-    parser.add_argument(
-        "--tparam",
-        action="extend",
-        nargs="+",
-        default=[],
-        metavar="NAME=VALUE",
-        help="the tangential law's start values in SI units, e.g. --tparam G_star=1.35e10 "
-        "mu=0.092 (mindlin also takes G=... nu=...)",
+        tparam_help="the tangential law's start values in SI units, e.g. --tparam "
+        "G_star=1.35e10 mu=0.092 (mindlin also takes G=... nu=...)",
     )
     parser.add_argument("--mass", type=float, required=True, metavar="KG", help="mass, kg (> 0)")
     parser.add_argument(
@@ -96,21 +83,7 @@ def add_fit_oblique(subparsers):
         help="gravity, m/s^2, of a video track's flights and contacts (default 9.81 for a "
         "track, 0 for rebounds)",
     )
-    parser.add_argument(
-        "--inertia",
-        type=float,
-        default=0.4,
-        metavar="K",
-        help="moment of inertia over m R^2 (default 0.4, a solid sphere)",
-    )
-    parser.add_argument(
-        "--contact-point",
-        choices=("surface", "midpoint", "plane"),
-        default="surface",
-        help="where the tangential force acts: lever arm R (surface, LAMMPS; the default), "
-        "R - x/2 (midpoint: LIGGGHTS, MuJoCo, Drake), R - x (plane: Yade's wall); fit with "
-        "the engine's to export to it",
-    )
+    _add_sphere_arguments(parser, "fit with the engine's to export to it")
     parser.add_argument(
         "--free",
         action="extend",
@@ -120,6 +93,167 @@ def add_fit_oblique(subparsers):
     )
     add_output_arguments(parser)
     parser.set_defaults(handler=run_fit_oblique)
+
+
+def _add_sphere_arguments(parser, contact_point_use: str, prefix: str = ""):
+    """`--inertia` and `--contact-point`, the sphere's moment of inertia and where its
+    tangential force acts (`prefix`: what the help says first, e.g. "with --tangential: ")."""
+    parser.add_argument(
+        "--inertia", type=float, default=0.4, metavar="K",
+        help=f"{prefix}moment of inertia over m R^2 (default 0.4, a solid sphere)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--contact-point", choices=("surface", "midpoint", "plane"), default="surface",
+        help=f"{prefix}where the tangential force acts: lever arm R (surface, LAMMPS; the "
+        "default), R - x/2 (midpoint: LIGGGHTS, MuJoCo, Drake), R - x (plane: Yade's wall); "
+        f"{contact_point_use}",
+    )  # fmt: skip
+
+
+def add_oblique_impact_arguments(parser):
+    """`simulate`'s oblique impact: `--tangential`, `--tparam`, `--radius`, `--angle`,
+    `--omega`, `--inertia`, `--contact-point` (`run_oblique_impact`)."""
+    add_tangential_arguments(
+        parser,
+        required=False,
+        help="an oblique impact of a sphere (with --radius and --angle): its tangential law",
+        tparam_help="with --tangential: the tangential law's parameters in SI units, e.g. "
+        "--tparam G_star=1.35e10 mu=0.092 (mindlin also takes G=... nu=...)",
+    )
+    parser.add_argument(
+        "--radius", type=float, metavar="M",
+        help="with --tangential: the sphere's radius, m (> 0)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--angle", type=float, nargs="+", metavar="DEG",
+        help="with --tangential: the incidence from the normal, degrees in [0, 90) (--v0 is "
+        "the speed: v_n = v0 cos, v_t = v0 sin); several for a sweep of e_t(angle)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--omega", type=float, default=0.0, metavar="RAD/S",
+        help="with --tangential: the spin before impact, rad/s (default 0; omega = v_t / R "
+        "rolls without slip)",
+    )  # fmt: skip
+    _add_sphere_arguments(parser, "as the engine you export to", "with --tangential: ")
+
+
+# the fields of an oblique impact printed by `simulate`: name, unit ("" a pure number,
+# "deg" an angle shown in degrees, None a count), in order
+_OBLIQUE_FIELDS = (("e", ""), ("e_t", ""), ("e_t_contact", ""), ("v_t_out", "m/s"),
+                   ("omega_out", "rad/s"), ("angle_out", "deg"),
+                   ("angle_out_contact", "deg"), ("T", "s"), ("num_switches", None))  # fmt: skip
+
+
+def check_oblique_arguments(args) -> None:
+    """`--radius`, `--angle` and the rest of an oblique impact, or a one-line `CLIError`:
+    asked without `--tangential`, missing, or out of range (before any work)."""
+    oblique = {"--radius": args.radius, "--angle": args.angle}
+    if args.tangential is None:
+        given = [flag for flag, value in oblique.items() if value is not None]
+        given += ["--tparam"] if args.tparam else []
+        given += ["--omega"] if args.omega != 0.0 else []
+        if given:
+            raise CLIError(f"{given[0]} is for an oblique impact: add --tangential NAME")
+        return
+    for flag, value in oblique.items():
+        if value is None:
+            raise CLIError(f"an oblique impact (--tangential) needs {flag}")
+    if not (math.isfinite(args.radius) and args.radius > 0):
+        raise CLIError(f"--radius must be a finite number > 0 (m), got {args.radius:g}")
+    for angle in args.angle:
+        if not (math.isfinite(angle) and 0 <= angle < 90):
+            raise CLIError(
+                f"--angle {angle:g}: the incidence is in degrees from the normal, in [0, 90)"
+            )
+    if len(args.v0) > 1:
+        raise CLIError("an oblique impact takes one --v0 (the speed); sweep --angle instead")
+    if not math.isfinite(args.omega):
+        raise CLIError(f"--omega must be a finite number (rad/s), got {args.omega:g}")
+    if not (math.isfinite(args.inertia) and args.inertia > 0):
+        raise CLIError(f"--inertia must be a finite number > 0 (I / (m R^2)), got {args.inertia:g}")
+
+
+def run_oblique_impact(args, law, head: list[str]) -> int:
+    """`simulate --tangential`: one oblique impact per `--angle`, printed as text (a line
+    per field for one angle, a table for several) or JSON; `head`: the normal law's lines."""
+    from .._oblique import oblique_impact
+    from .common import format_table
+
+    tangential = tangential_from_args(args)
+    v0 = args.v0[0]
+    runs = []
+    for angle in args.angle:
+        theta = math.radians(angle)
+        result = oblique_impact(
+            law, tangential, m=args.mass, R=args.radius, v_n=v0 * math.cos(theta),
+            v_t=v0 * math.sin(theta), omega=args.omega, inertia=args.inertia, g=args.gravity,
+            separation=args.separation, contact_point=args.contact_point,
+        )  # fmt: skip
+        data = {"angle_deg": angle, "v0": v0, **result.to_dict()}
+        for name in ("angle_out", "angle_out_contact"):
+            value = data[name]
+            data[f"{name}_deg"] = None if value is None else math.degrees(value)
+        runs.append(data)
+    if args.plot is not None:
+        _plot_oblique(args.plot, runs)
+    conditions = [
+        f"sphere     m = {args.mass:g} kg, R = {args.radius:g} m, I = {args.inertia:g} m R^2, "
+        f"contact point {args.contact_point}",
+        f"impact     v0 = {v0:g} m/s, omega = {args.omega:g} rad/s, g = {args.gravity:g} m/s^2, "
+        f"separation by {args.separation}",
+    ]
+    lines = [*head, f"tangential {tangential!r}", *conditions, ""]
+    if len(runs) == 1:
+        (data,) = runs
+        lines += [f"{'angle':<17} = {data['angle_deg']:g} deg"]
+        lines += [f"{name:<17} = {_oblique_cell(data, name, unit, True)}"
+                  for name, unit in _OBLIQUE_FIELDS]  # fmt: skip
+        lines.append(f"{'status':<17} = {data['status']}")
+    else:
+        header = ["angle (deg)"] + [
+            f"{name} ({unit})" if unit else name for name, unit in _OBLIQUE_FIELDS
+        ]
+        rows = [
+            [f"{d['angle_deg']:g}", *(_oblique_cell(d, n, u, False) for n, u in _OBLIQUE_FIELDS),
+             d["status"]]
+            for d in runs
+        ]  # fmt: skip
+        lines += format_table(header + ["status"], rows)
+    if args.plot is not None:
+        lines.append(f"plot written to {args.plot}")
+    emit(args, runs[0] if len(runs) == 1 else runs, "\n".join(lines))
+    return 0
+
+
+def _oblique_cell(data: dict, name: str, unit: str | None, with_unit: bool) -> str:
+    """One field of an oblique run as text (`with_unit`: a prefixed unit, else the table's
+    plain number); angles in degrees, a missing value (NaN) as `-`."""
+    from .._format import format_number, format_quantity
+
+    value = data[f"{name}_deg"] if unit == "deg" else data[name]
+    if value is None:
+        return "-"
+    if unit is None:
+        return str(int(value))
+    if unit == "deg":
+        return f"{value:.4g} deg" if with_unit else f"{value:.4g}"
+    if not with_unit:
+        return f"{value:.5g}"
+    return format_quantity(value, unit) if unit else format_number(value, 4)
+
+
+def _plot_oblique(path: Path, runs):
+    """e_t and the spin after (rad/s) against the incidence (degrees)."""
+    from .._plotting import new_figure, save_figure
+
+    fig = new_figure(figsize=(9, 3.6))
+    angles = [d["angle_deg"] for d in runs]
+    for k, (name, label) in enumerate((("e_t", "e_t"), ("omega_out", "spin after [rad/s]"))):
+        ax = fig.add_subplot(1, 2, k + 1)
+        ax.plot(angles, [math.nan if d[name] is None else d[name] for d in runs], "o-")
+        ax.set_xlabel("incidence from the normal [deg]")
+        ax.set_ylabel(label)
+    save_figure(fig, path)
 
 
 def read_track(path: Path, header, rows, g: float) -> dict:
@@ -218,7 +352,7 @@ def _number(cell: str, path: Path, line: int, column: str) -> float:
 def run_fit_oblique(args):
     import numpy as np
 
-    from .._oblique import fit_oblique, tangential_law
+    from .._oblique import fit_oblique
 
     check_plot_path(args.plot, inputs=(args.file,))
     if args.speed is not None and not args.speed > 0:
@@ -230,7 +364,7 @@ def run_fit_oblique(args):
     track = "sigma_e_t" in data
     g = (9.81 if track else 0.0) if g is None else g
     law = law_from_args(args)
-    tangential = tangential_law(args.tangential, **parse_params(args.tparam, "--tparam"))
+    tangential = tangential_from_args(args)
     free = free_names(args.free)
     if free is None:
         stiffness = "G_star" if "G_star" in tangential.params else "kt"

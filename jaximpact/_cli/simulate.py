@@ -20,6 +20,7 @@ from .common import (
     terminal_width,
 )
 from .laws import concrete_units
+from .oblique import add_oblique_impact_arguments, check_oblique_arguments, run_oblique_impact
 
 # --------------------------------------------------------------------------------------
 # jaximpact simulate
@@ -68,6 +69,7 @@ def add_simulate(subparsers):
             action.nargs = "+"
             action.help = "impact speed, m/s (> 0); several for a sweep of e(v0), T(v0)"
     add_output_arguments(parser)
+    add_oblique_impact_arguments(parser)
     parser.set_defaults(handler=_run_simulate)
 
 
@@ -77,12 +79,16 @@ def _run_simulate(args):
 
     from .._solve.impact import impact
 
+    check_oblique_arguments(args)
     law = law_from_args(args)
     speeds = list(args.v0)
     for v0 in speeds:  # every speed checked before any work
         if not (math.isfinite(v0) and v0 > 0):
             raise CLIError(f"--v0 {v0:g}: the impact speed v0 must be a finite number > 0 (m/s)")
         check_contact_scales(args.law, parse_params(args.param), args.mass, v0)
+    if args.tangential is not None:
+        params = {k: float(v) for k, v in law.parameters.items()}
+        return run_oblique_impact(args, law, _head(law, {"params": params}))
     runs = []
     for v0 in speeds:
         conditions = dict(m=args.mass, v0=v0, separation=args.separation, g=args.gravity)

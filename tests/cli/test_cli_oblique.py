@@ -152,3 +152,70 @@ def test_fits_a_video_track(capsys, tmp_path):
     fit = json.loads(out)
     assert fit["params"]["kt"] == pytest.approx(2e4, rel=1e-3)
     assert fit["params"]["mu"] == pytest.approx(0.3, rel=1e-3)
+
+
+# ----------------------------------------------------- jaximpact simulate --tangential
+
+SIMULATE = ["simulate", "--law", "hunt_crossley", "--param", "c=4.2e9", "a=0", "--mass",
+            "2.618e-4", "--v0", "3.9"]  # fmt: skip
+MINDLIN = ["--tangential", "mindlin", "--tparam", "G_star=1.35e10", "mu=0.092"]
+
+
+def test_the_command_line_s_tangential_names_are_the_library_s():
+    import jaximpact as ji
+    from jaximpact._cli.common import TANGENTIAL_CHOICES
+
+    assert set(TANGENTIAL_CHOICES) == set(ji.TANGENTIAL_LAW_NAMES)
+
+
+@pytest.mark.parametrize(
+    "extra, message",
+    [
+        (["--angle", "30"], "--angle is for an oblique impact: add --tangential NAME"),
+        (["--tparam", "mu=0.1"], "--tparam is for an oblique impact"),
+        (["--omega", "3"], "--omega is for an oblique impact"),
+        ([*MINDLIN, "--angle", "30"], "needs --radius"),
+        ([*MINDLIN, "--radius", "2.5e-3"], "needs --angle"),
+        ([*MINDLIN, "--radius", "2.5e-3", "--angle", "95"], "in degrees from the normal"),
+        ([*MINDLIN, "--radius", "-1", "--angle", "5"], "--radius must be"),
+        ([*MINDLIN, "--radius", "2.5e-3", "--angle", "5", "--v0", "1", "2"], "one --v0"),
+        ([*MINDLIN, "--radius", "2.5e-3", "--angle", "5", "--inertia", "0"], "--inertia"),
+        (["--tangential", "coulomb", "--radius", "2.5e-3", "--angle", "5"], "invalid choice"),
+        (["--tangential", "mindlin", "--tparam", "G_star=1e10", "mu=-0.1", "--radius",
+          "2.5e-3", "--angle", "5"], "mu must be"),
+    ],
+)  # fmt: skip
+def test_simulate_oblique_bad_input_is_one_line(capsys, extra, message):
+    status, out, err = run_cli(capsys, [*SIMULATE, *extra])
+    assert_one_line_error(status, out, err, contains=message)
+
+
+@pytest.mark.slow  # an oblique solve's compiling (the fast suite: 3 minutes)
+def test_simulate_an_oblique_impact_is_the_library_s(capsys, tmp_path):
+    """One angle as a line per field (angles in degrees), a sweep as a table and as JSON,
+    with the numbers of `oblique_impact` at the same incidence, and the plot."""
+    import math
+
+    import jaximpact as ji
+
+    want = ji.oblique_impact(
+        ji.law("hunt_crossley", c=4.2e9, a=0.0),
+        ji.tangential_law("mindlin", G_star=1.35e10, mu=0.092),
+        m=2.618e-4, R=2.5e-3, v_n=3.9 * math.cos(math.radians(20)),
+        v_t=3.9 * math.sin(math.radians(20)),
+    )  # fmt: skip
+    status, out, err = run_cli(capsys, [*SIMULATE, *MINDLIN, "--radius", "2.5e-3", "--angle",
+                                        "20"])  # fmt: skip
+    assert status == 0 and err == ""
+    assert "angle             = 20 deg" in out and "status            = separated" in out
+    assert f"e_t               = {float(want.e_t):.4g}" in out
+    assert f"{math.degrees(float(want.angle_out)):.4g} deg" in out
+    plot = tmp_path / "sweep.png"
+    status, out, err = run_cli(capsys, [*SIMULATE, *MINDLIN, "--radius", "2.5e-3", "--angle",
+                                        "5", "20", "--json", "--plot", str(plot)])  # fmt: skip
+    runs = json.loads(out)
+    assert status == 0 and [r["angle_deg"] for r in runs] == [5.0, 20.0]
+    assert runs[1]["e_t"] == pytest.approx(float(want.e_t), rel=1e-12)
+    assert runs[1]["omega_out"] == pytest.approx(float(want.omega_out), rel=1e-12)
+    assert runs[1]["angle_out_deg"] == pytest.approx(math.degrees(float(want.angle_out)))
+    assert plot.stat().st_size > 0
