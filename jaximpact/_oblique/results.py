@@ -1,9 +1,13 @@
 """What one oblique impact gives: `ObliqueResult`."""
 
+import math
+
 import equinox as eqx
+import numpy as np
 from jaxtyping import Array
 
-from .._format import format_fields, format_value, jsonable
+from .._checks import is_traced
+from .._format import format_fields, format_number, format_value, jsonable
 from .._solve.results import status_names, status_text
 from .._status import Status
 
@@ -14,6 +18,15 @@ _SHOWN = (("e", ""), ("e_t", ""), ("e_t_contact", ""), ("v_n_out", "m/s"),
           ("impulse_n", "N s"), ("impulse_t", "N s"), ("dissipated", "J"),
           ("num_switches", None), ("num_steps", None))  # fmt: skip
 _NOT_RESULTS = ("status", "num_steps", "num_switches")
+
+
+def _shown(value, unit: str | None) -> str:
+    """A field as `summary()` shows it: an angle in radians with its degrees beside it
+    (`408.7 mrad (23.42 deg)`), the rest by `format_value`."""
+    text = format_value(value, unit)
+    if unit != "rad" or is_traced(value) or np.ndim(value) != 0 or not np.isfinite(value):
+        return text
+    return f"{text} ({format_number(math.degrees(float(value)), 4)} deg)"
 
 
 class ObliqueResult(eqx.Module):
@@ -78,7 +91,7 @@ class ObliqueResult(eqx.Module):
     def summary(self) -> str:
         """The impact as text, every number with its unit; a batch by the range of each
         field and the count of each status; inside `jit` the shapes."""
-        rows = [(name, format_value(getattr(self, name), unit)) for name, unit in _SHOWN]
+        rows = [(name, _shown(getattr(self, name), unit)) for name, unit in _SHOWN]
         rows.append(("status", self._status_text()))
         return format_fields("ObliqueResult (SI units, angles in rad)", rows)
 

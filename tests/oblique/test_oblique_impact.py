@@ -297,6 +297,9 @@ def test_vmap_over_angles_and_jit():
         )
     assert np.all(np.asarray(batch.status) == 0)
     assert "separated 3" in batch.summary()
+    # one impact's angles in radians with their degrees beside them
+    angle = float(single.angle_out)
+    assert f"({np.degrees(angle):.4g} deg)" in single.summary() and " deg)" not in batch.summary()
 
 
 @pytest.mark.slow
