@@ -129,7 +129,10 @@ class TangentialDynamics(eqx.Module):
         for a history that is not rescaled)."""
         if not self.rescaled:
             return 1.0
-        return jnp.sqrt(jnp.clip(x / RESCALE_FLOOR, 0.0, 1.0))
+        # safe_pow: 0 with a zero derivative outside the surface (a square root of the
+        # clipped 0 has an infinite one, and a solve that steps to x = -1e-12 x* at the
+        # contact's end took NaN from its rate there)
+        return jnp.minimum(safe_pow(x / RESCALE_FLOOR, 0.5), 1.0)
 
     def elastic(self, q, x):
         """The spring's force on the body."""

@@ -185,7 +185,18 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
                 T=t_end,
                 switches=switches,
             )
-        assert sol.t_events[1].size, "oracle: the contact neither ended nor switched"
+        x_last = sol.y[0, -1]
+        if rescale and mode == "stick" and not sol.success and 0 <= x_last < 1e-12 * v_n * T_scale:
+            # a rescaled spring sticking to the surface: `q' = q x'/(2x)` outgrows any step
+            # within 1e-12 of the overlap's scale, where the spring's force, `(R x)^0.5`
+            # small, gives no impulse that counts; the last x travels at the speed reached
+            t_end, y_end = sol.t[-1] + x_last / abs(sol.y[1, -1]), sol.y[:, -1]
+            return dict(e=-y_end[1] / v_n, v_t_out=y_end[3], omega_out=y_end[4], T=t_end,
+                        switches=switches)  # fmt: skip
+        assert sol.t_events[1].size, (
+            f"oracle: the contact neither ended nor switched ({sol.message} at x = "
+            f"{x_last:.3e}, mode {mode})"
+        )
         t, state = sol.t_events[1][0], sol.y_events[1][0].copy()
         switches += 1
         if mode == "stick":
