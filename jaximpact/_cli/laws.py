@@ -23,7 +23,8 @@ def add_laws(subparsers):
         description="List every force law: its name (for --law), its equation in the seed "
         "paper (Polukoshko et al. 2007), its formula F(x, v) (N, positive pushing the body "
         "out; x penetration in m, v = dx/dt in m/s), its parameters with their SI units, "
-        "and its reference.",
+        "and its reference; then the tangential laws of oblique impacts (for --tangential, "
+        "with --tparam).",
         example="jaximpact laws\njaximpact laws --json",
     )
     add_output_arguments(parser, plot=False)
@@ -51,22 +52,64 @@ def _law_rows():
     return rows
 
 
-def _laws_text(rows, width=None) -> str:
+def _tangential_rows():
+    from .._oblique.tangential import TANGENTIAL_LAWS
+
+    return [
+        dict(
+            name=spec.name,
+            formula=spec.formula,
+            parameters=[
+                dict(name=p, unit=spec.units.get(p, "-"), default=spec.defaults.get(p))
+                for p in spec.parameters
+            ],
+            also=list(spec.inputs),
+            engines=spec.engines,
+            reference=spec.reference,
+        )
+        for spec in TANGENTIAL_LAWS.values()
+    ]
+
+
+def _params_text(row) -> str:
+    """Each parameter with its unit (and default) on one line, for `format_table`."""
+    return ", ".join(
+        (
+            f"{p['name']} [{p['unit']}]"
+            + ("" if p["default"] is None else f" = {format_number(p['default'])}")
+        ).replace(" ", KEEP_TOGETHER)
+        for p in row["parameters"]
+    )
+
+
+def _tangential_text(rows, width) -> list[str]:
+    """The tangential laws' table (`--tangential`), the engines and reference under each."""
+    import textwrap
+
+    table = [
+        (r["name"], r["formula"],
+         _params_text(r) + (f" (or {', '.join(r['also'])})" if r["also"] else ""))
+        for r in rows
+    ]  # fmt: skip
+    notes = [f"engines: {r['engines']}; ref.: {r['reference']}" for r in rows]
+    intro = (
+        "Tangential laws (--tangential NAME --tparam ...): F_t in N on the sphere at its "
+        "contact point, u its slip (m/s), delta the spring's stretch (m), x the overlap (m), "
+        "m the sphere's mass (kg), R its radius (m)."
+    )
+    lines = format_table(("name", "F_t [N]", "parameters"), table, width=width, wrap=(1, 2),
+                         notes=notes, note_column=1)  # fmt: skip
+    return [*textwrap.wrap(intro, width), "", *lines]
+
+
+def _laws_text(rows, width=None, tangential=()) -> str:
     """The table of laws, fitted to `width` columns (default: the terminal's, 88 when
     stdout is not one): formulas and parameters wrap at spaces, the reference under each."""
     import textwrap
 
     width = terminal_width() if width is None else width
 
-    def params(row):  # each parameter with its unit on one line
-        return ", ".join(
-            (
-                f"{p['name']} [{p['unit']}]"
-                + ("" if p["default"] is None else f" = {format_number(p['default'])}")
-            ).replace(" ", KEEP_TOGETHER)
-            for p in row["parameters"]
-        )
-
+    params = _params_text
     header = ("name", "eq.", "F(x, v) [N]", "parameters")
     table = [(r["name"], r["equation"], r["formula"], params(r)) for r in rows]
     lines = format_table(
@@ -94,9 +137,11 @@ def _laws_text(rows, width=None) -> str:
         "v = dx/dt (m/s). Equation numbers: Polukoshko, Viba, Kononova & Sokolova, Proc. "
         "Estonian Acad. Sci. Eng. 13 (2007)."
     )
-    return "\n".join([*textwrap.wrap(intro, width), "", *lines])
+    more = ["", *_tangential_text(tangential, width)] if tangential else []
+    return "\n".join([*textwrap.wrap(intro, width), "", *lines, *more])
 
 
 def _run_laws(args):
-    rows = _law_rows()
-    emit(args, {"laws": rows}, lambda: _laws_text(rows))
+    rows, tangential = _law_rows(), _tangential_rows()
+    emit(args, {"laws": rows, "tangential_laws": tangential},
+         lambda: _laws_text(rows, tangential=tangential))  # fmt: skip

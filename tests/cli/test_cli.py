@@ -49,6 +49,12 @@ def test_laws_table(capsys, monkeypatch):
     assert "b1 [N s/m^1.5]" in out  # units with the law's exponents filled in
     assert "n [-] = 1.5" in out  # a default
     assert "Kuwabara" in out  # a reference
+    # the tangential laws that --tangential takes, with their parameters and units
+    tangential = out[out.index("Tangential laws (--tangential") :]
+    for name in ji.TANGENTIAL_LAW_NAMES:
+        assert f"\n{name} " in tangential
+    assert "kt [N/m], mu [-], ct [N s/m] = 0" in tangential
+    assert "G_star [Pa]" in tangential and "(or G, nu, G2, nu2)" in tangential
 
 
 def test_laws_json(capsys):
@@ -66,6 +72,14 @@ def test_laws_json(capsys):
     for row in laws:
         assert row["reference"] and row["parameters"]
         assert [p["name"] for p in row["parameters"]] == list(ji.LAWS[row["name"]].parameters)
+    tangential = {row["name"]: row for row in json.loads(out)["tangential_laws"]}
+    assert list(tangential) == list(ji.TANGENTIAL_LAW_NAMES)
+    assert tangential["linear_history"]["parameters"][0] == {
+        "name": "kt",
+        "unit": "N/m",
+        "default": None,
+    }
+    assert tangential["mindlin"]["also"] == ["G", "nu", "G2", "nu2"]
 
 
 # -------------------------------------------------------------------------- simulate
