@@ -455,7 +455,13 @@ def hertz_rate_force(x, v, p):
             "penetration",
             marks=pytest.mark.slow,
         ),
-        (hertz_rate_force, "hertz_rate", dict(c=2e6, b1=800.0), "force"),
+        pytest.param(  # 7 s of compiling; tests/laws/test_custom_laws.py keeps the check
+            hertz_rate_force,
+            "hertz_rate",
+            dict(c=2e6, b1=800.0),
+            "force",
+            marks=pytest.mark.slow,
+        ),
         pytest.param(
             hertz_rate_force,
             "hertz_rate",
