@@ -221,6 +221,32 @@ def check_argument_scales(args):
                 check_scale(f"--{dest.replace('_', '-')}", number)
 
 
+# the mean densities (kg/m^3) a sphere of a command's --mass and --radius plausibly has: a
+# thin hollow ball (a ping-pong ball: 80) to osmium (22,590); a radius in mm given as m
+# moves it by 1e-9, a mass in g given as kg by 1e3
+PLAUSIBLE_DENSITY = (1.0, 3e4)
+
+
+def warn_sphere_density(m, R) -> None:
+    """A warning (one line on the command line) where a sphere of mass `m` (kg) and
+    radius `R` (m) would have a mean density outside `PLAUSIBLE_DENSITY`: a unit is
+    likely wrong. Nothing for values the commands' own checks refuse."""
+    import math
+    import warnings
+
+    if m is None or R is None or not (math.isfinite(m) and math.isfinite(R) and m > 0 and R > 0):
+        return
+    density = m / (4.0 / 3.0 * math.pi * R**3)
+    low, high = PLAUSIBLE_DENSITY
+    if not low <= density <= high:
+        warnings.warn(
+            f"a sphere of --mass {m:g} kg and --radius {R:g} m has a mean density of "
+            f"{density:.3g} kg/m^3, outside {low:g} to {high:g} (a ping-pong ball's is 80, "
+            "steel's 7800): check the units (--mass in kg, --radius in m)",
+            stacklevel=2,
+        )
+
+
 def check_contact_scales(law_name: str, params: dict, m: float, v0: float):
     """The scales of an impact of the law `law_name` (parameters `params`), mass `m` (kg)
     and speed `v0` (m/s): the energy `m v0^2` (J) and, for the family `F = c x^n + ...`,

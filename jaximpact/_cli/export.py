@@ -14,6 +14,7 @@ from .common import (
     emit,
     parse_params,
     tangential_from_args,
+    warn_sphere_density,
 )
 
 
@@ -193,6 +194,7 @@ def _run_export(args):
         if "--mass (kg)" in missing:
             raise CLIError(missing_mass(engine, name is not None, f"give {what}"))
         raise CLIError(f"{engine} needs {what} of the {'sphere' if args.wall else 'two spheres'}")
+    warn_sphere_density(args.mass, args.radius)
     source = None
     if name is not None:
         from .._laws import law

@@ -26,6 +26,7 @@ from .common import (
     law_from_args,
     read_table,
     tangential_from_args,
+    warn_sphere_density,
 )
 
 INCIDENCE = ("theta_deg", "v_n", "v_t", "omega")
@@ -171,6 +172,7 @@ def check_oblique_arguments(args) -> None:
         raise CLIError(f"--omega must be a finite number (rad/s), got {args.omega:g}")
     if not (math.isfinite(args.inertia) and args.inertia > 0):
         raise CLIError(f"--inertia must be a finite number > 0 (I / (m R^2)), got {args.inertia:g}")
+    warn_sphere_density(args.mass, args.radius)
 
 
 def run_oblique_impact(args, law, head: list[str]) -> int:
@@ -355,6 +357,7 @@ def run_fit_oblique(args):
     from .._oblique import fit_oblique
 
     check_plot_path(args.plot, inputs=(args.file,))
+    warn_sphere_density(args.mass, args.radius)
     if args.speed is not None and not args.speed > 0:
         raise CLIError(f"--speed must be > 0 (m/s), got {args.speed:g}")
     g = args.g

@@ -219,3 +219,28 @@ def test_simulate_an_oblique_impact_is_the_library_s(capsys, tmp_path):
     assert runs[1]["omega_out"] == pytest.approx(float(want.omega_out), rel=1e-12)
     assert runs[1]["angle_out_deg"] == pytest.approx(math.degrees(float(want.angle_out)))
     assert plot.stat().st_size > 0
+
+
+@pytest.mark.parametrize(
+    "m, R, warned",
+    [
+        (2.618e-4, 2.5e-3, False),  # Kharaz's alumina sphere, 3.99 g/cm^3
+        (2.7e-3, 0.02, False),  # a ping-pong ball, hollow: 80 kg/m^3
+        (2.618e-4, 2.5, True),  # the radius in mm given as m
+        (261.8, 2.5e-3, True),  # the mass in mg given as kg: 4e9 kg/m^3
+    ],
+)
+def test_a_sphere_of_implausible_density_is_warned(capsys, m, R, warned):
+    """A wrong unit in --mass or --radius (found by using the commands as a new user: a
+    radius of 2.5 "m" for a 5 mm ball gave a plausible-looking table) is said in one
+    warning line before any work; here the tangential law's refusal follows it."""
+    argv = ["simulate", "--law", "hunt_crossley", "--param", "c=4.2e9", "a=0", "--mass",
+            str(m), "--v0", "3.9", "--tangential", "mindlin", "--tparam", "G_star=1.35e10",
+            "mu=-0.1", "--radius", str(R), "--angle", "30"]  # fmt: skip
+    status, out, err = run_cli(capsys, argv)
+    lines = err.strip().splitlines()
+    assert status == 2 and out == "" and "mu must be" in lines[-1]
+    if warned:
+        assert len(lines) == 2 and "check the units (--mass in kg, --radius in m)" in lines[0]
+    else:
+        assert len(lines) == 1
