@@ -28,7 +28,9 @@ OUTPUTS = {  # script -> (arguments, files it must write)
     "fit_microphone_impacts.py": ([], ["microphone_impacts.png"]),
     "fit_video_trajectory.py": ([], ["video_trajectory.png"]),
     "maps.py": (["--out", "maps"], ["maps"]),
+    "oblique_rebounds.py": ([], ["oblique_rebounds.png"]),
     "pick_a_law.py": ([], ["pick_a_law.png"]),
+    "plastic_and_sticky.py": ([], ["plastic_and_sticky.png"]),
     "uncertainty_propagation.py": ([], ["uncertainty.png"]),
 }
 
