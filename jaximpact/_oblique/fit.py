@@ -121,7 +121,8 @@ def _fit(law, tangential, m, R, inertia, g, data, free, options, max_steps, tol,
 
         return jax.vmap(one)(v_n, v_t, omega)
 
-    def residuals(theta, _):
+    def outputs(theta):
+        """The residuals and the impacts' results at `theta`."""
         result = predict(theta)
         parts = []
         if has_e:
@@ -131,7 +132,10 @@ def _fit(law, tangential, m, R, inertia, g, data, free, options, max_steps, tol,
             known = jnp.isfinite(omega_out)
             target = jnp.where(known, omega_out, 0.0)
             parts.append(jnp.where(known, (result.omega_out - target) / s_w, 0.0))
-        return jnp.concatenate(parts)
+        return jnp.concatenate(parts), result
+
+    def residuals(theta, _):
+        return outputs(theta)[0]
 
     theta0 = jnp.stack([jnp.log(tangential.params[k]) for k in free])
     starts = theta0[None]
@@ -156,7 +160,7 @@ def _fit(law, tangential, m, R, inertia, g, data, free, options, max_steps, tol,
         best = thetas[order[: 2 if "mu" in free else 1]]
         starts = jnp.concatenate([theta0[None], best])
 
-    def solve(start):
+    def solve(start, compare: bool):
         solution = optx.least_squares(
             residuals,
             optx.LevenbergMarquardt(rtol=tol, atol=tol),
@@ -164,19 +168,31 @@ def _fit(law, tangential, m, R, inertia, g, data, free, options, max_steps, tol,
             max_steps=max_steps,
             throw=False,
         )
-        final = jnp.sum(residuals(solution.value, None) ** 2)
-        final = jnp.where(jnp.isfinite(final), final, jnp.inf)
+        final = jnp.zeros(())
+        if compare:  # the loss that picks among starts (a copy of the solve: only then)
+            final = jnp.sum(residuals(solution.value, None) ** 2)
+            final = jnp.where(jnp.isfinite(final), final, jnp.inf)
         ok = solution.result == optx.RESULTS.successful
         return solution.value, final, ok, solution.stats["num_steps"]
 
-    # one start after the other (`lax.map`): each solve as it runs alone (a vmap of the two
-    # ran both to the slower one's steps, and its batched events found another minimum)
-    values, finals, oks, counts = jax.lax.map(solve, starts)
-    pick = jnp.argmin(finals)
-    theta = values[pick]
-    r = residuals(theta, None)
-    jacobian = jax.jacfwd(lambda t: residuals(t, None))(theta)
-    return theta, r, jacobian, predict(theta), oks[pick], counts[pick]
+    if starts.shape[0] == 1:
+        theta, _, ok, count = solve(starts[0], compare=False)
+    else:
+        # one start after the other (`lax.map`): each solve as it runs alone (a vmap of the
+        # two ran both to the slower one's steps, and its batched events found another
+        # minimum)
+        values, finals, oks, counts = jax.lax.map(lambda s: solve(s, compare=True), starts)
+        pick = jnp.argmin(finals)
+        theta, ok, count = values[pick], oks[pick], counts[pick]
+
+    def with_aux(t):
+        r, result = outputs(t)
+        return r, (r, result)
+
+    # one pass for the Jacobian, the residuals and the results (each a copy of the solve
+    # in the compiled program, which takes most of a fit's time to compile)
+    jacobian, (r, result) = jax.jacfwd(with_aux, has_aux=True)(theta)
+    return theta, r, jacobian, result, ok, count
 
 
 def _rms(differences):
