@@ -653,9 +653,10 @@ def test_calibrate_takes_the_closed_form(name, truth, start):
         assert float(fit.params[key]) == pytest.approx(truth[key], rel=1e-10)
 
 
+@pytest.mark.slow  # 3.5 s: two laws fitted twice (the fast suite: 3 minutes)
 def test_compare_laws_in_threads_ranks_as_one_after_another():
     """The fits side by side (threads, `workers=2`) give the rankings one after another
-    gives, to the bit; `workers` other than an integer >= 1 is refused in one line."""
+    gives, to the bit."""
     data = dict(m=0.0027, v0=[1.0, 1.4, 1.9, 2.4], e=[0.95, 0.94, 0.936, 0.912], progress=False,
                 laws=("kelvin_voigt", "hertz_rate"))  # fmt: skip
     one = ji.compare_laws(workers=1, **data)
@@ -665,5 +666,10 @@ def test_compare_laws_in_threads_ranks_as_one_after_another():
         assert a.sum_sq == b.sum_sq
         for key in a.fit.params:
             assert float(a.fit.params[key]) == float(b.fit.params[key])
-    with pytest.raises(ValueError, match="workers must be an integer >= 1"):
-        ji.compare_laws(workers=0, **data)
+
+
+def test_compare_laws_refuses_workers_below_one_before_any_fit():
+    data = dict(m=0.0027, v0=[1.0, 1.4], e=[0.95, 0.94], progress=False, laws=("hertz_rate",))
+    for workers in (0, -1, 1.5):
+        with pytest.raises(ValueError, match="workers must be an integer >= 1"):
+            ji.compare_laws(workers=workers, **data)

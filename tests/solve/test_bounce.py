@@ -291,6 +291,7 @@ def test_height_in_flight_is_the_parabola():
     )
 
 
+@pytest.mark.slow  # 5 s: the drop's trajectory and scipy (the fast suite: 3 minutes)
 def test_height_inside_contact_from_the_contact_solution():
     b, n, ts, y, u, F = histories()
     name, params = "hertz_rate", SECTION7["hertz_rate"]
@@ -312,6 +313,7 @@ def test_height_inside_contact_from_the_contact_solution():
     assert np.all(np.isfinite(y[ts <= float(b.t_rest)]))
 
 
+@pytest.mark.slow  # the trajectory of the test above (tests/test_fuzz.py keeps one fast)
 def test_height_at_rest_after_t_rest():
     b, n, ts, y, u, F = histories()
     rest = ts > float(b.t_rest)
