@@ -109,9 +109,8 @@ def _laws_text(rows, width=None, tangential=()) -> str:
 
     width = terminal_width() if width is None else width
 
-    params = _params_text
     header = ("name", "eq.", "F(x, v) [N]", "parameters")
-    table = [(r["name"], r["equation"], r["formula"], params(r)) for r in rows]
+    table = [(r["name"], r["equation"], r["formula"], _params_text(r)) for r in rows]
     lines = format_table(
         header,
         table,
