@@ -67,6 +67,17 @@ def test_closed_forms_page_lists_the_module():
     assert listed == public
 
 
+def test_every_page_is_in_the_nav():
+    """Each page of docs/ and each table of benchmarks/ is listed in mkdocs.yml's nav: the strict
+    build refuses a page left out of it, and that build runs only in the slow group."""
+    nav = (ROOT / "mkdocs.yml").read_text(encoding="utf-8").split("\nnav:", 1)[1]
+    listed = set(re.findall(r"(?:: |- )(\S+\.md)$", nav, re.M))
+    pages = {p.relative_to(ROOT / "docs").as_posix() for p in (ROOT / "docs").rglob("*.md")}
+    pages |= {f"benchmarks/{p.name}" for p in (ROOT / "benchmarks").glob("*.md")}
+    missing = sorted(pages - listed)
+    assert not missing, f"pages not in mkdocs.yml's nav: {missing}"
+
+
 @pytest.mark.slow
 def test_site_builds_strict(tmp_path):
     missing = [
