@@ -208,6 +208,11 @@ def fit_bounces(
             sigma=sigma, clean_tol=clean_tol, outlier_sigma=outlier_sigma, max_iter=max_iter,
             tol=tol, rtol=rtol, max_steps=max_steps,
         )  # fmt: skip
+        for i, times in enumerate(impact_times):  # every drop checked before any is fitted
+            try:
+                prepare_impacts(times_in_order(times, "impact_times"), clean_tol)
+            except ValueError as error:
+                raise ValueError(f"drop {i} of impact_times: {error}") from None
         return [fit_bounces(law, impact_times=times, **options) for times in impact_times]
     if (impact_times is None) == (t is None and y is None):
         raise ValueError("give either a trajectory (t=..., y=...) or impact_times=..., not both")

@@ -7,6 +7,7 @@ same compiled drop as test_bounce.py's.
 """
 
 import functools
+import importlib
 import json
 
 import jax.numpy as jnp
@@ -17,6 +18,8 @@ from helpers import run_cli
 import jaximpact as ji
 from jaximpact import clean_impact_times, fit_bounces, interval_restitution
 from jaximpact._solve.bounce import bounce
+
+fit_bounces_module = importlib.import_module("jaximpact._fit.fit_bounces")
 
 GOLF_M = 0.0415  # kg
 GOLF = dict(c=5.5e7, b1=700.0)  # contact about 0.5 ms, e about 0.92 at 4 m/s
@@ -263,7 +266,11 @@ def two_drops_concatenated():
     return first, second, np.concatenate([first, second])
 
 
-def test_impact_times_that_go_backwards_are_refused():
+def _must_not_fit(*args, **kwargs):
+    raise AssertionError("a drop was fitted before every drop was checked")
+
+
+def test_impact_times_that_go_backwards_are_refused(monkeypatch):
     first, second, both = two_drops_concatenated()
     law = ji.law("hertz_rate", **GOLF)
     with pytest.raises(ValueError, match=f"go backwards at index {first.size} ") as error:
@@ -276,8 +283,12 @@ def test_impact_times_that_go_backwards_are_refused():
         fit_bounces(law, m=GOLF_M, impact_times=np.stack([first[:8], second[:8]]))
     with pytest.raises(ValueError, match="not a mix"):
         fit_bounces(law, m=GOLF_M, impact_times=[first, 3.0])
-    with pytest.raises(ValueError, match="go backwards at index 1"):
+    # every drop is checked before the first is fitted (drop 0 was fitted first, 6 s)
+    monkeypatch.setattr(fit_bounces_module, "_fit_impacts", _must_not_fit)
+    with pytest.raises(ValueError, match="drop 1 of impact_times: .* go backwards at index 1"):
         fit_bounces(law, m=GOLF_M, impact_times=[first, second[::-1]])
+    with pytest.raises(ValueError, match="drop 1 of impact_times: need at least 3"):
+        fit_bounces(law, m=GOLF_M, impact_times=[first, second[:2]])
 
 
 def test_a_list_of_drops_is_fitted_drop_by_drop():
