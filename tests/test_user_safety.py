@@ -6,6 +6,7 @@ print as numbers with units, and `dir(jaximpact)` holds the public names only.""
 import json
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -508,3 +509,30 @@ def test_impact_refuses_a_mass_float64_cannot_carry(m):
     with pytest.raises(ValueError, match="float64 cannot hold") as error:
         ji.impact(ji.law("hertz_rate", c=2e6, b1=800.0), m=m, v0=2.5)
     assert "\n" not in str(error.value)
+
+
+@pytest.mark.parametrize(
+    "call, said",
+    [
+        (lambda: ji.law("hertz", c=1e9),
+         "did you mean hertz_viscous, hertz_modified or hertz_rate?"),
+        (lambda: ji.law("Hunt-Crossley", c=1e9), "did you mean hunt_crossley?"),
+        (lambda: ji.law("jkrr", c=1e9), "did you mean jkr?"),
+        (lambda: ji.tangential_law("Mindlin", G_star=1e10, mu=0.3), "did you mean mindlin?"),
+        (lambda: ji.export(ji.law("kelvin_voigt", c=1e6, b=10.0), "Lammps", m=1.0, v0=1.0),
+         "did you mean lammps?"),
+    ],
+)  # fmt: skip
+def test_a_mistyped_name_is_told_the_nearest_names(call, said):
+    """A law, tangential law or engine named as people say it (`hertz`, `Hunt-Crossley`) is
+    refused in one line that names the nearest names first, then lists them all."""
+    with pytest.raises(ValueError, match=re.escape(said)) as error:
+        call()
+    assert "choose one of: " in str(error.value) and "\n" not in str(error.value)
+
+
+def test_a_name_like_no_other_gets_the_list_alone():
+    with pytest.raises(ValueError) as error:
+        ji.law("xyz", c=1.0)
+    message = str(error.value)
+    assert "did you mean" not in message and "choose one of: kelvin_voigt" in message

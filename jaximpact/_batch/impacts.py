@@ -18,6 +18,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._checks import check_nonnegative, check_positive, invalid_entries
+from .._choices import unknown_name
 from .._laws import LAW_NAMES, LAWS, AbstractLaw, CustomLaw, custom_law, law as make_law
 from .._laws.named_law import invalid_parameter_rows, table_law
 from .._progress import AbstractMeter
@@ -178,7 +179,7 @@ def prepare_rows(law, params, *, m, v0, g=0.0, invalid: str = "raise"):
     if skeleton[0] == "law":
         name = skeleton[1]
         if name not in LAWS:
-            raise ValueError(f"unknown law {name!r}; choose one of: {', '.join(LAW_NAMES)}")
+            raise ValueError(unknown_name("law", name, LAW_NAMES))
         given = {**LAWS[name].defaults, **given}
     arrays = {k: np.asarray(v, dtype=float) for k, v in given.items()}
     if {"m", "v0", "g"} & set(arrays):

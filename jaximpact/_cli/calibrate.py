@@ -11,6 +11,7 @@ import math
 import sys
 from pathlib import Path
 
+from .._choices import unknown_name
 from .._format import format_number, format_quantity
 from .._interrupt import check_interrupt, set_note
 from .._plotting import new_figure, save_figure
@@ -279,7 +280,7 @@ def _run_one(args, data):
     from .._laws import LAW_NAMES, LAWS
 
     if args.law not in LAWS:
-        raise CLIError(f"unknown law {args.law!r}; choose one of: {', '.join(LAW_NAMES)}, or {ALL}")
+        raise CLIError(unknown_name("law", args.law, LAW_NAMES, also=ALL))
     given = parse_params(args.param)
     row = _middle(data)
     T_row = None if data["T"] is None else data["T"][row]

@@ -5,6 +5,7 @@ names and what the help says of each come from the one registry, `_engines.expor
 import json
 import sys
 
+from .._choices import unknown_name
 from .._format import format_number
 from .common import (
     CLIError,
@@ -158,7 +159,7 @@ def _engine_name(args) -> str:
 
 def _check_engine(name: str) -> None:
     if name not in _engines():
-        raise CLIError(f"unknown engine {name!r}; choose one of: {', '.join(_engines())}")
+        raise CLIError(unknown_name("engine", name, list(_engines())))
 
 
 def _run_export(args):

@@ -8,6 +8,7 @@ import warnings as _warnings
 import numpy as np
 
 from .._checks import check_scale
+from .._choices import unknown_name
 from . import _stepping, chrono, drake, lammps, liggghts, mujoco, yade
 from .base import AbstractEngine, Design
 from .materials import check_poisson, check_positive, check_restitution
@@ -724,5 +725,5 @@ def stepped_response(engine: str, parameters: dict, *, m, speeds, radius=None):
 def _engine(name: str) -> AbstractEngine:
     """The engine `name` of `ENGINES`, or a one-line ValueError naming the engines."""
     if name not in ENGINES:
-        raise ValueError(f"unknown engine {name!r}; choose one of: {', '.join(ENGINES)}")
+        raise ValueError(unknown_name("engine", name, list(ENGINES)))
     return ENGINES[name]

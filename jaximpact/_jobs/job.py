@@ -27,9 +27,10 @@ import os
 import time
 from pathlib import Path
 
+from .._choices import unknown_name
 from .._files import check_outputs, check_suffix, temporary_name
 from .._interrupt import check_interrupt, set_note
-from .._laws import LAWS
+from .._laws import LAW_NAMES, LAWS
 from .._progress import AbstractMeter, metered
 from .._status import Status
 from .chunks import compute_chunk
@@ -165,7 +166,7 @@ def plan(source, out, law, *, params, given, chunk_rows, resume, progress, mesh,
     """The job of `batch_file`'s arguments (`given`: its `m`, `v0`, `g`, `separation`), each
     checked, and the table opened: a one-line `ValueError` before any work."""
     if law not in LAWS:
-        raise ValueError(f"unknown law {law!r}; see `jaximpact laws`")
+        raise ValueError(unknown_name("law", law, LAW_NAMES))
     if mesh not in ("global", "local"):
         raise ValueError(f"mesh must be 'global' or 'local', got {mesh!r}")
     if isinstance(chunk_rows, bool) or not (isinstance(chunk_rows, int) and chunk_rows >= 1):

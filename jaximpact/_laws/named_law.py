@@ -11,6 +11,7 @@ import numpy as np
 from jaxtyping import Array
 
 from .._checks import invalid_entries
+from .._choices import unknown_name
 from .._powers import contact_pow
 from .base import AbstractLaw, LawSpec
 from .dynamics import power_dynamics
@@ -115,7 +116,7 @@ def law(name: str, **params) -> AbstractLaw:
     **Example**: `law("kelvin_voigt", c=2e6, b=400.0)`.
     """
     if name not in LAWS:
-        raise ValueError(f"unknown law {name!r}; choose one of: {', '.join(LAW_NAMES)}")
+        raise ValueError(unknown_name("law", name, LAW_NAMES))
     return table_law(name, checked_parameters(LAWS[name], params))
 
 

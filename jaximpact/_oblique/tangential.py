@@ -50,6 +50,7 @@ import jax.numpy as jnp
 from jaxtyping import Array
 
 from .._checks import check_nonnegative, check_positive, is_traced
+from .._choices import unknown_name
 from .._powers import safe_pow
 
 HISTORIES = ("displacement", "force")
@@ -497,9 +498,7 @@ def tangential_law(name: str, **params) -> AbstractTangentialLaw:
     **Example**: `tangential_law("linear_history", kt=1e7, mu=0.3)`.
     """
     if name not in TANGENTIAL_LAWS:
-        raise ValueError(
-            f"unknown tangential law {name!r}; choose one of: {', '.join(TANGENTIAL_LAW_NAMES)}"
-        )
+        raise ValueError(unknown_name("tangential law", name, TANGENTIAL_LAW_NAMES))
     spec = TANGENTIAL_LAWS[name]
     unknown = sorted(set(params) - set(spec.parameters) - set(spec.inputs))
     if unknown:

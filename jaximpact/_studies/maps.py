@@ -10,6 +10,7 @@ import equinox as eqx
 import numpy as np
 
 from .._batch import batch_path, impact_batch
+from .._choices import unknown_name
 from .._format import PrintedFields, concrete_units
 from .._laws import LAW_NAMES, LAWS, law
 from .._laws.closed_forms import exact_batch
@@ -116,7 +117,7 @@ def restitution_map(
     `plot_map(restitution_map("kelvin_voigt")).savefig("fig1.png")`.
     """
     if law_name not in LAWS:
-        raise ValueError(f"unknown law {law_name!r}; choose one of: {', '.join(LAW_NAMES)}")
+        raise ValueError(unknown_name("law", law_name, LAW_NAMES))
     spec = LAWS[law_name]
     damping_name = spec.damping if damping_name is None else damping_name
     fixed = held_fixed(spec, fixed, damping_name)
