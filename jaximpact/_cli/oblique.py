@@ -14,6 +14,7 @@ Or a video track of the ball bouncing across a floor, one row per frame: `t` (s)
 import math
 from pathlib import Path
 
+from .._status import Status
 from .common import (
     CLIError,
     add_law_arguments,
@@ -135,6 +136,11 @@ def add_oblique_impact_arguments(parser):
         help="with --tangential: the spin before impact, rad/s (default 0; omega = v_t / R "
         "rolls without slip)",
     )  # fmt: skip
+    parser.add_argument(
+        "--max-segments", type=int, default=16, metavar="N",
+        help="with --tangential: the most stick and slip phases one impact may have (default "
+        "16); an impact that needs more ends out_of_steps and says so",
+    )  # fmt: skip
     _add_sphere_arguments(parser, "as the engine you export to", "with --tangential: ")
 
 
@@ -153,6 +159,7 @@ def check_oblique_arguments(args) -> None:
         given = [flag for flag, value in oblique.items() if value is not None]
         given += ["--tparam"] if args.tparam else []
         given += ["--omega"] if args.omega != 0.0 else []
+        given += ["--max-segments"] if args.max_segments != 16 else []
         if given:
             raise CLIError(f"{given[0]} is for an oblique impact: add --tangential NAME")
         return
@@ -172,6 +179,8 @@ def check_oblique_arguments(args) -> None:
         raise CLIError(f"--omega must be a finite number (rad/s), got {args.omega:g}")
     if not (math.isfinite(args.inertia) and args.inertia > 0):
         raise CLIError(f"--inertia must be a finite number > 0 (I / (m R^2)), got {args.inertia:g}")
+    if args.max_segments < 1:
+        raise CLIError(f"--max-segments must be at least 1, got {args.max_segments}")
     warn_sphere_density(args.mass, args.radius)
 
 
@@ -190,6 +199,7 @@ def run_oblique_impact(args, law, head: list[str]) -> int:
             law, tangential, m=args.mass, R=args.radius, v_n=v0 * math.cos(theta),
             v_t=v0 * math.sin(theta), omega=args.omega, inertia=args.inertia, g=args.gravity,
             separation=args.separation, contact_point=args.contact_point,
+            max_segments=args.max_segments, throw=False,
         )  # fmt: skip
         data = {"angle_deg": angle, "v0": v0, **result.to_dict()}
         for name in ("angle_out", "angle_out_contact"):
@@ -223,8 +233,21 @@ def run_oblique_impact(args, law, head: list[str]) -> int:
         lines += format_table(header + ["status"], rows)
     if args.plot is not None:
         lines.append(f"plot written to {args.plot}")
+    failed = [d for d in runs if Status[d["status"]].is_failure]
+    if failed:
+        angles = ", ".join(format(d["angle_deg"], "g") for d in failed)
+        switches = max(d["num_switches"] for d in failed)
+        what = (
+            f"raise --max-segments ({args.max_segments})"
+            if switches + 1 >= args.max_segments
+            else "each phase ran out of solver steps: check the units and the laws' parameters"
+        )
+        lines.append(
+            f"the solve ended {failed[0]['status']} at --angle {angles} (after {switches} "
+            f"stick-slip switches): {what}"
+        )
     emit(args, runs[0] if len(runs) == 1 else runs, "\n".join(lines))
-    return 0
+    return 1 if failed else 0
 
 
 def _oblique_cell(data: dict, name: str, unit: str | None, with_unit: bool) -> str:

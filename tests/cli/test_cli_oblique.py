@@ -180,6 +180,9 @@ def test_the_command_line_s_tangential_names_are_the_library_s():
         ([*MINDLIN, "--radius", "-1", "--angle", "5"], "--radius must be"),
         ([*MINDLIN, "--radius", "2.5e-3", "--angle", "5", "--v0", "1", "2"], "one --v0"),
         ([*MINDLIN, "--radius", "2.5e-3", "--angle", "5", "--inertia", "0"], "--inertia"),
+        ([*MINDLIN, "--radius", "2.5e-3", "--angle", "5", "--max-segments", "0"],
+         "--max-segments must be at least 1"),
+        (["--max-segments", "40"], "--max-segments is for an oblique impact"),
         (["--tangential", "coulomb", "--radius", "2.5e-3", "--angle", "5"], "invalid choice"),
         (["--tangential", "mindlin", "--tparam", "G_star=1e10", "mu=-0.1", "--radius",
           "2.5e-3", "--angle", "5"], "mu must be"),
@@ -219,6 +222,26 @@ def test_simulate_an_oblique_impact_is_the_library_s(capsys, tmp_path):
     assert runs[1]["omega_out"] == pytest.approx(float(want.omega_out), rel=1e-12)
     assert runs[1]["angle_out_deg"] == pytest.approx(math.degrees(float(want.angle_out)))
     assert plot.stat().st_size > 0
+
+
+@pytest.mark.slow  # an oblique solve's compiling
+def test_simulate_says_which_angles_ran_out_of_segments(capsys):
+    """A sphere whose tangential spring is far stiffer than its normal one (a 5 m radius,
+    from a wrong unit) switches between stick and slip 16 times: with the default 16
+    segments the solve ends out_of_steps. The command prints the status and what to raise,
+    exits 1 (it said `internal error, RuntimeError` before), and --max-segments 64 ends it."""
+    argv = ["simulate", "--law", "hertz_rate", "--param", "c=1e9", "b1=0", "--mass", "0.01",
+            "--v0", "1", "--tangential", "mindlin", "--tparam", "G_star=1e10", "mu=0.3",
+            "--radius", "5", "--angle", "30"]  # fmt: skip
+    status, out, err = run_cli(capsys, argv)
+    assert status == 1 and "internal error" not in err
+    assert "status            = out_of_steps" in out
+    assert out.strip().splitlines()[-1] == (
+        "the solve ended out_of_steps at --angle 30 (after 16 stick-slip switches): raise "
+        "--max-segments (16)"
+    )
+    status, out, err = run_cli(capsys, [*argv, "--max-segments", "64", "--json"])
+    assert status == 0 and json.loads(out)["status"] == "separated"
 
 
 @pytest.mark.parametrize(
