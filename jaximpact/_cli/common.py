@@ -6,6 +6,7 @@ imported only then); anything long reports through a meter of `jaximpact._progre
 import argparse
 import json
 import os
+import re
 import sys
 import textwrap
 from collections.abc import Callable, Iterable
@@ -24,11 +25,50 @@ class CLIError(Exception):
 
 
 class Parser(argparse.ArgumentParser):
-    """An ArgumentParser whose usage errors are one line (`jaximpact: error: ...`)."""
+    """An ArgumentParser whose usage errors are one line (`jaximpact: error: ...`); a number
+    given with a unit (`--radius 5mm`, `--mass 10 g`) is told to drop it (`unit_hint`)."""
 
     def error(self, message):
-        hint = f" (see '{self.prog} --help')"
-        fail(f"{message}{hint}", status=2)
+        bad = re.search(r"invalid float value: '(.*)'$", message)
+        loose = re.match(r"unrecognized arguments: (.*)$", message)
+        if bad and unit_hint(bad.group(1)):
+            message += f": {unit_hint(bad.group(1))}"
+        elif loose and all(_UNIT.fullmatch(word) for word in loose.group(1).split()):
+            message += f": {SI_NUMBERS}"
+        fail(f"{message} (see '{self.prog} --help')", status=2)
+
+
+SI_NUMBERS = "numbers are given without a unit, in the units --help gives (SI: kg, m, s, N, Pa)"
+_UNIT = re.compile(r"(?:[GMkcmuµn]?(?:m|g|s|N|Pa)|m/s|N/m(?:\^?1\.5)?|deg|rad(?:/s)?)")
+_PREFIX = {
+    "G": 1e9,
+    "M": 1e6,
+    "k": 1e3,
+    "": 1.0,
+    "c": 1e-2,
+    "m": 1e-3,
+    "u": 1e-6,
+    "µ": 1e-6,
+    "n": 1e-9,
+}
+
+
+def unit_hint(text: str) -> str | None:
+    """For a number written with a unit (`"5mm"`, `"2.5 m/s"`, `"10g"`), what to give
+    instead (`"... 5mm is 0.005 (m)"`, converted where the unit is a prefixed kg, m, s, N or
+    Pa); None for text that is no such number."""
+    match = re.fullmatch(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S+)\s*", text)
+    if match is None or not _UNIT.fullmatch(match.group(2)):
+        return None
+    number, unit = float(match.group(1)), match.group(2)
+    simple = re.fullmatch(r"([GMkcmuµn]?)(m|g|s|N|Pa)", unit)
+    if simple and unit not in ("ms", "mm", "mg", "cm") and simple.group(1) == "m":
+        simple = None  # a prefix m is milli only in the units above ("mN": no guess)
+    if simple is None:
+        return f"{SI_NUMBERS}: give {match.group(1)} if it is in that unit"
+    prefix, base = simple.groups()
+    scale, base = (_PREFIX[prefix] * 1e-3, "kg") if base == "g" else (_PREFIX[prefix], base)
+    return f"{SI_NUMBERS}: {text.strip()} is {number * scale:.6g} ({base})"
 
 
 def fail(message: str, status: int):
@@ -173,7 +213,10 @@ def parse_params(items: Iterable[str], flag: str = "--param") -> dict[str, float
         try:
             number = float(value)
         except ValueError:
-            raise CLIError(f"{flag} {item!r}: {value!r} is not a number") from None
+            hint = unit_hint(value)
+            raise CLIError(
+                f"{flag} {item!r}: {value!r} is not a number" + (f": {hint}" if hint else "")
+            ) from None
         if name in params:
             raise CLIError(f"{flag} {name} is given twice")
         check_scale(f"{flag} {name}", number)

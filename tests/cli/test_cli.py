@@ -144,6 +144,25 @@ def test_simulate_bad_input(capsys, argv, contains):
     assert_one_line_error(*run_cli(capsys, ["simulate", *argv]), contains=contains)
 
 
+@pytest.mark.parametrize(
+    "extra, contains",
+    [
+        (["--mass", "10g"], "'10g': numbers are given without a unit, in the units --help gives "
+         "(SI: kg, m, s, N, Pa): 10g is 0.01 (kg)"),
+        (["--mass", "250mg"], "250mg is 0.00025 (kg)"),
+        (["--v0", "2.5m/s"], "give 2.5 if it is in that unit"),
+        (["--mass", "10", "g"], "unrecognized arguments: g: numbers are given without a unit"),
+        (["--param", "c=2MPa"], "'2MPa' is not a number: numbers are given without a unit"),
+        (["--mass", "abc"], "invalid float value: 'abc' (see"),
+    ],
+)  # fmt: skip
+def test_a_number_with_a_unit_is_told_what_to_give(capsys, extra, contains):
+    """Found by using the command as a new user: `--radius 5mm` or `--mass 10 g` said only
+    `invalid float value` or `unrecognized arguments: g`."""
+    argv = ["simulate", "--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "2.5"]
+    assert_one_line_error(*run_cli(capsys, [*argv, *extra]), contains=contains)
+
+
 @pytest.mark.parametrize("argv", [[], ["frobnicate"], ["laws", "--bogus"]])
 def test_usage_errors(capsys, argv):
     assert_one_line_error(*run_cli(capsys, argv))
