@@ -8,14 +8,13 @@ its nondimensional restitution table (`calibrate(..., init="auto")`).
 """
 
 import math
-import sys
 from pathlib import Path
 
 from .._choices import unknown_name
 from .._format import format_number, format_quantity
 from .._interrupt import check_interrupt, set_note
 from .._plotting import new_figure, save_figure
-from .._progress import NoMeter, TextMeter, is_terminal, metered, progress_enabled
+from .._progress import metered
 from .common import (
     CLIError,
     add_law_arguments,
@@ -24,6 +23,7 @@ from .common import (
     command_parser,
     emit,
     free_names,
+    heartbeat_meter,
     parse_params,
     read_table,
 )
@@ -222,20 +222,6 @@ def _middle(data):
     return order[data["rows"] // 2]
 
 
-# --------------------------------------------------------------------- progress bar
-
-
-def _meter(delay=None):
-    """A bar redrawn every 0.2 s while the fits run (a first fit compiles for tens of seconds
-    without other sign of life): after 0.5 s on a terminal; elsewhere a line every 10 s,
-    none for work under 3 s; none at all when `JAXIMPACT_PROGRESS` is off."""
-    if not progress_enabled():
-        return NoMeter()
-    if delay is None:
-        delay = 0.5 if is_terminal(sys.stderr) else 3.0
-    return TextMeter(interval=10.0, delay=delay, heartbeat=0.2)
-
-
 # ------------------------------------------------------------------------- running
 
 
@@ -297,7 +283,7 @@ def _run_one(args, data):
     free = free_names(args.free)
     fitted_names = free or default_free(start, stiffness=data["T"] is not None)
     init = args.init or ("given" if set(given) & set(fitted_names) else "auto")
-    with metered(_meter(), 1, f"calibrating {args.law}") as bar:
+    with metered(heartbeat_meter(), 1, f"calibrating {args.law}") as bar:
         fit = calibrate(start, free=free, init=init, **_fit_kwargs(args, data))
         jax.block_until_ready(fit)
         bar.update(1, "done")
@@ -385,7 +371,7 @@ def _run_all(args, data):
     has_sigma = data["sigma_e"] is not None
     kwargs = _fit_kwargs(args, data)
     rankings, failed = [], {}
-    with metered(_meter(), len(laws), "fitting laws") as bar:
+    with metered(heartbeat_meter(), len(laws), "fitting laws") as bar:
         for done, name in enumerate(laws):
             set_note(f"{done} of {len(laws)} laws fitted, nothing written (the ranking is "
                      "printed at the end)")  # fmt: skip

@@ -520,3 +520,16 @@ def format_table(header, rows, *, width=None, wrap=(), keep=1, notes=None, note_
             at = max(0, min(indent, width - max(map(len, note.split()))))
             out += [" " * at + line for line in textwrap.wrap(note, width - at, **_WHOLE_WORDS)]
     return [line.replace(KEEP_TOGETHER, " ") for line in out]
+
+
+def heartbeat_meter(delay=None):
+    """A bar redrawn every 0.2 s while a fit runs (a first fit compiles for tens of seconds
+    without other sign of life): after 0.5 s on a terminal; elsewhere a line every 10 s,
+    none for work under 3 s; none at all when `JAXIMPACT_PROGRESS` is off."""
+    from .._progress import NoMeter, TextMeter, is_terminal, progress_enabled
+
+    if not progress_enabled():
+        return NoMeter()
+    if delay is None:
+        delay = 0.5 if is_terminal(sys.stderr) else 3.0
+    return TextMeter(interval=10.0, delay=delay, heartbeat=0.2)

@@ -24,6 +24,7 @@ from .common import (
     command_parser,
     emit,
     free_names,
+    heartbeat_meter,
     law_from_args,
 )
 
@@ -237,7 +238,7 @@ def run_fit(args):
     from .._progress import metered
 
     fits = {}
-    with metered(True, len(recording.groups), "fitting") as bar:
+    with metered(heartbeat_meter(), len(recording.groups), "fitting") as bar:
         for name, data in recording.groups.items():
             fits[name] = _fit_one(law, args, recording, name, data, length_scale, y_axis)
             bar.update(1, name[:24])

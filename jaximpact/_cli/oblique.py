@@ -14,6 +14,7 @@ Or a video track of the ball bouncing across a floor, one row per frame: `t` (s)
 import math
 from pathlib import Path
 
+from .._progress import metered
 from .._status import Status
 from .common import (
     CLIError,
@@ -24,6 +25,7 @@ from .common import (
     command_parser,
     emit,
     free_names,
+    heartbeat_meter,
     law_from_args,
     read_table,
     tangential_from_args,
@@ -398,22 +400,25 @@ def run_fit_oblique(args):
     rows = {k: np.asarray(data.get(k, []), dtype=float) for k in (*COLUMNS, "theta")}
     measured = {k: rows[k] if np.any(np.isfinite(rows[k])) else None for k in MEASURED}
     sigmas = {k: np.asarray(data[k]) for k in ("sigma_e_t", "sigma_omega") if k in data}
-    fit = fit_oblique(
-        law,
-        tangential,
-        m=args.mass,
-        R=args.radius,
-        v_n=rows["v_n"],
-        v_t=rows["v_t"],
-        omega=rows["omega"],
-        e_t=measured["e_t"],
-        omega_out=measured["omega_out"],
-        free=free,
-        inertia=args.inertia,
-        g=g,
-        contact_point=args.contact_point,
-        **sigmas,
-    )
+    label = f"fitting {args.tangential} to {rows['v_n'].size} rebounds"
+    with metered(heartbeat_meter(), 1, label) as bar:  # a first fit compiles for 40-75 s
+        fit = fit_oblique(
+            law,
+            tangential,
+            m=args.mass,
+            R=args.radius,
+            v_n=rows["v_n"],
+            v_t=rows["v_t"],
+            omega=rows["omega"],
+            e_t=measured["e_t"],
+            omega_out=measured["omega_out"],
+            free=free,
+            inertia=args.inertia,
+            g=g,
+            contact_point=args.contact_point,
+            **sigmas,
+        )
+        bar.update(1, "done")
     if args.plot is not None:
         _plot(args.plot, rows, fit)
     check = _sanity(law, args.mass, float(np.max(rows["v_n"])))

@@ -13,7 +13,7 @@ import pytest
 from helpers import assert_one_line_error, assert_rel, run_cli
 from reference import reference_impact
 
-from jaximpact._cli import calibrate as _cli_calibrate
+from jaximpact._cli import calibrate as _cli_calibrate, common as _cli_common
 from jaximpact._fit import model_choice as _model_choice
 
 LAW14 = dict(c=2e6, b1=800.0)
@@ -102,8 +102,8 @@ def test_one_impact_json_with_start_values(capsys):
 
 
 def test_progress_bar(capsys, monkeypatch):
-    monkeypatch.setattr(_cli_calibrate, "progress_enabled", lambda: True)
-    monkeypatch.setattr(_cli_calibrate._meter, "__defaults__", (0.0,))  # no delay
+    monkeypatch.setenv("JAXIMPACT_PROGRESS", "on")
+    monkeypatch.setattr(_cli_common.heartbeat_meter, "__defaults__", (0.0,))  # no delay
     status, _, err = run_cli(capsys, ONE)
     assert status == 0
     assert "calibrating hertz_rate [" in err and "1/1" in err and err.endswith("\n")

@@ -55,6 +55,28 @@ def test_a_missing_file_and_a_plot_that_is_the_input(capsys, tmp_path):
     assert_one_line_error(status, out, err, contains="input")
 
 
+def test_the_fit_shows_the_clock_while_it_compiles(capsys, tmp_path, monkeypatch):
+    """fit-oblique's first call compiles for 40-75 s: a bar shows the time going (it printed
+    nothing until the end); here the fit itself is a stand-in that takes 0.5 s and fails."""
+    import time
+
+    import jaximpact._oblique as oblique
+    from jaximpact._cli import common
+
+    def stand_in(*args, **kwargs):
+        time.sleep(0.5)
+        raise ValueError("the stand-in fit")
+
+    monkeypatch.setenv("JAXIMPACT_PROGRESS", "on")
+    monkeypatch.setattr(common.heartbeat_meter, "__defaults__", (0.0,))  # no delay
+    monkeypatch.setattr(oblique, "fit_oblique", stand_in)
+    data = _write(tmp_path, "theta_deg,e_t\n10,0.6\n20,0.55\n30,0.6\n")
+    status, out, err = run_cli(capsys, ["fit-oblique", data, *BASE, "--speed", "3.9"])
+    assert status == 2 and out == ""
+    assert err.startswith("fitting linear_history to 3 rebounds [---")
+    assert err.strip().splitlines()[-1] == "jaximpact: error: the stand-in fit"
+
+
 @pytest.mark.slow
 def test_fits_rebounds_made_by_the_library(capsys, tmp_path):
     """e_t and spin made by `oblique_impact` with kt = 5e6 N/m, mu = 0.12 at five angles,
