@@ -403,21 +403,10 @@ def run_fit_oblique(args):
     label = f"fitting {args.tangential} to {rows['v_n'].size} rebounds"
     with metered(heartbeat_meter(), 1, label) as bar:  # a first fit compiles for 40-75 s
         fit = fit_oblique(
-            law,
-            tangential,
-            m=args.mass,
-            R=args.radius,
-            v_n=rows["v_n"],
-            v_t=rows["v_t"],
-            omega=rows["omega"],
-            e_t=measured["e_t"],
-            omega_out=measured["omega_out"],
-            free=free,
-            inertia=args.inertia,
-            g=g,
-            contact_point=args.contact_point,
-            **sigmas,
-        )
+            law, tangential, m=args.mass, R=args.radius, v_n=rows["v_n"], v_t=rows["v_t"],
+            omega=rows["omega"], e_t=measured["e_t"], omega_out=measured["omega_out"],
+            free=free, inertia=args.inertia, g=g, contact_point=args.contact_point, **sigmas,
+        )  # fmt: skip
         bar.update(1, "done")
     if args.plot is not None:
         _plot(args.plot, rows, fit)
