@@ -51,8 +51,6 @@ def clean_impact_times(
     t = times_in_order(times, "impact times")
     if t.size < 3:
         raise ValueError(f"need at least 3 impact times to find the intervals, got {t.size}")
-    if not np.all(np.isfinite(t)):
-        raise ValueError("impact times must be finite numbers (s)")
     d = np.diff(t)
     if np.any(d <= 0):
         raise ValueError("impact times must be distinct")
@@ -111,9 +109,9 @@ def clean_impact_times(
 
 
 def times_in_order(times, what="impact times") -> np.ndarray:
-    """`times` as a 1-D float array, refused (ValueError) when it is not 1-D or when it goes
-    backwards: impact times of several drops concatenated (each drop's clock starting again
-    at zero) must be passed apart, never sorted into one sequence."""
+    """`times` as a 1-D float array, refused (ValueError) when it is not 1-D, not finite or
+    when it goes backwards: impact times of several drops concatenated (each drop's clock
+    starting again at zero) must be passed apart, never sorted into one sequence."""
     try:
         t = np.asarray(times, dtype=float)
     except (TypeError, ValueError):
@@ -126,6 +124,8 @@ def times_in_order(times, what="impact times") -> np.ndarray:
             f"{what} must be a 1-D array (one drop), got shape {t.shape}; for several drops "
             "pass a list of 1-D arrays, one per drop"
         )
+    if not np.all(np.isfinite(t)):
+        raise ValueError(f"{what} must be finite numbers (s)")
     back = np.flatnonzero(np.diff(t) < 0)
     if back.size:
         i = int(back[0]) + 1
