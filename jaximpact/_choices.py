@@ -5,15 +5,16 @@ user what to type instead of only that it is wrong."""
 import difflib
 
 
-def _plain(name: str) -> str:
+def plain_name(name: str) -> str:
+    """A name as the tables write it: lower case, `_` for hyphens and spaces."""
     return str(name).strip().lower().replace("-", "_").replace(" ", "_")
 
 
 def nearest_names(name, choices) -> list[str]:
     """The names of `choices` a mistyped `name` most likely meant: the same name but for
     case, hyphens or spaces; the names it begins; then the closest spellings (difflib)."""
-    plain = _plain(name)
-    by_plain = {_plain(choice): choice for choice in choices}
+    plain = plain_name(name)
+    by_plain = {plain_name(choice): choice for choice in choices}
     if plain in by_plain:
         return [by_plain[plain]]
     starting = [choice for key, choice in by_plain.items() if plain and key.startswith(plain)]

@@ -25,8 +25,14 @@ def add_laws(subparsers):
         "out; x penetration in m, v = dx/dt in m/s), its parameters with their SI units, "
         "and its reference; then the tangential laws of oblique impacts (for --tangential, "
         "with --tparam).",
-        example="jaximpact laws\njaximpact laws --json",
+        example="jaximpact laws\njaximpact laws hertz mindlin   # the laws whose names begin so\n"
+        "jaximpact laws --json",
     )
+    parser.add_argument(
+        "names", nargs="*", metavar="NAME",
+        help="only these laws, normal or tangential; a name's beginning shows every law it "
+        "begins (hertz: hertz_viscous, hertz_modified, hertz_rate)",
+    )  # fmt: skip
     add_output_arguments(parser, plot=False)
     parser.set_defaults(handler=_run_laws)
 
@@ -136,11 +142,30 @@ def _laws_text(rows, width=None, tangential=()) -> str:
         "v = dx/dt (m/s). Equation numbers: Polukoshko, Viba, Kononova & Sokolova, Proc. "
         "Estonian Acad. Sci. Eng. 13 (2007)."
     )
-    more = ["", *_tangential_text(tangential, width)] if tangential else []
-    return "\n".join([*textwrap.wrap(intro, width), "", *lines, *more])
+    more = _tangential_text(tangential, width) if tangential else []
+    normal = [*textwrap.wrap(intro, width), "", *lines] if rows else []
+    return "\n".join([*normal, *([""] if normal and more else []), *more])
+
+
+def _chosen(rows, tangential, names):
+    """The rows of both tables whose names begin with one of `names` (a name as people
+    write it: any case, `-` for `_`), or a one-line `CLIError` naming the nearest laws."""
+    from .._choices import plain_name, unknown_name
+    from .common import CLIError
+
+    everything = [r["name"] for r in (*rows, *tangential)]
+    wanted = set()
+    for name in names:
+        found = {n for n in everything if n.startswith(plain_name(name))}
+        if not found:
+            raise CLIError(unknown_name("law", name, everything))
+        wanted |= found
+    return [r for r in rows if r["name"] in wanted], [r for r in tangential if r["name"] in wanted]
 
 
 def _run_laws(args):
     rows, tangential = _law_rows(), _tangential_rows()
+    if args.names:
+        rows, tangential = _chosen(rows, tangential, args.names)
     emit(args, {"laws": rows, "tangential_laws": tangential},
          lambda: _laws_text(rows, tangential=tangential))  # fmt: skip

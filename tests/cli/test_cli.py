@@ -57,6 +57,24 @@ def test_laws_table(capsys, monkeypatch):
     assert "G_star [Pa]" in tangential and "(or G, nu, G2, nu2)" in tangential
 
 
+def test_laws_by_name(capsys, monkeypatch):
+    """`jaximpact laws NAME ...`: the laws whose names begin with one of the names, normal
+    or tangential (a user who typed `jaximpact laws hertz` got `unrecognized arguments`);
+    a name that begins none is refused with the nearest names."""
+    monkeypatch.setenv("COLUMNS", "200")
+    status, out, err = run_cli(capsys, ["laws", "hertz", "Mindlin-Rescale"])
+    assert status == 0 and err == ""
+    shown = {line.split()[0] for line in out.splitlines() if line and line[0].isalpha()}
+    wanted = {"hertz_viscous", "hertz_modified", "hertz_rate", "mindlin_rescale",
+              "mindlin_rescale_force"}  # fmt: skip
+    assert wanted <= shown and not shown & ({*ji.LAW_NAMES, *ji.TANGENTIAL_LAW_NAMES} - wanted)
+    status, out, _ = run_cli(capsys, ["laws", "linear_history", "--json"])
+    data = json.loads(out)
+    assert data["laws"] == [] and [r["name"] for r in data["tangential_laws"]] == ["linear_history"]
+    assert "Force laws" not in run_cli(capsys, ["laws", "linear_history"])[1]
+    assert_one_line_error(*run_cli(capsys, ["laws", "hertzz"]), contains="did you mean hertz_rate?")
+
+
 def test_laws_json(capsys):
     status, out, _ = run_cli(capsys, ["laws", "--json"])
     assert status == 0
