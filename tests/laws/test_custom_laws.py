@@ -254,8 +254,8 @@ def test_a_plain_law_is_never_evaluated_below_the_surface():
 
 def test_a_failed_solve_is_never_a_number():
     """The failure rule: an eager impact whose solve fails raises one line that says what
-    to change; with throw=False, and under vmap, every result field is NaN and the status
-    says why (it once returned e = 0.0 with only the status saying so)."""
+    to change; with throw=False (and under vmap, the slow test below) every result field is
+    NaN and the status says why (it once returned e = 0.0 with only the status saying so)."""
     law = ji.custom_law(_hunt_crossley_pow, c=2e6, n=1.5, a=0.3)
     with pytest.raises(RuntimeError, match=r"ran out of steps \(max_steps=3\).*raise max_steps"):
         ji.impact(law, m=1.0, v0=2.5, max_steps=3)
@@ -263,6 +263,12 @@ def test_a_failed_solve_is_never_a_number():
     assert r.status_name == "out_of_steps"
     for key in ("e", "T", "x_max", "F_max", "t_max", "dissipated", "v_out"):
         assert math.isnan(float(getattr(r, key))), key
+
+
+@pytest.mark.slow  # a program of its own (the fast suite: 3 minutes)
+def test_a_failed_solve_under_vmap_is_never_a_number():
+    """The failure rule under vmap: every result field NaN, the status saying why."""
+    law = ji.custom_law(_hunt_crossley_pow, c=2e6, n=1.5, a=0.3)
     batch = jax.vmap(lambda v0: ji.impact(law, m=1.0, v0=v0, max_steps=3))(jnp.array([1.0, 2.0]))
     assert np.all(np.isnan(batch.e)) and np.all(np.isnan(batch.T))
     assert np.all(np.asarray(batch.status) == int(ji.Status.out_of_steps))

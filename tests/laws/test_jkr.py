@@ -125,7 +125,10 @@ def test_closed_form_matches_an_independent_scipy_integration(ratio):
 
 
 @pytest.mark.parametrize("ratio", [0.7, 1.5, 10.0])
-@pytest.mark.parametrize("separation", ["force", "penetration"])
+@pytest.mark.parametrize(
+    "separation",
+    ["force", pytest.param("penetration", marks=pytest.mark.slow)],  # its own compiling
+)
 def test_the_integrated_path_matches_the_closed_form(ratio, separation):
     """Either criterion ends contact at pull-off: the neck holds the body until it breaks."""
     v0 = ratio * V_S
@@ -138,6 +141,7 @@ def test_the_integrated_path_matches_the_closed_form(ratio, separation):
         )
 
 
+@pytest.mark.slow  # its own compiling; thornton's gravity test is the fast suite's
 def test_with_gravity_it_matches_scipy():
     law = ji.law("jkr", c=2e5, R=0.02, w=0.5)  # a soft adhesive ball, where gravity matters
     m, v0, g = 1e-3, 0.0725, 9.81  # 1.5 V_s, g x* / v0^2 = 0.11

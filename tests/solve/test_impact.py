@@ -258,7 +258,9 @@ def test_gravity_keeps_the_closed_form():
     assert_rel(r.T, ref["T"], 1e-9, "KV T with gravity")
 
 
-@pytest.mark.parametrize("separation", SEPARATIONS)
+@pytest.mark.parametrize(
+    "separation", ["force", pytest.param("penetration", marks=pytest.mark.slow)]
+)  # penetration's program is its own (the fast suite: 3 minutes)
 def test_slow_impact_under_gravity_is_captured(separation):
     """v0 = 0.1 m/s on a soft, damped spring: the body sinks to x = m g / c and the spring
     never lifts it back; the contact ends when the body stops moving out (v back to 0)."""
