@@ -205,6 +205,7 @@ def test_damped_lammps_impact_without_damping_is_the_closed_form(e):
     assert lammps_jkr_viscoelastic.lammps_impact(q, 0.1)[0] < e  # damping takes energy
 
 
+@pytest.mark.slow  # jkr_viscoelastic's integrated impact, compiled for it alone (fast: 3 min)
 @pytest.mark.parametrize("geometry", ["wall", "spheres"])
 def test_damped_jkr_export_to_lammps_realises_the_law_at_v0(geometry):
     """`jkr_viscoelastic` goes to LAMMPS's `jkr` with `damping viscoelastic`: the law's
