@@ -120,7 +120,7 @@ def _track_csv(tmp_path, scale=1.0, columns=("t", "x", "y", "phi"), solved=False
         sys.path.insert(0, str(Path(__file__).parents[1] / "oblique"))
         from test_track import synthetic_track
 
-        t, x, y, phi, _ = synthetic_track()
+        t, x, y, phi, _ = synthetic_track(impacts="solve")
     else:
         frames, t0, x0, vx, vy, h0 = [], 0.0, 0.0, 1.0, 0.0, 0.25
         for _ in range(3):
