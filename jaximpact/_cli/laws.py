@@ -1,8 +1,10 @@
 """`jaximpact laws`: the force laws, their equations, parameters and units."""
 
+from .._choices import plain_name, unknown_name
 from .._format import concrete_units as concrete_units, format_number
 from .common import (
     KEEP_TOGETHER,
+    CLIError,
     add_output_arguments,
     command_parser,
     emit,
@@ -150,9 +152,6 @@ def _laws_text(rows, width=None, tangential=()) -> str:
 def _chosen(rows, tangential, names):
     """The rows of both tables whose names begin with one of `names` (a name as people
     write it: any case, `-` for `_`), or a one-line `CLIError` naming the nearest laws."""
-    from .._choices import plain_name, unknown_name
-    from .common import CLIError
-
     everything = [r["name"] for r in (*rows, *tangential)]
     wanted = set()
     for name in names:
