@@ -11,6 +11,7 @@ from jaxtyping import Array
 
 from .._checks import check_values
 from .base import AbstractLaw, LawSpec
+from .clamps import unclamped
 from .dynamics import scaled_dynamics
 from .parameters import as_arrays
 
@@ -44,11 +45,29 @@ class CustomLaw(AbstractLaw):
         first touch, e.g. `b v` for `c x + b v`), and below the surface the force is 0 with
         gradient 0. So `x**1.5`, `jnp.sqrt(x)` or `jnp.power(x, n)` need no guard: neither
         the value nor the gradient is ever NaN."""
-        x = jnp.asarray(x, dtype=float)
-        v = jnp.asarray(v, dtype=float)
-        tiny = jnp.finfo(x.dtype).tiny
-        inside = jnp.where(x > tiny, x, tiny)
-        return jnp.where(x >= 0, self.fn(inside, v, self.params), 0.0)
+        return _inside_surface(self.fn, x, v, self.params)
+
+    def edge_force(self, x, v):
+        """The force whose first zero inside the surface ends contact under the force
+        criterion (N): the law's own, or, where the law clamps its result at zero
+        (`jnp.maximum(F, 0)`, `jnp.clip(F, 0, None)`, `jax.nn.relu(F)`,
+        `jnp.where(F > 0, F, 0)`), the `F` before the clamp (`clamps.unclamped`). The
+        clamped force reaches zero with a flat tail that no root finder can place; `F`
+        crosses zero at the same instant, transversally. The motion is always integrated
+        with the law as written (`force`)."""
+        peeled = unclamped(self.fn, self.params)
+        if peeled is None:
+            return self.force(x, v)
+        return _inside_surface(peeled, x, v, self.params)
+
+
+def _inside_surface(fn, x, v, params):
+    """`fn(x, v, params)` evaluated inside the surface only (see `CustomLaw.force`)."""
+    x = jnp.asarray(x, dtype=float)
+    v = jnp.asarray(v, dtype=float)
+    tiny = jnp.finfo(x.dtype).tiny
+    inside = jnp.where(x > tiny, x, tiny)
+    return jnp.where(x >= 0, fn(inside, v, params), 0.0)
 
 
 def custom_law(fn: Callable, **params) -> CustomLaw:
@@ -59,7 +78,9 @@ def custom_law(fn: Callable, **params) -> CustomLaw:
     `jnp.power(x, n)` need no guard, since the library only calls `fn` with `x > 0` (the
     force is 0 outside the surface; `CustomLaw.force`). Contact ends where the force
     returns to zero inside the surface, or at `x = 0` for a force that only vanishes there
-    (both separation criteria then agree).
+    (both separation criteria then agree). A clamp that keeps the surface from pulling,
+    `jnp.maximum(F, 0)` (or `jnp.clip`, `jax.nn.relu`, `jnp.where(F > 0, F, 0)`), is
+    integrated as written, and contact ends where the clamped force reaches zero.
 
     **Example**:
     `custom_law(lambda x, v, p: p["c"] * x**1.5 * (1 + p["a"] * v), c=2e6, a=0.2)`.

@@ -260,9 +260,13 @@ class ScaledDynamics(AbstractDynamics):
         # laws that go tensile there, e.g. c x + b v); at and below X = 0 the force's limit
         # at the surface where that pulls (so a zero crossed within the step that also
         # crosses X = 0 is still seen), else +1: the surface event ends those contacts
-        at_surface = self.force(jnp.stack([jnp.zeros_like(y[0]), y[1]]), compressing)
+        # (the force before a clamp at zero where the law clamps it: `CustomLaw.edge_force`)
+        at_surface = self._edge_force(jnp.stack([jnp.zeros_like(y[0]), y[1]]))
         below = jnp.where(at_surface < 0, at_surface, 1.0)
-        return jnp.where(y[0] > 0, self.force(y, compressing), below)
+        return jnp.where(y[0] > 0, self._edge_force(y), below)
+
+    def _edge_force(self, y):
+        return self.law.edge_force(self.x_star * y[0], self.v0 * y[1]) / self.force_scale
 
     def surface_gap(self, y):
         return y[0]
