@@ -1,4 +1,7 @@
-"""Value checks that raise a clear error eagerly and survive `jax.jit`."""
+"""Value checks that raise a clear error eagerly and survive `jax.jit`; `MemberChecks`,
+the entry points' checks that mark a bad member of a batch instead of aborting it."""
+
+import dataclasses
 
 import equinox as eqx
 import jax
@@ -36,16 +39,102 @@ def invalid_entries(value, bad) -> np.ndarray:
 
 def check_positive(name: str, value, unit: str = ""):
     """Require a finite value > 0."""
-    unit = f" {unit}" if unit else ""
-    message = f"{name} must be a finite number > 0{unit}, got {_show(value, _not_positive)}"
-    return check_values(value, _not_positive, message)
+    return check_values(value, _not_positive, _positive_message(name, value, unit))
 
 
 def check_nonnegative(name: str, value, unit: str = ""):
     """Require a finite value >= 0."""
+    return check_values(value, _negative, _nonnegative_message(name, value, unit))
+
+
+def _positive_message(name, value, unit):
     unit = f" {unit}" if unit else ""
-    message = f"{name} must be a finite number >= 0{unit}, got {_show(value, _negative)}"
-    return check_values(value, _negative, message)
+    return f"{name} must be a finite number > 0{unit}, got {_show(value, _not_positive)}"
+
+
+def _nonnegative_message(name, value, unit):
+    unit = f" {unit}" if unit else ""
+    return f"{name} must be a finite number >= 0{unit}, got {_show(value, _negative)}"
+
+
+class MemberChecks:
+    """The value checks of one call of an entry point (`impact`, `bounce`, `oblique_impact`,
+    `calibrate`), and the one owner of "a bad member is NaN and `invalid`" (DESIGN.md, "Off
+    the curves").
+
+    A concrete value is checked at once: a one-line `ValueError`, as `check_values`. A
+    traced one (inside `jit`, `vmap`, `grad`) is not refused, as one bad member must not
+    abort a batch: where it is not finite or `bad` holds, the member is marked invalid and
+    the value replaced by a harmless one, so that the member's solve runs on numbers (and
+    no NaN reaches a gradient through a `jnp.where`). `refuse` then gives that member's
+    results NaN, their derivatives with respect to the checked values NaN too, and its
+    status `invalid`.
+
+    **Example**: `checks = MemberChecks(); m = checks.positive("mass m", m, "kg"); ...;
+    return checks.refuse(result, status=Status.invalid)`.
+    """
+
+    def __init__(self):
+        self.invalid = None  # a traced boolean once a traced value was checked
+        self._checked = []  # the traced values checked (their derivatives: NaN if invalid)
+
+    def mark(self, wrong, value, harmless):
+        """`value` with `harmless` where the traced boolean `wrong` holds, which makes the
+        member invalid."""
+        wrong = jnp.asarray(wrong)
+        self.invalid = wrong if self.invalid is None else self.invalid | wrong
+        if is_traced(value):
+            self._checked.append(value)
+        return jnp.where(wrong, harmless, value)
+
+    def values(self, value, bad, message: str, harmless=1.0):
+        """`check_values(value, bad, message)` for a concrete value; a traced one marks
+        the member invalid where any entry is not finite or `bad` holds."""
+        if not is_traced(value):
+            return check_values(value, bad, message)
+        array = jnp.asarray(value)
+        return self.mark(jnp.any(~jnp.isfinite(array) | bad(array)), array, harmless)
+
+    def positive(self, name: str, value, unit: str = "", harmless=1.0):
+        """`check_positive`, or a traced value's member marked where it is not > 0."""
+        return self.values(value, _not_positive, _positive_message(name, value, unit), harmless)
+
+    def nonnegative(self, name: str, value, unit: str = "", harmless=0.0):
+        """`check_nonnegative`, or a traced value's member marked where it is < 0."""
+        message = _nonnegative_message(name, value, unit)
+        return self.values(value, _negative, message, harmless)
+
+    def refuse(self, result, *, keep=(), **codes):
+        """`result` (an `eqx.Module`) as it is where the member is valid (or nothing traced
+        was checked); for an invalid member every float field NaN (inside dicts and laws
+        too) but those named in `keep`, and the fields named in `codes` set to their
+        value (`status=Status.invalid`, `converged=False`)."""
+        if self.invalid is None:
+            return result
+        invalid = self.invalid
+        # 0 for a valid member (value and derivatives unchanged); NaN with NaN derivatives
+        # with respect to the checked values for an invalid one
+        moved = sum(jnp.sum(jnp.asarray(v, float) - jax.lax.stop_gradient(v))
+                    for v in self._checked)  # fmt: skip
+        poison = jnp.where(invalid, jnp.nan, 0.0) * moved
+
+        def blank(leaf):
+            if hasattr(leaf, "dtype") and jnp.issubdtype(leaf.dtype, jnp.inexact):
+                return jnp.where(invalid, jnp.nan, leaf) + poison
+            return leaf
+
+        changes = {}
+        for field in dataclasses.fields(result):
+            if field.metadata.get("static", False) or field.name in keep:
+                continue
+            value = getattr(result, field.name)
+            if field.name in codes:
+                value = jnp.asarray(value)
+                code = jnp.asarray(codes[field.name], value.dtype)
+                changes[field.name] = jnp.where(invalid, code, value)
+            else:
+                changes[field.name] = jax.tree.map(blank, value)
+        return dataclasses.replace(result, **changes)
 
 
 def _not_positive(a):

@@ -162,12 +162,12 @@ def handle_interrupts():
     previous_fd = signal.set_wakeup_fd(write_fd, warn_on_full_buffer=False)
     previous_hook = sys.unraisablehook
     sys.unraisablehook = _quiet_unraisable(previous_hook)
-    for s in _SIGNALS:
-        signal.signal(s, _handler)
     _state.update(signal=None, note=None, active=True, reported=False)
     watchdog = threading.Thread(target=_watch, args=(read_fd, stop), daemon=True)
     watchdog.start()
-    try:
+    try:  # the handlers that raise last: a signal from here on is the block's to handle
+        for s in _SIGNALS:
+            signal.signal(s, _handler)
         yield
     finally:
         if _state["signal"] is None:  # a stop under way keeps its watchdog to the end

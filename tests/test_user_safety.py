@@ -24,6 +24,7 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 import jaximpact as ji
 from jaximpact._checks import check_scale
 from jaximpact._files import atomic_output, check_outputs, same_file
+from jaximpact._laws.named_law import batch_law
 
 CSV = "c,b1,m,v0\n2e6,800,1,2.5\n1.5e6,600,0.5,1.5\n"
 ONCE = settings(
@@ -452,7 +453,9 @@ def test_a_law_prints_as_the_call_that_builds_it_with_its_units():
     assert repr(ji.tangential_law("mindlin", G_star=1.35e10, mu=0.3)) == (
         "tangential_law('mindlin', G_star=13.5 GPa, mu=0.3, beta=0)"
     )
-    batch = ji.law("hertz_rate", c=jnp.array([1e6, 2e6]), b1=800.0)
+    # a batch of laws (one per row, as `impact_batch` and the maps build them; `law` takes
+    # one number per parameter)
+    batch = batch_law("hertz_rate", c=jnp.array([1e6, 2e6]), b1=800.0)
     assert repr(batch) == "law('hertz_rate', c=[1e6 N/m^1.5, 2e6 N/m^1.5], b1=800 N s/m^1.5)"
     shown = []
     jax.vmap(lambda c: shown.append(repr(ji.law("hertz_rate", c=c, b1=800.0))) or c)(

@@ -11,6 +11,7 @@ from .impacts import (
     build_law as build_law,
     cost_key as cost_key,
     impact_batch as impact_batch,
+    law_skeleton as law_skeleton,
     mark_invalid as mark_invalid,
     prepare_rows as prepare_rows,
     run_impacts as run_impacts,

@@ -19,8 +19,8 @@ import numpy as np
 
 from .._checks import check_nonnegative, check_positive, invalid_entries
 from .._choices import unknown_name
-from .._laws import LAW_NAMES, LAWS, AbstractLaw, CustomLaw, custom_law, law as make_law
-from .._laws.named_law import invalid_parameter_rows, table_law
+from .._laws import LAW_NAMES, LAWS, AbstractLaw, CustomLaw, custom_law
+from .._laws.named_law import batch_law, invalid_parameter_rows, table_law
 from .._progress import AbstractMeter
 from .._solve.impact import check_custom_law, solve_impact
 from .._solve.options import (
@@ -52,7 +52,7 @@ _ALL_FIELDS = (
 _GROUPS = ("beta", "mu", "dry_in", "dry_out", "gamma")  # dimensionless groups, by importance
 
 
-def _law_skeleton(law):
+def law_skeleton(law):
     """A hashable description of a law's structure (everything but its parameter values)."""
     if isinstance(law, str):
         return ("law", law)
@@ -152,7 +152,7 @@ def batch_path(law, separation, *, method="auto", rtol=1e-11, g=0.0, **impact_op
     `run_impacts` decides it (`choose_path` for the law as the batch's members see it; `g`
     an array: gravity given per row)."""
     params = {k: np.atleast_1d(np.asarray(v, dtype=float)) for k, v in law.parameters.items()}
-    skeleton, params = _fix_shape(_law_skeleton(law), params)
+    skeleton, params = _fix_shape(law_skeleton(law), params)
     gravity = not (isinstance(g, (int, float)) and g == 0)
     path = _member_path(skeleton, params, gravity, separation=separation, method=method,
                         solver=impact_options.get("solver"), rtol=rtol)  # fmt: skip
@@ -173,7 +173,7 @@ def prepare_rows(law, params, *, m, v0, g=0.0, invalid: str = "raise"):
     """
     if invalid not in ("raise", "mark"):
         raise ValueError(f"invalid must be 'raise' or 'mark', got {invalid!r}")
-    skeleton = _law_skeleton(law)
+    skeleton = law_skeleton(law)
     base = {} if isinstance(law, str) else dict(law.parameters)
     given = {**base, **(params or {})}
     if skeleton[0] == "law":
@@ -211,9 +211,10 @@ def prepare_rows(law, params, *, m, v0, g=0.0, invalid: str = "raise"):
 
 
 def _law_of(skeleton, params):
-    """The law of `skeleton` built from `params` by the law's own checks (names, values)."""
+    """The law of `skeleton` built from `params` (1-D arrays) by the law's own checks
+    (names, values)."""
     if skeleton[0] == "law":
-        return make_law(skeleton[1], **params)
+        return batch_law(skeleton[1], **params)
     return custom_law(skeleton[1], **params)
 
 

@@ -6,12 +6,19 @@ Bad input is a `ValueError` (the library's), a `CLIError` (the command line's) o
 with exit status 2, never a traceback. To add a command, write `jaximpact/_cli/NAME.py` with
 its `add_NAME` and append it to `COMMANDS`. The command modules import only argparse and the
 helpers at import time, so `jaximpact --help` stays quick.
+
+Started as the command line (the console script, `python -m jaximpact._cli`), this package
+installs its handling of Ctrl-C and SIGTERM before it imports anything heavy (numpy, then
+JAX, load in the first seconds): a signal at any moment of the start ends the process with
+the one line `interrupted by SIGINT` and status 130 (`_interrupt.stop_at_once`), never a
+traceback from inside an import. A closed stdout (`jaximpact ... >&-`) is refused before
+any work: what the command prints would be lost.
 """
 
-import argparse
+# the handlers are installed between imports, before those that load numpy and JAX
+# ruff: noqa: E402
 import os
 import sys
-import warnings
 
 from .._interrupt import (
     Interrupted,
@@ -19,7 +26,23 @@ from .._interrupt import (
     handle_interrupts,
     mark_reported,
     received,
+    stop_at_once,
 )
+
+
+def _started_as_command() -> bool:
+    """Whether this process is the command line: the `jaximpact` console script, or
+    `python -m jaximpact._cli` (whose `sys.argv[0]` is `-m` while this package loads)."""
+    first = sys.argv[0] if sys.argv else ""
+    return os.path.basename(first).removesuffix(".exe") == "jaximpact" or first == "-m"
+
+
+if _started_as_command():  # before numpy and JAX load (the command modules bring them)
+    stop_at_once()
+
+import argparse
+import warnings
+
 from .batch import add_batch
 from .bench import add_bench
 from .calibrate import add_calibrate
@@ -91,11 +114,16 @@ def main(argv: list[str] | None = None) -> int:
     """
     if os.path.basename(sys.argv[0]) == PROG:  # the console script: before JAX loads
         console_environment()
+    if sys.stdout is None:  # started with stdout closed (`>&-`): its output would be lost
+        fail("cannot write the output: stdout is closed", status=2)
     parser = build_parser()
     args = parser.parse_args(argv)
     configure_jax()
-    with handle_interrupts():
-        return _run(args)
+    try:
+        with handle_interrupts():
+            return _run(args)
+    except Interrupted as error:  # while the handling began or ended, outside `_run`
+        _stop(error)
 
 
 def _run(args) -> int:
@@ -115,17 +143,7 @@ def _run(args) -> int:
                 raise Interrupted(signum) from None
             raise
     except Interrupted as error:
-        mark_reported()
-        # the line, then out at once: a signal that lands while XLA compiles leaves its
-        # threads running, and Python's own teardown beside them crashed (SIGSEGV, measured:
-        # `calibrate --law all` interrupted 4 s in); every file is already complete or not
-        # there under its final name (`_files.atomic_output`)
-        try:
-            fail(str(error), status=error.status)
-        except SystemExit:
-            sys.stdout.flush()
-            sys.stderr.flush()
-            os._exit(error.status)
+        _stop(error)
     except BrokenPipeError:  # e.g. `jaximpact laws | head`: stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         raise SystemExit(1) from None
@@ -148,3 +166,19 @@ def _run(args) -> int:
             status=1,
         )
     return 0 if status is None else int(status)
+
+
+def _stop(error: Interrupted):
+    """The line `jaximpact: error: interrupted by SIGINT; ...`, then out at once with status
+    128 + the signal: a signal that lands while XLA compiles leaves its threads running, and
+    Python's own teardown beside them crashed (SIGSEGV, measured: `calibrate --law all`
+    interrupted 4 s in); every file is already complete or not there under its final name
+    (`_files.atomic_output`)."""
+    mark_reported()
+    try:
+        fail(str(error), status=error.status)
+    except SystemExit:
+        for stream in (sys.stdout, sys.stderr):
+            if stream is not None:
+                stream.flush()
+        os._exit(error.status)

@@ -3,7 +3,7 @@ Parquet) file; on one process or several (`jax.distributed`)."""
 
 from pathlib import Path
 
-from .common import CLIError, command_parser, emit, parse_params
+from .common import CLIError, command_parser, emit, file_law, is_file_law, parse_params
 
 
 def add_batch(subparsers):
@@ -22,6 +22,9 @@ def add_batch(subparsers):
         "value is checked before any work; chunks of --chunk-rows rows are written whole "
         "into OUT.parts/ with a SHA-256 of their inputs and joined into OUT at the end; "
         "--resume reuses the chunks of an interrupted run whose inputs did not change.\n\n"
+        "A user's law, --law FILE.py:NAME (the function NAME(x, v, params) of a Python "
+        "file), takes its parameters from --param and from the columns of IN: every column "
+        "but m, v0, g and separation is a parameter it must read.\n\n"
         "Several processes (jax.distributed): start one per process with --coordinator "
         "HOST:PORT --num-processes N --process-id K, or with --distributed alone under "
         "SLURM or Open MPI (srun, mpirun), which tell JAX the rest. Process K reads and "
@@ -37,7 +40,11 @@ def add_batch(subparsers):
     parser.add_argument(
         "source", type=Path, metavar="IN", help="CSV or Parquet file, one body per row"
     )
-    parser.add_argument("--law", required=True, metavar="NAME", help="see `jaximpact laws`")
+    parser.add_argument(
+        "--law", required=True, metavar="NAME",
+        help="see `jaximpact laws`; or a user's law FILE.py:NAME, the function NAME(x, v, "
+        "params) of a Python file",
+    )  # fmt: skip
     parser.add_argument(
         "--param", action="extend", nargs="+", default=[], metavar="NAME=VALUE",
         help="a law parameter for every row, SI units (--param c=2e6 b1=800, or repeated)",
@@ -121,11 +128,13 @@ def run_batch_command(args):
     # before any work: an OUT that cannot be written, or that is IN however spelled
     check_output_file(args.out, args.source, "--out")
     params = parse_params(args.param)
+    # a user's law: its parameters come from --param and the columns (the job checks them)
+    law = file_law(args.law, {}, complete=False) if is_file_law(args.law) else args.law
     _start_processes(args)
     result = batch_file(
         args.source,
         args.out,
-        args.law,
+        law,
         params=params,
         m=args.mass,
         v0=args.v0,

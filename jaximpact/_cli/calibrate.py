@@ -11,6 +11,7 @@ import math
 from pathlib import Path
 
 from .._choices import unknown_name
+from .._files import cell_number
 from .._format import format_number, format_quantity
 from .._interrupt import check_interrupt, set_note
 from .._plotting import new_figure, save_figure
@@ -22,8 +23,10 @@ from .common import (
     check_plot_path,
     command_parser,
     emit,
+    file_law,
     free_names,
     heartbeat_meter,
+    is_file_law,
     parse_params,
     read_table,
 )
@@ -126,14 +129,15 @@ def add_calibrate(subparsers):
 # --------------------------------------------------------------------------- the data
 
 
-def _cell(text, line, column):
-    text = text.strip()
-    if not text:
+def _cell(text, where, column):
+    """The number in a cell of `--data` (NaN where empty); a `CLIError` naming the file and
+    line (`where`) and the column of one that is not a number (`_files.cell_number`)."""
+    if not text.strip():
         return math.nan
     try:
-        return float(text)
-    except ValueError:
-        raise CLIError(f"line {line}, column {column}: {text!r} is not a number") from None
+        return cell_number(text)
+    except ValueError as error:
+        raise CLIError(f"{where}, column {column}: {error}") from None
 
 
 def read_data(path: Path) -> dict:
@@ -152,7 +156,7 @@ def read_data(path: Path) -> dict:
                 f"--data {path}, line {number}: {len(cells)} cells for {len(header)} columns"
             )
         for name, cell in zip(header, cells, strict=True):
-            columns[name].append(_cell(cell, number, name))
+            columns[name].append(_cell(cell, f"--data {path}, line {number}", name))
         for name in ("v0", "e"):
             if math.isnan(columns[name][-1]):
                 what = "impact speed" if name == "v0" else "restitution (T may be left empty)"
@@ -265,21 +269,24 @@ def _run_one(args, data):
     from .._fit.parameters import default_free
     from .._laws import LAW_NAMES, LAWS
 
-    if args.law not in LAWS:
-        raise CLIError(unknown_name("law", args.law, LAW_NAMES, also=ALL))
     given = parse_params(args.param)
-    row = _middle(data)
-    T_row = None if data["T"] is None else data["T"][row]
-    start = starting_law(
-        args.law,
-        m=args.mass,
-        v0=data["v0"][row],
-        e=data["e"][row],
-        T=None if T_row is None or math.isnan(T_row) else T_row,
-        **{k: given[k] for k in LAWS[args.law].geometry if k in given},  # JKR's radius
-    )
-    if given:
-        start = start.replace(**given)
+    if is_file_law(args.law):  # a user's law starts from --param, all its parameters
+        start = file_law(args.law, given)
+    else:
+        if args.law not in LAWS:
+            raise CLIError(unknown_name("law", args.law, LAW_NAMES, also=ALL))
+        row = _middle(data)
+        T_row = None if data["T"] is None else data["T"][row]
+        start = starting_law(
+            args.law,
+            m=args.mass,
+            v0=data["v0"][row],
+            e=data["e"][row],
+            T=None if T_row is None or math.isnan(T_row) else T_row,
+            **{k: given[k] for k in LAWS[args.law].geometry if k in given},  # JKR's radius
+        )
+        if given:
+            start = start.replace(**given)
     free = free_names(args.free)
     fitted_names = free or default_free(start, stiffness=data["T"] is not None)
     init = args.init or ("given" if set(given) & set(fitted_names) else "auto")
@@ -287,7 +294,7 @@ def _run_one(args, data):
         fit = calibrate(start, free=free, init=init, **_fit_kwargs(args, data))
         jax.block_until_ready(fit)
         bar.update(1, "done")
-    result = _fit_record(args.law, fit, data)
+    result = _fit_record(args.law, fit, data, order=tuple(start.parameters))
     result.update(
         m=args.mass,
         separation=args.separation,
@@ -304,7 +311,9 @@ def _run_one(args, data):
     return 0
 
 
-def _fit_record(name, fit, data):
+def _fit_record(name, fit, data, order=None):
+    """What one fit of the law `name` found, for --json and the text (`order`: the order of
+    its parameters, a user's law's as given; a law of the table has its own)."""
     import numpy as np
 
     from .._fit.calibrate import goodness_text
@@ -327,7 +336,7 @@ def _fit_record(name, fit, data):
             )
         )
     residuals = np.asarray(fit.residuals)
-    order = list(fit.law.parameters)
+    order = [k for k in (order or fit.law.parameters) if k in fit.params]
     if name in LAWS:  # the law's own order (a compiled fit returns its dict sorted)
         order = [k for k in LAWS[name].parameters if k in fit.params]
     for i, row in enumerate(rows):
@@ -430,7 +439,9 @@ MODEL_CHOICE_LAWS: tuple[str, ...] | None = None
 def _law_line(name):
     from .._laws import LAWS
 
-    spec = LAWS[name]
+    spec = LAWS.get(name)
+    if spec is None:  # a user's law, FILE.py:NAME
+        return name
     eq = f"eq. {spec.equation}: " if spec.equation != "-" else ""
     return f"{name} ({eq}F = {spec.formula})"
 
@@ -438,6 +449,8 @@ def _law_line(name):
 def _units(name, params):
     from .._laws import LAWS
 
+    if name not in LAWS:  # a user's law: its units are its own
+        return {}
     return concrete_units(LAWS[name], params)
 
 

@@ -1,7 +1,8 @@
 """What the subcommands share: the one-line error (`CLIError`, `fail`), the parser factory
-and argument groups, reading `--param NAME=VALUE`, `--json` output (`emit`) and JAX's set-up
-(`configure_jax`). `--plot FILE` goes through `jaximpact._plotting` (matplotlib's Agg backend,
-imported only then); anything long reports through a meter of `jaximpact._progress` on stderr."""
+and argument groups, reading `--param NAME=VALUE` and a user's law `--law FILE.py:NAME`
+(`file_law`), `--json` output (`emit`) and JAX's set-up (`configure_jax`). `--plot FILE` goes
+through `jaximpact._plotting` (matplotlib's Agg backend, imported only then); anything long
+reports through a meter of `jaximpact._progress` on stderr."""
 
 import argparse
 import json
@@ -105,14 +106,17 @@ def command_parser(
     )
 
 
+LAW_HELP = (
+    "force law, one of those listed by 'jaximpact laws' (e.g. hertz_rate), or a user's "
+    "law FILE.py:NAME, the function NAME(x, v, params) of a Python file (its parameters "
+    "all from --param)"
+)
+
+
 def add_law_arguments(parser, *, required: bool = True):
-    """`--law NAME` and `--param NAME=VALUE` (repeatable); read them with `law_from_args`."""
-    parser.add_argument(
-        "--law",
-        required=required,
-        metavar="NAME",
-        help="force law, one of those listed by 'jaximpact laws' (e.g. hertz_rate)",
-    )
+    """`--law NAME` (or `FILE.py:NAME`) and `--param NAME=VALUE` (repeatable); read them with
+    `law_from_args`."""
+    parser.add_argument("--law", required=required, metavar="NAME", help=LAW_HELP)
     parser.add_argument(
         "--param",
         action="extend",
@@ -225,18 +229,18 @@ def parse_params(items: Iterable[str], flag: str = "--param") -> dict[str, float
 
 
 def read_table(path: Path, columns, *, label: str, hint: str):
-    """`(header, rows)` of the small CSV file at `path` (`_files.read_csv`, `#` comments
-    skipped), its header stripped and checked against `columns`; one-line `CLIError`s that
-    name the file as `label` (e.g. `--data in.csv`) for a file that cannot be read, is
-    empty, has an unknown column (`hint`: the columns expected, in words) or a column
-    named twice."""
-    from .._files import read_csv
+    """`(header, rows)` of the small CSV file at `path` (`_files.read_text` and `read_csv`:
+    as people save it, `#` comments skipped), its header stripped and checked against
+    `columns`; one-line `CLIError`s that name the file as `label` (e.g. `--data in.csv`)
+    for a file that cannot be read or is not text, is empty, has an unknown column
+    (`hint`: the columns expected, in words) or a column named twice."""
+    from .._files import NotText, read_csv, read_text
 
     try:
-        text = path.read_text()
+        text = read_text(path)  # as people save it: a byte-order mark, UTF-16, cp1252
     except OSError as error:
         raise CLIError(f"cannot read {label}: {error.strerror or error}") from None
-    except UnicodeDecodeError:
+    except NotText:
         raise CLIError(f"{label} is not a text file (a CSV with columns {hint})") from None
     header, rows = read_csv(text, comments=True)
     if not header:
@@ -337,10 +341,161 @@ def free_names(items) -> tuple[str, ...] | None:
 
 
 def law_from_args(args):
-    """The law of `--law` and `--param` (the library checks the name and the values)."""
+    """The law of `--law` and `--param` (the library checks the name and the values): a law
+    of the table, or a user's law `FILE.py:NAME` (`file_law`)."""
+    return make_law(args.law, parse_params(args.param))
+
+
+def make_law(name: str, params: dict):
+    """The law `name` (of the table, or a user's `FILE.py:NAME`) with `params`."""
+    if is_file_law(name):
+        return file_law(name, params)
     from .._laws import law
 
-    return law(args.law, **parse_params(args.param))
+    return law(name, **params)
+
+
+# --------------------------------------------------------------------------------------
+# A user's law on the command line: --law FILE.py:NAME
+# --------------------------------------------------------------------------------------
+
+
+def is_file_law(name) -> bool:
+    """Whether `--law name` names a user's law, `FILE.py:NAME` (a table name has no colon;
+    a name ending in `.py` is a file whose function is not named: `load_law_function` says
+    so)."""
+    return isinstance(name, str) and (":" in name or name.endswith(".py"))
+
+
+def file_law(text: str, params: dict, *, complete: bool = True):
+    """The user's law `FILE.py:NAME` (`text`, its name in all output) with the parameters
+    `params` (`--param`): `custom_law(fn, **params)` of the function NAME of the file.
+    With `complete`, its function is traced once (no numbers, no compilation): a
+    parameter it reads that `params` lacks (its `KeyError`), or one of `params` it does not
+    read, is a one-line `CLIError`; without (`jaximpact batch`, whose table's columns may
+    give parameters), the job checks them."""
+    from .._laws import CustomLaw, custom_law
+
+    fn = load_law_function(text)
+    law = custom_law(fn, **params) if params else CustomLaw(fn, {}, text)
+    law = CustomLaw(law.fn, law.params, text)
+    if complete:
+        check_file_law(law)
+    return law
+
+
+def check_file_law(law):
+    """One-line `CLIError`s for a user's law of the command line (`file_law`) whose function
+    reads a parameter that `--param` does not give, fails when traced, or is given a
+    parameter it does not read."""
+    from .._jobs.job_law import MissingParameter, parameters_read
+
+    text = law.name
+    try:
+        read = parameters_read(law.fn, law.params)
+    except MissingParameter as error:
+        key = error.args[0]
+        raise CLIError(f"{text} reads params[{json.dumps(key)}]: give it with --param "
+                       f"{key}=...") from None  # fmt: skip
+    except Exception as error:  # the user's function: where it failed, in one line
+        raise CLIError(
+            f"{text} failed when called as NAME(x, v, params) with numbers ("
+            f"{type(error).__name__}{_line_in(error, law.fn)}: {_first_line(error)})"
+        ) from None
+    unread = [k for k in law.params if k not in read]
+    if unread:
+        reads = ", ".join(read) or "no parameter"
+        raise CLIError(f"--param {unread[0]}: {text} does not read params["
+                       f"{json.dumps(unread[0])}] (it reads {reads})")  # fmt: skip
+
+
+_LOADED: dict = {}  # (file, SHA-256 of its bytes) -> its module: a file loaded once
+
+
+def load_law_function(text: str):
+    """The function NAME of the file FILE.py of `--law FILE.py:NAME`, the file imported once
+    per content (`importlib`); one-line `CLIError`s for a name that is not `FILE.py:NAME`, a
+    file that is missing or not a .py file, a file that raises on import (which exception,
+    at which line), NAME not in the file (with the callables it has) or not callable."""
+    import hashlib
+    import importlib.util
+
+    where, _, name = text.rpartition(":")
+    flag = f"--law {text}"
+    if not where or not name:
+        raise CLIError(f"{flag}: a user's law is FILE.py:NAME, the file and the name of its "
+                       "function NAME(x, v, params)")  # fmt: skip
+    path = Path(where)
+    if path.suffix != ".py":
+        raise CLIError(f"{flag}: {where} is not a .py file; a user's law is FILE.py:NAME, a "
+                       "function NAME(x, v, params) in a Python file")  # fmt: skip
+    if not path.exists():
+        raise CLIError(f"{flag}: no such file {where}")
+    if not path.is_file():
+        raise CLIError(f"{flag}: {where} is not a file")
+    try:
+        source = path.read_bytes()
+    except OSError as error:
+        raise CLIError(f"{flag}: cannot read {where} ({error.strerror or error})") from None
+    digest = hashlib.sha256(source).hexdigest()
+    key = (str(path.resolve()), digest)
+    module = _LOADED.get(key)
+    if module is None:
+        module_name = f"_jaximpact_law_{digest[:16]}"
+        spec = importlib.util.spec_from_file_location(module_name, path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[module_name] = module  # as an import has it (dataclasses look it up)
+        try:
+            spec.loader.exec_module(module)
+        except (Exception, SystemExit) as error:
+            del sys.modules[module_name]
+            line = _line_in(error, path)
+            raise CLIError(f"{flag}: importing {where} raised {type(error).__name__}{line}: "
+                           f"{_first_line(error)}") from None  # fmt: skip
+        _LOADED[key] = module
+    if not hasattr(module, name):
+        from .._choices import nearest_names
+
+        own = [k for k, v in vars(module).items() if callable(v) and not k.startswith("_")
+               and getattr(v, "__module__", None) == module.__name__]  # fmt: skip
+        near = nearest_names(name, own)
+        hint = f" (did you mean {' or '.join(near)}?)" if near else ""
+        has = f"its callables: {', '.join(own)}" if own else "it defines no function"
+        raise CLIError(f"{flag}: {where} has no {name!r}{hint}; {has}")
+    fn = getattr(module, name)
+    if not callable(fn):
+        raise CLIError(f"{flag}: {name} in {where} is a {type(fn).__name__}, not a function "
+                       f"{name}(x, v, params)")  # fmt: skip
+    return fn
+
+
+def _first_line(error) -> str:
+    text = str(error).strip()
+    if isinstance(error, SyntaxError):  # its str holds the file and line: said apart
+        text = error.msg or text
+    return (text.splitlines() or [""])[0] or "(no message)"
+
+
+def _line_in(error, where) -> str:
+    """` at line N` of the user's file (`where`: its path, or a function defined in it)
+    where `error` was raised, or `""`."""
+    import traceback
+
+    if isinstance(where, (str, Path)):
+        file = str(Path(where).resolve())
+    else:
+        import inspect
+
+        try:
+            file = str(Path(inspect.getsourcefile(inspect.unwrap(where))).resolve())
+        except TypeError:
+            return ""
+    if isinstance(error, SyntaxError) and error.filename is not None:
+        if str(Path(error.filename).resolve()) == file and error.lineno:
+            return f" at line {error.lineno}"
+    frames = [f for f in traceback.extract_tb(error.__traceback__)
+              if str(Path(f.filename).resolve()) == file]  # fmt: skip
+    return f" at line {frames[-1].lineno}" if frames else ""
 
 
 def check_plot_path(path: Path | None, inputs=()):

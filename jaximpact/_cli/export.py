@@ -13,6 +13,8 @@ from .common import (
     add_tangential_arguments,
     command_parser,
     emit,
+    is_file_law,
+    make_law,
     parse_params,
     tangential_from_args,
     warn_sphere_density,
@@ -50,7 +52,9 @@ def _export_description() -> str:
         "Turn a law (--law, --param), a fit (--from FILE, the JSON of 'jaximpact calibrate "
         f"--json') or target --e and --T into the contact parameters of {_labels(last='or')}, "
         "in the engine's own names and units, with a snippet to paste, a recommended time "
-        "step, and the e and T the engine realises (its time stepping included). Scenes: "
+        "step (the coarsest at which the engine's stepping realises e within 0.5 % wherever "
+        "the first touch falls and T within 0.5 %, printed as T/n too), and the e and T the "
+        "engine realises (its time stepping included). Scenes: "
         f"{plane}, a body of --mass on a plane; the others, two spheres each of --mass and "
         "--radius colliding head-on at relative speed --v0 (--wall: one sphere on a fixed "
         "flat wall). docs/engines.md has the formulas and measured tables.\n\n"
@@ -91,7 +95,11 @@ def add_export(subparsers):
         help="a fit to export: the JSON that 'jaximpact calibrate --json' (or 'simulate "
         "--json') writes, '-' for stdin; its law, parameters, mass and speed are used",
     )  # fmt: skip
-    parser.add_argument("--law", metavar="NAME", help="a law of 'jaximpact laws'")
+    parser.add_argument(
+        "--law", metavar="NAME",
+        help="a law of 'jaximpact laws', or a user's law FILE.py:NAME, the function "
+        "NAME(x, v, params) of a Python file (its parameters all from --param)",
+    )  # fmt: skip
     parser.add_argument("--param", action="extend", nargs="+", default=[], metavar="NAME=VALUE")
     parser.add_argument("--e", type=float, help="target restitution in (0, 1] (without --law)")
     parser.add_argument("--T", type=float, metavar="S", help="target contact duration, s")
@@ -163,8 +171,11 @@ def _check_engine(name: str) -> None:
 
 
 def _run_export(args):
+    import warnings
+
     from .._engines import export
-    from .._engines.export import UnrealisedExport, missing_mass
+    from .._engines._stepping import describe_step
+    from .._engines.export import UnrealisedExport, UnrealisedWarning, missing_mass
 
     engine = _engine_name(args)
     notes = []
@@ -198,32 +209,47 @@ def _run_export(args):
     warn_sphere_density(args.mass, args.radius)
     source = None
     if name is not None:
-        from .._laws import law
-
-        source = law(name, **params)
+        source = make_law(name, params)
     tangential = tangential_from_args(args)
     try:  # with --no-strict, the refusal comes as a warning (one line on stderr)
-        x = export(
-            source,
-            engine,
-            m=args.mass,
-            v0=args.v0,
-            timestep=args.timestep,
-            radius=args.radius,
-            poisson=args.poisson,
-            e=args.e,
-            T=args.T,
-            limit_damping=args.limit_damping,
-            **({"geometry": "wall"} if args.wall else {}),
-            strict=args.strict,
-            tangential=tangential,
-        )
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", UnrealisedWarning)
+            x = export(
+                source,
+                engine,
+                m=args.mass,
+                v0=args.v0,
+                timestep=args.timestep,
+                radius=args.radius,
+                poisson=args.poisson,
+                e=args.e,
+                T=args.T,
+                limit_damping=args.limit_damping,
+                **({"geometry": "wall"} if args.wall else {}),
+                strict=args.strict,
+                tangential=tangential,
+            )
     except UnrealisedExport as refusal:
-        raise CLIError(refusal.message("--no-strict to export it anyway")) from None
+        raise CLIError(refusal.message("--no-strict")) from None
     data = x.to_dict()
+    for caught_warning in caught:  # in the command line's words, then shown as they came
+        message = caught_warning.message
+        if isinstance(message, UnrealisedWarning) and message.refusal is not None:
+            said = message.refusal.message("--no-strict", exported=True)
+            data["warnings"] = [said if w == str(message) else w for w in data["warnings"]]
+            warnings.warn(said, UnrealisedWarning, stacklevel=1)
+        else:
+            warnings.warn_explicit(message, caught_warning.category, caught_warning.filename,
+                                   caught_warning.lineno, source=caught_warning.source)  # fmt: skip
     data["warnings"] = [*notes, *data["warnings"]]
     if args.source is not None:
         data["from"] = str(args.source)
+
+    if not x.timestep:
+        step = "timestep 0 (its continuous plant)"
+    else:  # the coarsest step that realises the target within 0.5 %, as T/n too
+        which = "recommended" if args.timestep is None else "given"
+        step = f"{which} timestep {describe_step(x.timestep, x.target_T)}"
 
     def text():
         mass = "per unit mass" if x.m is None else f"m = {format_number(x.m)} kg"
@@ -231,7 +257,8 @@ def _run_export(args):
             f"{x.engine}: {x.scene}",
             *([f"from     {args.source}: law {name}"] if args.source is not None else []),
             f"asked    e = {x.target_e:.6g}, T = {x.target_T:.6g} s at v0 = {x.v0:g} m/s, {mass}",
-            f"realised e = {x.e:.6g}, T = {x.T:.6g} s with time step {x.timestep:.6g} s"
+            step,
+            f"realised e = {x.e:.6g}, T = {x.T:.6g} s at that step"
             + (
                 f" (e {x.e_range[0]:.5g} to {x.e_range[1]:.5g} over where contact starts)"
                 if x.e_range
@@ -309,7 +336,8 @@ def read_fit(path: str, args):
     name = record.get("law")
     if not isinstance(name, str):
         raise CLIError(f"{where}: no law name ('law'); is it the output of calibrate --json?")
-    if name not in LAWS:
+    user = is_file_law(name)  # a fit of a user's law, FILE.py:NAME: its file is read again
+    if name not in LAWS and not user:
         raise CLIError(f"{where}: law {name!r} is not one of 'jaximpact laws'")
     if args.law is not None and args.law != name:
         raise CLIError(f"--law {args.law} but {path} holds a fit of {name}")
@@ -319,7 +347,7 @@ def read_fit(path: str, args):
     for key, value in params.items():
         if not _number(value) or not math.isfinite(value):
             raise CLIError(f"{where}: parameter {key} = {value!r} is not a finite number")
-    unknown = sorted(set(params) - set(LAWS[name].parameters))
+    unknown = [] if user else sorted(set(params) - set(LAWS[name].parameters))
     if unknown:
         raise CLIError(f"{where}: law {name} has no parameter {', '.join(unknown)}")
     m = data.get("m", record.get("m"))

@@ -9,6 +9,7 @@ from .common import (
     command_parser,
     emit,
     format_table,
+    is_file_law,
     terminal_width,
 )
 
@@ -155,6 +156,12 @@ def _chosen(rows, tangential, names):
     everything = [r["name"] for r in (*rows, *tangential)]
     wanted = set()
     for name in names:
+        if is_file_law(name):
+            raise CLIError(
+                f"{name} is a user's law: 'jaximpact laws' lists the law table, and a user's "
+                "law has no row in it (its parameters are those its function reads from "
+                "params; --law FILE.py:NAME --param ... uses it)"
+            )
         found = {n for n in everything if n.startswith(plain_name(name))}
         if not found:
             raise CLIError(unknown_name("law", name, everything))

@@ -14,6 +14,7 @@ Or a video track of the ball bouncing across a floor, one row per frame: `t` (s)
 import math
 from pathlib import Path
 
+from .._files import cell_number
 from .._progress import metered
 from .._status import Status
 from .common import (
@@ -371,9 +372,9 @@ def _number(cell: str, path: Path, line: int, column: str) -> float:
     if not cell.strip():
         return math.nan
     try:
-        return float(cell)
-    except ValueError:
-        raise CLIError(f"{path}, line {line}, column {column}: {cell!r} is not a number") from None
+        return cell_number(cell)
+    except ValueError as error:
+        raise CLIError(f"{path}, line {line}, column {column}: {error}") from None
 
 
 def run_fit_oblique(args):

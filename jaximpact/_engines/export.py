@@ -11,7 +11,13 @@ from .._checks import check_scale
 from .._choices import unknown_name
 from . import _stepping, chrono, drake, lammps, liggghts, mujoco, yade
 from .base import AbstractEngine, Design
-from .materials import check_poisson, check_positive, check_restitution
+from .materials import (
+    check_poisson,
+    check_positive,
+    check_restitution,
+    hertz_constant,
+    modulus_warnings,
+)
 
 # The registry, in the order messages list the engines: one final `AbstractEngine` each.
 # A new engine is its module and one line here (docs/layout.md, "Adding an engine").
@@ -33,31 +39,48 @@ class UnrealisedExport(ValueError):
     """An export its engine cannot realise at the given step (`_stepping.unrealised`): the
     `engine`, its time `step` (s), the `reason`, and `working` (s), a step that realises the
     target (0.0: Drake's continuous plant; None where none was found); `continuous`: the
-    engine also has a continuous plant (time step 0)."""
+    engine also has a continuous plant (time step 0); `T` (s): the target duration, by
+    which the steps are also told as T/n."""
 
-    def __init__(self, engine: str, step, reason: str, working, *, continuous: bool = False):
+    def __init__(self, engine: str, step, reason: str, working, *, continuous: bool = False,
+                 T=None):  # fmt: skip
         self.engine, self.step, self.reason, self.working = engine, step, reason, working
-        self.continuous = continuous
-        super().__init__(self.message("pass strict=False to export it anyway"))
+        self.continuous, self.T = continuous, T
+        super().__init__(self.message("strict=False"))
 
-    def message(self, anyway: str) -> str:
-        """The one-line refusal, ending with how to `anyway` export it."""
+    def message(self, option: str, *, exported: bool = False) -> str:
+        """The one line: the refusal, ending with how to export it anyway (`option`:
+        `"strict=False"` in Python, `"--no-strict"` on the command line), or with
+        `exported` the warning of an export made anyway with that option."""
         if self.working is None:
-            fix = "no time step down to T/51200 realises it"
+            fix = f"no time step down to T/{_stepping.MAX_STEPS} realises it"
         elif self.working == 0.0:
             fix = "use time_step = 0 (its continuous plant)"
         else:
             fix = f"use a time step of {self.working:.3g} s or less"
+            if self.T:
+                fix += f" ({_stepping.per_contact(self.working, self.T)})"
             if self.continuous:
                 fix += " (or time_step = 0, its continuous plant)"
+        if exported:
+            tail = f"; exported anyway ({option})"
+        else:
+            tail = f", or pass {option} to export it anyway"
         return (
-            f"{self.engine} cannot realise the target at time step {self.step:.3g} s: "
-            f"{self.reason}; {fix}, or {anyway}"
+            f"{self.engine} cannot realise the target at time step "
+            f"{_stepping.describe_step(self.step, self.T)}: {self.reason}; {fix}{tail}"
         )
 
 
 class UnrealisedWarning(UserWarning):
-    """`export(..., strict=False)` of an export its engine cannot realise."""
+    """`export(..., strict=False)` of an export its engine cannot realise, built from the
+    `refusal` it would have raised (an `UnrealisedExport`, kept as `.refusal`: its `message`
+    in other words, as the command line's) or from a text (`.refusal` None)."""
+
+    def __init__(self, refusal):
+        self.refusal = refusal if isinstance(refusal, UnrealisedExport) else None
+        text = refusal if self.refusal is None else refusal.message("strict=False", exported=True)
+        super().__init__(text)
 
 
 def missing_mass(engine: str, from_law: bool, how: str) -> str:
@@ -86,16 +109,43 @@ class Export:
     - `e`, `T` (s): what the engine realises at `v0` with `timestep` (its time stepping
       included: the mean over where the first touch falls inside a step); `e_range`,
       `T_range`: their extremes over those start phases (None for Drake's continuous plant).
-    - `timestep` (s): the recommended (or given) step; `steps_per_contact`.
+    - `timestep` (s): the given step, or the recommended one: the coarsest at which the
+      engine's replicated stepping realises e within 0.5 % of the target wherever the first
+      touch falls and T (the mean over those start phases) within 0.5 %
+      (`_stepping.recommended_step`; T/100 for Chrono, whose stepper is not replicated; at
+      most T/400 with a tangential law); `steps_per_contact`.
     - `target_e`, `target_T`: what was asked (the law's e and T at `v0`, or the targets).
       With `v0=[...]` (a law the engine lacks): `v0` is the speeds' geometric middle,
       `target_e` the middle of the law's e over them, `speeds` those given.
-    - `law`: the engine's law as a jaximpact law, `separation`: its end of contact.
+    - `law` (SI units), `law_m` (kg), `separation`: the engine's contact as a jaximpact law,
+      for every engine the law whose impact at the export's effective mass `law_m` is the
+      engine's contact without its time stepping: `impact(x.law, m=x.law_m, v0=x.v0,
+      separation=x.separation)`. `law_m` is the mass the contact moves: `m/2` for two equal
+      spheres of mass `m` (the default scene of LAMMPS, LIGGGHTS, Yade and Chrono; `law`'s
+      forces are then half those of a law that moves `m` alike), `m` for a body on a plane
+      or wall (MuJoCo, Drake, `geometry="wall"`; 1 kg for MuJoCo from targets alone, its
+      contact per unit mass). That impact gives `target_e` and `target_T` (to 1e-6)
+      where the design inverts the engine's continuous law (LAMMPS's hertz/material and
+      dmt, LIGGGHTS, Yade, Chrono, Drake's continuous plant), `e` and `T` then being the
+      same within the stepping's error (the 0.5 % above at the recommended step). MuJoCo
+      and Drake's discrete plant set their law off the target by their stepping's own bias,
+      so that the stepping lands on it: the law's e and T are then what the replica gives
+      as the step vanishes. LAMMPS's jkr models break the neck at the least force, which no
+      jkr law does: `law` is the jkr law whose neck takes LAMMPS's energy per impact (its
+      e is LAMMPS's continuous e at every speed, its contact longer, by 0.3 % at e = 0.95 to
+      7 % at e = 0.2), and with `damping viscoelastic` the `jkr_viscoelastic` law alike (its
+      e and T within 0.3 % of the target, LAMMPS's continuous impact, for the rubber-like
+      spheres of tests/engines). For a law the engine lacks (`thornton`), `law` is the
+      nearest law it has.
     - `speeds` (m/s), `e_engine`, `T_engine`, `e_target`, `T_target`: e(v) and T(v) that the
       engine realises (its time stepping included where it is replicated, as `e` is; else
       its continuous law) and of the given law (None when targets were given) over a range
       of speeds.
-    - `warnings`: where the engine will not do what was asked, or only with care.
+    - `warnings`: where the engine will not do what was asked, or only with care; among them
+      where, with a radius, the contact's Hertz constant implies a Young's modulus no
+      material has (outside 1e5 to 1e12 Pa, by `c = 4/3 E* sqrt(R*)`), or a tangential
+      law's shear modulus lies more than a factor 100 from its `E / (2 (1 + nu))`
+      (`materials.modulus_warnings`).
     - With a tangential law (`export(tangential=...)`): `tangential`, the engine's (as
       `law`: the given one, its forces halved for two spheres of mass `m` as the normal
       law's are, so that the pair moves as the law moves `m`), and at `v0` from
@@ -129,6 +179,7 @@ class Export:
     T_range: tuple | None = None
     steps_per_contact: float | None = None
     law: object = None
+    law_m: float | None = None
     separation: str = "force"
     speeds: tuple = ()
     e_engine: tuple = ()
@@ -211,7 +262,8 @@ def export(
     default for those engines) is the pair. MuJoCo and Drake have only their body on a plane
     (`"wall"` is accepted for them and changes nothing). `timestep` (s): the engine's step
     if already chosen (the export then corrects for it where it can and warns where it
-    cannot); default, a recommended step.
+    cannot); default, the recommended step (`Export.timestep`: the coarsest at which the
+    engine's stepping realises the target within 0.5 %).
     The returned `Export` states what the engine realises, computed through a replica of its
     time stepping (MuJoCo, LAMMPS) checked against the engines in tests/engines.
 
@@ -241,8 +293,9 @@ def export(
     `e_n_engine`, and the law's `e_t_target`. Another engine: a one-line ValueError.
 
     An export the engine cannot realise at `timestep` is refused: an `UnrealisedExport`
-    (a `ValueError`) that names the step that would work (`.working`), or with `strict=False`
-    a warning (also in `Export.warnings`) and the export anyway. It cannot realise it when a
+    (a `ValueError`) that names the step that would work (`.working`, told as T/n too), or
+    with `strict=False` an `UnrealisedWarning` (also in `Export.warnings`) and the export
+    anyway. It cannot realise it when a
     parameter is not finite, when what it realises is no impact (e or T not finite, e
     outside [0, 1], T <= 0), when fewer than 5 steps resolve the contact (T over the step),
     or when its e or T (the mean over where first touch falls inside a step) misses the
@@ -283,6 +336,12 @@ def export(
         if tied != options:
             options = tied
             out = chosen.design(target_e, target_T, timestep=timestep, **options)
+    if tangential is not None and timestep is None and out.timestep:
+        # the tangential promise (the continuous laws where the oblique stepping is not
+        # replicated) was measured against the engines at TANGENTIAL_STEPS per contact
+        fine = _stepping.nice_down(out.T / TANGENTIAL_STEPS)
+        if out.timestep > fine:
+            out = chosen.design(target_e, target_T, timestep=fine, **options)
     if out.target_T is not None:  # MuJoCo without T: its default timeconst's
         target_T = out.target_T
     warnings = list(out.warnings)
@@ -290,31 +349,33 @@ def export(
     if reason is not None:
         step = _working_step(chosen, target_e, target_T, options)
         refusal = UnrealisedExport(
-            engine, out.timestep, reason, step, continuous=chosen.CONTINUOUS_PLANT
+            engine, out.timestep, reason, step, continuous=chosen.CONTINUOUS_PLANT, T=target_T
         )
         if strict:
             raise refusal
-        warnings.insert(0, str(refusal))
-        _warnings.warn(str(refusal), UnrealisedWarning, stacklevel=2)
+        anyway = UnrealisedWarning(refusal)
+        warnings.insert(0, str(anyway))
+        _warnings.warn(anyway, stacklevel=2)
     # the law each side realises; a two-sphere engine's promise is for the pair (effective
-    # mass m/2), or for the sphere on a wall (its own mass)
+    # mass m/2), or for the sphere on a wall (its own mass): `law_m`
     engine_law = chosen.law(out.parameters, m)
+    law_m = chosen.effective_mass(m, geometry)
     response = {}
     if curves or lacked:  # the nearest law's report needs its e(v)
         stepping = None if out.stepping is None else chosen.stepper(out.stepping, m=m,
                                                                     radius=radius)  # fmt: skip
-        response, note = _responses(engine_law, chosen.effective_mass(m, geometry), out,
-                                    stepping, source, m=m, v0=v0, speeds=speeds)  # fmt: skip
+        response, note = _responses(engine_law, law_m, out, stepping, source, m=m, v0=v0,
+                                    speeds=speeds)  # fmt: skip
         if lacked and (note or speeds is not None):
             warnings.insert(0, _nearest(chosen, source, response, target_e,
                                         fitted=speeds is not None, v0=v0))  # fmt: skip
         else:
             warnings += [note] if note else []
-    parameters, oblique = out.parameters, {}
+    parameters, oblique, exported = out.parameters, {}, None
     if tangential is not None:
         # the normal export moves the scene's mass (m/2 for two spheres) as the law moves
         # m, its forces scaled by that ratio: the tangential law's forces alike
-        exported = tangential.forces_scaled(chosen.effective_mass(m, geometry) / m)
+        exported = tangential.forces_scaled(law_m / m)
         parameters = chosen.with_tangential(parameters, exported)
         oblique = _oblique_promise(chosen, parameters, engine_law, out.separation, exported,
                                    source, tangential, m=m, v0=v0, radius=radius,
@@ -326,6 +387,12 @@ def export(
             warnings.append(departure[1] + _contact_point_note(chosen, geometry))
         if _two_spheres(chosen, geometry):
             warnings += _turning_note(out.T, v0=v0, radius=radius)
+    if radius is not None:  # a stiffness or shear modulus no material has
+        c = hertz_constant(engine_law, v0)
+        if c is None and source is not None and (c := hertz_constant(source, v0)) is not None:
+            c *= law_m / m  # the engine's law is not Hertz's (MuJoCo, Drake): the given law's
+        warnings += modulus_warnings(c, exported, radius=radius, poisson=options["poisson"],
+                                     two_spheres=_two_spheres(chosen, geometry))  # fmt: skip
     return Export(
         engine=engine,
         scene=chosen.SCENES[geometry],
@@ -343,12 +410,16 @@ def export(
         T_range=out.T_range,
         steps_per_contact=out.steps_per_contact,
         law=engine_law,
+        law_m=law_m,
         separation=out.separation,
         **response,
         **oblique,
     )
 
 
+# the steps per contact an export with a tangential law takes at most when no step is given:
+# its promise was measured against the real engines at this resolution (docs/oblique.md)
+TANGENTIAL_STEPS = 400
 # the incidences (degrees from the normal) an export with a tangential law reports
 OBLIQUE_ANGLES = (5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 75.0)
 # how far the engine's e_t may fall from the law's before an export warns

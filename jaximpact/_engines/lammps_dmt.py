@@ -14,13 +14,16 @@ wheel), with `pair_coeff * * dmt E damp poisson cohesion damping viscoelastic`:
 - A contact holds while the spheres overlap (`delta > 0`); the force is attractive from the
   first touch (`-4 pi cohesion Reff`) to the last.
 
-So LAMMPS's contact is the `dmt` law itself. The export keeps the law's dimensionless
-impact at every speed: the pair moves the effective mass `meff` (m/2 for two spheres of
-mass m, m for one on a wall) where the law moves `m`, so every force of the law is scaled
-by `meff/m` (`c`, `b` and the pull-off alike: the groups `beta` and `(2 pi w R) x*/(m v0^2)`
-and the time scale `t*` are the law's), and the export realises the law's e(v) and T(v) at
-every speed up to the stepping's own error. `fix nve/sphere` is velocity Verlet, the force
-from the new positions and the half-step velocity (`replica`).
+So LAMMPS's contact is a `dmt` law. The export keeps the law's dimensionless impact at
+every speed: the pair moves the effective mass `meff` (m/2 for two spheres of mass m, m for
+one on a wall) where the law moves `m`, so every force of the law is scaled by `meff/m`
+(`c`, `b` and the pull-off alike: the groups `beta` and `(2 pi w R) x*/(m v0^2)` and the
+time scale `t*` are the law's), and the export realises the law's e(v) and T(v) at every
+speed up to the stepping's own error. The export's `law` is LAMMPS's contact itself, the
+law for the effective mass (as every engine's: `Export`), i.e. the given law with its
+forces scaled by `meff/m` (`w` halved for two spheres, whose `R` is the pair's `R/2`).
+`fix nve/sphere` is velocity Verlet, the force from the new positions and the half-step
+velocity (`replica`).
 """
 
 import math
@@ -162,15 +165,14 @@ class LammpsDMT(AbstractEngine):
         )
 
     def law_parameters(self, parameters, m):
-        """The `dmt` law (c N/m^1.5, b N s/m^1.5, R m, w J/m^2) whose impact for a body of
-        mass `m` (kg; each sphere's) is LAMMPS's contact: its forces over `meff/m`."""
+        """The `dmt` law (c N/m^1.5, b N s/m^1.5, R m, w J/m^2) that is LAMMPS's contact, for
+        its effective mass (m/2 for two spheres of mass `m`, kg; `m` on a wall):
+        `c = 4/3 Emix Reff^0.5`, `b = damp meff Reff^0.5`, `R = Reff`, `w = 2 cohesion`."""
         wall = parameters.get("geometry", "spheres") == "wall"
         m_eff = m if wall else m / 2.0
         c, b, pull = _contact(parameters, m_eff)
         R_eff = float(parameters["R_eff"])
-        scale = m_eff / m
-        w = pull / scale / (2.0 * math.pi * R_eff)
-        return {"c": c / scale, "b": b / scale, "R": R_eff, "w": w}
+        return {"c": c, "b": b, "R": R_eff, "w": pull / (2.0 * math.pi * R_eff)}
 
     def response(self, parameters, *, m, radius=None):
         """`(law, "penetration")`: `law_parameters`' `dmt` law for `parameters`."""

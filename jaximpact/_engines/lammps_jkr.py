@@ -289,7 +289,9 @@ class LammpsJKR(AbstractEngine):
         """The `jkr` law (c N/m^1.5, R m, w J/m^2) that takes the energy LAMMPS's jkr takes:
         LAMMPS's `c = 4/3 Emix Reff^0.5` and `R = Reff`, and `w` = 2 cohesion times
         `ENERGY_RATIO^(3/5)` (the energy goes as `w^(5/3)`), so that its e(v) is LAMMPS's
-        continuous one at every speed (its T is not: LAMMPS's neck breaks earlier)."""
+        continuous one at every speed; its T is not (LAMMPS's neck breaks earlier): the
+        law's contact lasts longer, by 0.3 % at e = 0.95, 1.5 % at 0.8, 4 % at 0.5 and 7 %
+        at 0.2 (measured against `lammps_impact`)."""
         E, nu, cohesion = _check(parameters)
         R_eff = check_positive("R_eff", parameters["R_eff"], "m")
         c = 4.0 / 3.0 * emix(E, nu) * math.sqrt(R_eff)

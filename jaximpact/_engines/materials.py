@@ -178,6 +178,75 @@ def work_of_adhesion(gamma, gamma2=None, gamma12=0.0) -> float:
     return w
 
 
+# The Young's moduli (Pa) that materials have: a soft gel or foam (1e5) to diamond (1.2e12);
+# an export whose contact implies one outside warns (`modulus_warnings`)
+PLAUSIBLE_MODULUS = (1e5, 1e12)
+# how far (a factor either way) a tangential law's shear modulus may lie from the normal
+# contact's G = E / (2 (1 + nu)) before an export warns
+SHEAR_FACTOR = 100.0
+
+
+def hertz_constant(law, v0: float) -> float | None:
+    """The Hertz constant `c` (N/m^1.5) of `law`'s elastic force `c x^1.5` (a family law
+    with `n = 1.5` at speed `v0`, m/s, or a law whose `c` is in N/m^1.5: JKR's, Thornton's),
+    or None (another elastic force)."""
+    coefficients = law.coefficients(v0)
+    if coefficients is not None:
+        c, n = float(coefficients[0]), float(coefficients[1])
+        return c if n == 1.5 else None
+    if law.spec is not None and law.spec.units.get("c") == "N/m^1.5":
+        return float(law.params["c"])
+    return None
+
+
+def modulus_warnings(c, tangential, *, radius: float, poisson: float, two_spheres: bool) -> list:
+    """The sanity lines of an export (each one line; none where `c` is None):
+
+    - where the contact's Hertz constant `c` (N/m^1.5; for two spheres, the pair's) with the
+      spheres' `radius` (m) implies a Young's modulus outside `PLAUSIBLE_MODULUS`: `c = 4/3
+      E* sqrt(R*)` (Johnson 1985, eq. 4.23), `R* = R/2` (`two_spheres`) or `R` (a sphere on
+      a flat), `E* = E / (2 (1 - nu^2))` (two bodies of one material, as the engines take
+      them; a rigid flat would halve E), `nu` = `poisson`;
+    - where a tangential law (`tangential`, exported alike; None: none) has an effective
+      shear modulus (its parameters in Pa: Mindlin's `G*`) more than `SHEAR_FACTOR` from the
+      one the normal contact's material has: one elastic material has `G = E / (2 (1 +
+      nu))`, i.e. `G*/E* = (1 - nu) / (2 (2 - nu))`, against a body of itself or a rigid
+      one alike."""
+    if c is None or not (c > 0 and math.isfinite(c)):
+        return []
+    R_star = radius / 2.0 if two_spheres else radius
+    E_star = 0.75 * c / math.sqrt(R_star)
+    E = E_star * 2.0 * (1.0 - poisson) * (1.0 + poisson)
+    low, high = PLAUSIBLE_MODULUS
+    out = []
+    if not low <= E <= high:
+        out.append(
+            f"the contact's Hertz constant c = {c:.4g} N/m^1.5 with radius {radius:g} m "
+            f"implies a Young's modulus E = {E:.3g} Pa (c = 4/3 E* sqrt(R*), E* = E/(2 (1 - "
+            f"nu^2)), R* = {R_star:g} m, nu = {poisson:g}), outside what materials have "
+            f"({low:g} Pa, a soft gel, to {high:g} Pa, diamond): check the law's units, m, v0 "
+            "and radius"
+        )
+    shear = [] if tangential is None else [
+        (name, float(tangential.params[name]))
+        for name, unit in tangential.spec.units.items()
+        if unit == "Pa" and name in tangential.params
+    ]  # fmt: skip
+    expected = E_star * (1.0 - poisson) / (2.0 * (2.0 - poisson))
+    for name, G_star in shear:
+        ratio = G_star / expected
+        if G_star > 0 and not 1.0 / SHEAR_FACTOR <= ratio <= SHEAR_FACTOR:
+            G = E / (2.0 * (1.0 + poisson))
+            out.append(
+                f"the tangential law's {name} = {G_star:.4g} Pa is {ratio:.3g} times the "
+                f"{expected:.3g} Pa of the normal contact's material (E = {E:.3g} Pa, G = E/(2 "
+                f"(1 + nu)) = {G:.3g} Pa, nu = {poisson:g}; G*/E* = (1 - nu)/(2 (2 - nu))): the "
+                f"two laws are not of one material (more than a factor {SHEAR_FACTOR:g} "
+                "apart); check both"
+            )
+    return out
+
+
 def _representable(name: str, value: float, unit: str) -> float:
     """`value` if float64 holds it to full precision (finite, not below the smallest normal
     number); a one-line ValueError otherwise (inputs whose result over- or underflows:

@@ -100,31 +100,64 @@ def replica(solref, timestep: float, v0: float, phases=_stepping.PHASES):
 def _corrected(e: float, T: float, v0: float, timestep) -> tuple[float, float, float]:
     """`(w0, zeta, h)`: the natural frequency (1/s) and damping ratio that MuJoCo's Euler
     step at `h` (s: `timestep`, or the recommended step) turns into `e` and `T` (s) at `v0`
-    (m/s), the continuous contact's corrected for the step's own bias (phase means)."""
+    (m/s), the continuous contact's corrected for the step's own bias (phase means). The
+    recommended step is the coarsest at which e's spread over start phases stays within the
+    export's tolerance (`_stepping.recommended_step`; the correction then moves the mean onto
+    the target, within `_CORRECTION_TOL`), halved where the corrected contact still misses
+    it."""
+    if timestep is not None:
+        return (*_at_step(e, T, v0, float(timestep))[:2], float(timestep))
     zeta = dampratio_for(e)
     w0 = continuous(zeta)[1] / T
-    if timestep is None:
-        h = _stepping.recommended_step(lambda h: replica(_solref(w0, zeta), h, v0), T)
-    else:
-        h = float(timestep)
+    tol = _stepping.STEP_TOL - _CORRECTION_TOL
+    h = _stepping.recommended_step(lambda h: replica(_solref_at(w0, zeta, h), h, v0), T, None,
+                                   tol)  # fmt: skip
+    while True:
+        w0, zeta, es, Ts = _at_step(e, T, v0, h)
+        if _stepping.realises(es, Ts, e, T) or T / h > _stepping.MAX_STEPS:
+            return w0, zeta, h
+        h = _stepping.nice_down(h / 2.0)
+
+
+# how far (relative) the corrected contact's phase-mean e and T may stay from the target
+_CORRECTION_TOL = 2e-5
+
+
+def _at_step(e: float, T: float, v0: float, h: float):
+    """`(w0, zeta, es, Ts)`: the continuous contact's natural frequency (1/s) and damping
+    ratio corrected (phase means, up to 8 rounds) so that MuJoCo's Euler step at `h` (s)
+    realises `e` and `T` (s) at `v0` (m/s), and what it realises per start phase."""
+    zeta = target = dampratio_for(e)
+    w0 = continuous(zeta)[1] / T
     for _ in range(8):
-        es, Ts = replica(_solref(w0, zeta), h, v0)
+        es, Ts = replica(_solref_at(w0, zeta, h), h, v0)
         e_mean, T_mean = float(es.mean()), float(Ts.mean())
-        if abs(e_mean / e - 1) < 2e-5 and abs(T_mean / T - 1) < 2e-5:
+        if abs(e_mean / e - 1) < _CORRECTION_TOL and abs(T_mean / T - 1) < _CORRECTION_TOL:
             break
         try:
             zeta_apparent = dampratio_for(min(e_mean, 1.0))
         except ValueError:
             break
-        zeta = max(0.0, zeta + dampratio_for(e) - zeta_apparent)
+        zeta = max(0.0, zeta + target - zeta_apparent)
         w0 *= T_mean / T
-    return w0, zeta, h
+    else:
+        es, Ts = replica(_solref_at(w0, zeta, h), h, v0)
+    return w0, zeta, es, Ts
 
 
 def _solref(w0: float, zeta: float):
     if zeta <= 0.0:
         return (-(w0**2), 0.0)  # e = 1: only the direct form has no damping
     return (1.0 / (w0 * zeta), zeta)
+
+
+def _solref_at(w0: float, zeta: float, h: float):
+    """`_solref`, in the direct form where refsafe would raise the standard form's
+    timeconst (below two steps `h`, s): the solref the design gives MuJoCo."""
+    solref = _solref(w0, zeta)
+    if solref[0] > 0 and solref[0] < 2.0 * h:
+        return (-(w0**2), -2.0 * zeta * w0)
+    return solref
 
 
 class Mujoco(AbstractEngine):
@@ -228,13 +261,15 @@ class Mujoco(AbstractEngine):
             solref = (-(w0**2), -2.0 * zeta * w0)
             es, Ts = replica(solref, h, v0)
         half_spread = float((es.max() - es.min()) / 2 / es.mean()) if es.mean() > 0 else 0.0
-        if half_spread > 0.005:
+        if half_spread > _stepping.STEP_TOL:
             warnings.append(
                 f"time step {h:.3g} s gives {steps_per_contact:.0f} steps per contact: e "
                 f"ranges {es.min():.4g} to {es.max():.4g} with where contact starts inside a "
-                f"step; use a step of {_stepping.nice_down(T / 400):.3g} s or less"
+                f"step; use a step of {_stepping.describe_step(_corrected(e, T, v0, None)[2], T)}"
+                " or less"
             )
-        if abs(es.mean() / e - 1) > 0.005 or abs(Ts.mean() / T - 1) > 0.005:
+        tol = _stepping.STEP_TOL
+        if abs(es.mean() / e - 1) > tol or abs(Ts.mean() / T - 1) > tol:
             warnings.append(
                 f"with time step {h:.3g} s MuJoCo realises e = {es.mean():.4g}, T = "
                 f"{Ts.mean():.4g} s instead of e = {e:.4g}, T = {T:.4g} s"

@@ -12,7 +12,7 @@ import optax
 import optimistix as optx
 from jaxtyping import Array
 
-from .._checks import check_scale, is_traced
+from .._checks import MemberChecks, check_scale, is_traced
 from .._curves.shapes import curve_key
 from .._curves.similarity import beta_for_restitution, curve_values
 from .._curves.store import curves_for
@@ -328,45 +328,66 @@ def _as_rows(name, value, rows, allow_missing=False):
     return xp.broadcast_to(value, (rows,)) if rows is not None else value
 
 
-def check_targets(m, v0, e, T, sigma_e, sigma_T, *, sticks=False):
-    """One-line ValueErrors for impossible targets (only for concrete inputs); `sticks`: the
-    law can hold the body (`LawSpec.captures`), so `e = 0` is a measurement."""
-    concrete = not any(is_traced(a) for a in (m, v0, e, T, sigma_e, sigma_T))
-    if not concrete:
-        return
-    if not np.all(np.asarray(m) > 0) or not np.all(np.isfinite(np.asarray(m))):
-        raise ValueError(f"mass m must be a finite number > 0 kg, got {np.asarray(m)}")
-    if np.any(~np.isfinite(np.asarray(v0))) or np.any(np.asarray(v0) <= 0):
-        raise ValueError("every impact speed v0 must be a finite number > 0 m/s")
-    if e is not None:
+def check_targets(m, v0, e, T, sigma_e, sigma_T, *, sticks=False, checks=None):
+    """One-line ValueErrors for impossible targets, each concrete input checked; `sticks`:
+    the law can hold the body (`LawSpec.captures`), so `e = 0` is a measurement. Returns
+    `(m, v0, e, T, sigma_e, sigma_T)`: a traced input (inside `jit` or `vmap`) is not
+    refused but marks the member invalid in `checks` (a `MemberChecks`, whose `refuse`
+    gives that fit NaN) and is replaced by a harmless value."""
+    checks = MemberChecks() if checks is None else checks
+    if not is_traced(m):
+        if not np.all(np.asarray(m) > 0) or not np.all(np.isfinite(np.asarray(m))):
+            raise ValueError(f"mass m must be a finite number > 0 kg, got {np.asarray(m)}")
+    else:
+        m = checks.values(m, _not_positive, "")
+    if not is_traced(v0):
+        if np.any(~np.isfinite(np.asarray(v0))) or np.any(np.asarray(v0) <= 0):
+            raise ValueError("every impact speed v0 must be a finite number > 0 m/s")
+    else:
+        v0 = checks.values(v0, _not_positive, "")
+
+    def out_of_range(a):
+        return ((a < 0) if sticks else (a <= 0)) | (a > 1)
+
+    if e is not None and not is_traced(e):
         ea = np.asarray(e)
         if np.any(np.isnan(ea)):
             raise ValueError("e contains NaN; every row needs a measured restitution")
-        bad = ((ea < 0) if sticks else (ea <= 0)) | (ea > 1)
+        bad = out_of_range(ea)
         if np.any(bad):
             interval = "[0, 1] (0: stuck)" if sticks else "(0, 1]"
             raise ValueError(f"restitution e must lie in {interval}, got {ea[bad]}")
-    if T is not None:
+    elif e is not None:
+        e = checks.values(e, out_of_range, "", harmless=0.5)
+    if T is not None and not is_traced(T):
         Ta = np.asarray(T)
         if np.all(np.isnan(Ta)):
             raise ValueError("T has no value; leave T=None to fit e alone")
         if np.any(Ta[~np.isnan(Ta)] <= 0) or np.any(np.isinf(Ta)):
             raise ValueError("contact durations T must be finite and > 0 s (None: no T)")
-    for name, sigma in (("sigma_e", sigma_e), ("sigma_T", sigma_T)):
-        if sigma is not None and (
-            np.any(~np.isfinite(np.asarray(sigma))) or np.any(np.asarray(sigma) <= 0)
-        ):
-            raise ValueError(f"{name} must be finite and > 0")
+    elif T is not None:  # NaN: a row without T, unless every row is
+        wrong = jnp.all(jnp.isnan(T)) | jnp.any((T <= 0) | jnp.isinf(T))
+        T = checks.mark(wrong, T, 1e-3)
+    sigmas = {"sigma_e": sigma_e, "sigma_T": sigma_T}
+    for name, sigma in sigmas.items():
+        if sigma is not None and not is_traced(sigma):
+            if np.any(~np.isfinite(np.asarray(sigma))) or np.any(np.asarray(sigma) <= 0):
+                raise ValueError(f"{name} must be finite and > 0")
+        elif sigma is not None:
+            sigmas[name] = checks.values(sigma, _not_positive, "")
+    sigma_e, sigma_T = sigmas.values()
     if e is None and T is None:
         raise ValueError("give e, T or both to calibrate against")
-    # sizes float64 carries through a fit: 1e-300 kg refused as 1e300 kg is
+    # sizes float64 carries through a fit: 1e-300 kg refused as 1e300 kg is (traced: left)
     check_scale("mass m", m, "kg")
     check_scale("impact speed v0", v0, "m/s")
-    check_scale("contact energy m v0^2", np.asarray(m, float) * np.asarray(v0, float) ** 2, "J")
+    if not any(is_traced(a) for a in (m, v0)):
+        energy = np.asarray(m, float) * np.asarray(v0, float) ** 2
+        check_scale("contact energy m v0^2", energy, "J")
     for name, value, unit in (("T", T, "s"), ("sigma_e", sigma_e, ""), ("sigma_T", sigma_T, "s")):
         if value is not None:
             check_scale(name, value, unit)
-    if T is not None:
+    if T is not None and not any(is_traced(a) for a in (v0, T)):
         span = np.asarray(v0) * np.asarray(T)  # the contact's reach: x_max < v0 T
         worst = int(np.nanargmax(span)) if np.any(np.isfinite(span)) else None
         if worst is not None and span[worst] > MAX_REACH:
@@ -377,6 +398,11 @@ def check_targets(m, v0, e, T, sigma_e, sigma_T, *, sticks=False):
                 "in m/s?",
                 stacklevel=3,
             )
+    return m, v0, e, T, sigma_e, sigma_T
+
+
+def _not_positive(a):
+    return a <= 0
 
 
 # the reach v0 T (m) above which a target is flagged as implausible for a compliant contact
@@ -595,9 +621,10 @@ def calibrate(
     A batch of fits (one body per element: its own mass, speeds and targets) is `jax.vmap`
     over a lambda, `jax.jit(jax.vmap(lambda m, e, T: calibrate(start, m=m, v0=v0, e=e, T=T)))`,
     which returns one `Fit` whose fields carry a leading batch axis; a batch runs until its
-    slowest member has converged (benchmarks/calibrate.md times 10 000 such fits). Targets
-    are refused (ValueError: e outside (0, 1], T <= 0, NaN, rows of different lengths) only
-    when they are concrete, so check a batch's targets before mapping over them.
+    slowest member has converged (benchmarks/calibrate.md times 10 000 such fits). Concrete
+    inputs are refused (ValueError: m or v0 <= 0, e outside (0, 1], T <= 0, NaN, rows of
+    different lengths); under `jit` or `vmap` a member whose inputs would be refused is
+    not fitted: its `params`, `e`, `T`, `loss` are NaN and `converged` is False.
 
     **Example**:
     `calibrate(law("hertz_rate", c=1e6, b1=100.0), m=1.0, v0=2.5, e=0.85, T=7.8e-3)`.
@@ -625,7 +652,11 @@ def calibrate(
     sigma_e = _as_rows("sigma_e", sigma_e, rows)
     sigma_T = _as_rows("sigma_T", sigma_T, rows)
     sticks = law.spec is not None and law.spec.captures
-    check_targets(m, v0, e, T, sigma_e, sigma_T, sticks=sticks)
+    # eager: a one-line ValueError; traced: a bad member is NaN and invalid (`MemberChecks`)
+    checks = MemberChecks()
+    m, v0, e, T, sigma_e, sigma_T = check_targets(
+        m, v0, e, T, sigma_e, sigma_T, sticks=sticks, checks=checks
+    )
     m = jnp.asarray(m, dtype=float) if is_traced(m) else np.float64(m)
     has_sigma = sigma_e is not None or sigma_T is not None
     free = default_free(law, stiffness=T is not None) if free is None else tuple(free)
@@ -686,6 +717,7 @@ def calibrate(
     # the formulas without gravity are compiled alone
     fit = _fit(law, data, m, 0.0 if g_is_zero else jnp.asarray(g, dtype=float),
                np.float64(target_tol), options)  # fmt: skip
+    fit = checks.refuse(fit, keep=("target_tol", "n_data"), converged=False, reproduces=False)
     e_only = T is None and g_is_zero and shape_of(law) is not None
     return _reported(fit, undetermined, undetermined_why, e_only)
 

@@ -33,6 +33,7 @@ import numpy as np
 
 from .._laws import AbstractLaw
 from .._solve.bounce import bounce_options
+from .._solve.options import default_rtol
 from .bounce_fit import BounceFit, Measurements, find_outliers, finish
 from .bounce_model import (
     BounceProblem,
@@ -158,7 +159,7 @@ def fit_bounces(
     outlier_sigma: float = 5.0,
     max_iter: int = 100,
     tol: float = 1e-10,
-    rtol: float = 1e-8,
+    rtol: float | None = None,
     max_steps: int = 4096,
 ) -> BounceFit:
     """Fit `law` to a bouncing ball of mass `m` (kg): a sampled trajectory `(t, y)` or the
@@ -186,7 +187,8 @@ def fit_bounces(
       fits it starting from that value.
     - `sigma`: measurement noise (s for impact times, y units for a trajectory); default:
       estimated from the residuals.
-    - `rtol`, `max_steps`: each contact's solve; `max_iter`, `tol`: the optimiser.
+    - `rtol`, `max_steps`: each contact's solve (`rtol` as `bounce`'s: by default 1e-11
+      for a law of the table, 1e-12 for a user's law); `max_iter`, `tol`: the optimiser.
     Eager (it sorts data and chooses the model's size), with a compiled core: the chain
     and its forward-mode Jacobian, compiled once per law, data kind and size bucket.
 
@@ -243,7 +245,7 @@ def fit_bounces(
     options = bounce_options(
         separation=separation,
         max_impacts=8,
-        rtol=rtol,
+        rtol=default_rtol(rtol, table_law=law.spec is not None),
         max_steps=max_steps,
         adjoint=dfx.ForwardMode(),
         peaks=False,

@@ -9,17 +9,21 @@ Formats (detected from the file unless `fmt` says):
   `impact_time`, `t`, ...) is a list of impact times, one group per drop when the file has
   other columns that tell drops apart (`where` selects some);
 - plain numbers: two columns are `t y`, one column is impact times.
+
+The file is read as people save it (`_files.read_text`: a byte-order mark, UTF-16, a note
+in cp1252) and each number as `_files.cell_number` reads it.
 """
 
 import math
 from pathlib import Path
 
-from .._files import read_csv
+from .._files import NotText, cell_number, read_csv, read_text
 
 _TIME_NAMES = ("t", "time", "time_s", "t_s", "times", "seconds", "frame")
 _IMPACT_NAMES = ("event_time_s", "impact_time", "impact_times", "impact_time_s", "event_time")
 _HEIGHT_NAMES = ("y", "height", "h", "z", "y_m", "height_m", "position", "y1")
 _IGNORED = ("impact_index", "index", "n")
+_LINE = object()  # the key of a row's line number in the rows of `_read_csv`
 
 
 class Recording:
@@ -31,12 +35,24 @@ class Recording:
 
 
 def parse_number(text):
-    """`float(text)`, or None when it is not a finite number."""
+    """The number in `text` (`_files.cell_number`), or None when it is not a finite one."""
     try:
-        value = float(text)
+        value = cell_number(text)
     except ValueError:
         return None
     return value if math.isfinite(value) else None
+
+
+def _number(cell, where: str) -> float:
+    """The finite number in `cell`; a one-line `ValueError` naming the file, line and column
+    (`where`) of one that is not."""
+    try:
+        value = cell_number(cell or "")
+    except ValueError as error:
+        raise ValueError(f"{where}: {error}") from None
+    if not math.isfinite(value):
+        raise ValueError(f"{where}: {cell.strip()!r} is not a finite number")
+    return value
 
 
 def _read_mtrack(lines):
@@ -84,13 +100,13 @@ def _pick(columns, names):
     return None
 
 
-def _read_csv(text, where, fmt):
+def _read_csv(text, where, fmt, path):
     columns, cells = read_csv(text)
     # as `csv.DictReader` reads them: a short row's missing cells None, a long row's extra
-    # cells dropped
+    # cells dropped; each row's line in the file kept for the messages (`_LINE`)
     rows = [
-        dict(zip(columns, row + [None] * (len(columns) - len(row)), strict=False))
-        for _, row in cells
+        {**dict(zip(columns, row + [None] * (len(columns) - len(row)), strict=False)), _LINE: n}
+        for n, row in cells
     ]
     for condition in where:
         column, sep, value = condition.partition("=")
@@ -129,10 +145,7 @@ def _read_csv(text, where, fmt):
         groups.setdefault(key, []).append(row)
 
     def numbers(group, column):
-        values = [parse_number(r[column]) for r in group]
-        if any(v is None for v in values):
-            raise ValueError(f"column {column!r} has a value that is not a number")
-        return values
+        return [_number(r[column], f"{path}, line {r[_LINE]}, column {column}") for r in group]
 
     if kind == "trajectory":
         data = {k: (numbers(g, time_column), numbers(g, height_column)) for k, g in groups.items()}
@@ -144,10 +157,10 @@ def _read_csv(text, where, fmt):
 def read_recording(path: Path, fmt: str = "auto", where=()) -> Recording:
     """Read FILE (see the module docstring); a `ValueError` for anything it cannot use."""
     try:
-        text = path.read_text()
+        text = read_text(path)
     except OSError as error:
         raise ValueError(f"cannot read {path}: {error.strerror or error}") from None
-    except UnicodeDecodeError:
+    except NotText:
         raise ValueError(f"{path} is not a text file") from None
     lines = [line for line in text.splitlines() if line.strip()]
     if not lines:
@@ -164,7 +177,7 @@ def read_recording(path: Path, fmt: str = "auto", where=()) -> Recording:
         if where:
             raise ValueError("--where applies to CSV files with named columns")
     else:
-        recording = _read_csv(text, where, fmt)
+        recording = _read_csv(text, where, fmt, path)
     if fmt != "auto" and recording.kind != fmt:
         raise ValueError(f"{path} holds {recording.kind}, not {fmt}")
     return recording

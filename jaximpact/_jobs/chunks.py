@@ -11,7 +11,6 @@ import json
 import numpy as np
 
 from .._batch import GLOBAL, mark_invalid, run_impacts
-from .._laws import LAWS
 from .._status import Status
 from .parts import FLOAT_OUTPUTS
 from .processes import ProcessGroup
@@ -20,12 +19,12 @@ _STATUS_NAMES = np.array([Status(i).name if i in set(map(int, Status)) else "" f
                           range(max(map(int, Status)) + 1)], object)  # fmt: skip
 
 
-def compute_chunk(law: str, cells, fixed: dict, options: dict, group: ProcessGroup | None) -> dict:
-    """The impacts of one chunk (`cells`, whose values `row_checks` accepted; `fixed`: the
-    values given for every row; `options`: `impact`'s keywords); rows grouped by
-    separation, by whether gravity is zero and by the law's shape parameters, so that each
-    row's path depends on that row alone (not on the chunk it falls in). Returns `OUTPUTS`
-    -> one entry per row.
+def compute_chunk(law, cells, fixed: dict, options: dict, group: ProcessGroup | None) -> dict:
+    """The impacts of one chunk (`cells`, whose values `row_checks` accepted; `law`: a
+    `job_law.JobLaw`; `fixed`: the values given for every row; `options`: `impact`'s
+    keywords); rows grouped by separation, by whether gravity is zero and by the law's
+    shape parameters, so that each row's path depends on that row alone (not on the chunk
+    it falls in). Returns `OUTPUTS` -> one entry per row.
 
     With `group`, every process of it calls `compute_chunk` at once (`cells` None where it
     has nothing to compute): the processes agree on the row groups of the round, and each
@@ -33,7 +32,6 @@ def compute_chunk(law: str, cells, fixed: dict, options: dict, group: ProcessGro
     process giving the same number of rows: the group's first row of the first process
     that has it (so that every process takes the same path and shapes), its own rows, and
     that first row again as padding."""
-    spec = LAWS[law]
     rows = 0 if cells is None else cells.rows
     values = {} if cells is None else cells.values
     given = {k: np.broadcast_to(np.asarray(v, float), (rows,)) for k, v in fixed.items()
@@ -41,8 +39,8 @@ def compute_chunk(law: str, cells, fixed: dict, options: dict, group: ProcessGro
     given.update({k: v for k, v in values.items() if k != "separation"})
     given.setdefault("g", np.zeros(rows))
     sep = values.get("separation", np.full(rows, fixed.get("separation", "force"), object))
-    columns = (*spec.parameters, "m", "v0", "g")
-    local = _row_groups(spec, given, sep, values) if rows else {}  # key -> this chunk's rows
+    columns = (*law.parameters, "m", "v0", "g")
+    local = _row_groups(law, given, sep, values) if rows else {}  # key -> this chunk's rows
     plan = {key: (None, idx.size) for key, idx in local.items()}  # key -> (first row, rows)
     if group is not None:
         plan = _shared_plan(group, local, given, columns)
@@ -57,10 +55,11 @@ def compute_chunk(law: str, cells, fixed: dict, options: dict, group: ProcessGro
             inputs = {k: np.concatenate([[first[j]], inputs[k], np.full(size - idx.size, first[j])])
                       for j, k in enumerate(columns)}  # fmt: skip
         done = run_impacts(
-            ("law", law), {k: inputs[k] for k in spec.parameters},
+            law.skeleton, {k: inputs[k] for k in law.parameters},
             {k: inputs[k] for k in ("m", "v0", "g")}, separation=json.loads(key)[0],
             fields=(*FLOAT_OUTPUTS, "status"), progress=False,
-            **({"devices": GLOBAL} if group is not None else {}), **options,
+            **({"devices": GLOBAL} if group is not None else {}),
+            **{"rtol": None, **options},  # as `impact`: 1e-11, a user's law 1e-12
         )  # fmt: skip
         if not idx.size:
             continue
@@ -73,12 +72,12 @@ def compute_chunk(law: str, cells, fixed: dict, options: dict, group: ProcessGro
     return {**results, "status": status.tolist(), "path": path.tolist()}
 
 
-def _row_groups(spec, given: dict, sep, values: dict) -> dict:
+def _row_groups(law, given: dict, sep, values: dict) -> dict:
     """The rows of a chunk by group, `json` key `[separation, g == 0, shape parameters]` ->
     row indices: the rows that share a path and a compiled program."""
     keys = [np.unique(sep, return_inverse=True)[1]] if "separation" in values else []
     keys += [given["g"] == 0.0] if "g" in values else []
-    keys += [np.unique(values[k], return_inverse=True)[1] for k in spec.shape_parameters
+    keys += [np.unique(values[k], return_inverse=True)[1] for k in law.shape_parameters
              if k in values]  # fmt: skip
     group_of = np.zeros(len(sep), int)
     if keys:
@@ -87,7 +86,7 @@ def _row_groups(spec, given: dict, sep, values: dict) -> dict:
     groups = {}
     for number in range(int(group_of.max()) + 1):
         idx = np.flatnonzero(group_of == number)
-        shape = [float(given[k][idx[0]]) for k in spec.shape_parameters]
+        shape = [float(given[k][idx[0]]) for k in law.shape_parameters]
         groups[json.dumps([str(sep[idx[0]]), bool(given["g"][idx[0]] == 0.0), shape])] = idx
     return groups
 

@@ -13,6 +13,9 @@ and `path`.
   hash are there and recomputes those whose input changed;
 - `join`: the parts joined into `OUT` (renamed into place) once all are done.
 
+From `check` to `join` the run holds `OUT.lock` (`_files.output_lock`): a second run on the
+same output is refused in one line, before any work, naming the first run's process.
+
 Memory holds one chunk at a time. Under `jax.distributed` chunk `k` is process `k mod N`'s to
 read, check and write (`processes`); each process runs its own chunks on its own devices
 (`mesh="local"`), or each round of chunks, one per process, runs as one program over the
@@ -20,6 +23,7 @@ devices of all processes (`mesh="global"`); process 0 joins the parts: the same 
 for bit, as one process writes.
 """
 
+import contextlib
 import dataclasses
 import hashlib
 import json
@@ -27,13 +31,12 @@ import os
 import time
 from pathlib import Path
 
-from .._choices import unknown_name
-from .._files import check_outputs, check_suffix, temporary_name
+from .._files import check_outputs, check_suffix, lock_name, output_lock, temporary_name
 from .._interrupt import check_interrupt, set_note
-from .._laws import LAW_NAMES, LAWS
 from .._progress import AbstractMeter, metered
 from .._status import Status
 from .chunks import compute_chunk
+from .job_law import JobLaw, job_law
 from .parts import Parts
 from .processes import ProcessGroup
 from .readers import (
@@ -71,7 +74,8 @@ class BatchFile:
 class Job:
     """A file job, as each step leaves it (`plan`, `check`, `compute`).
 
-    `law` (a name of the law table); `table`, the reader of the rows (`readers`), `label`
+    `law`, the law as the job reads it (`job_law.JobLaw`: a name of the law table, a law of
+    the table or a user's law); `table`, the reader of the rows (`readers`), `label`
     its name for messages and `from_file` whether it is a file; `out` and its `parts`;
     `columns` of the table; `fixed`: the values every row takes from the arguments (law
     parameters, `m`, `v0`, `g`, `separation`); `agree`: the arguments that a column of
@@ -83,7 +87,7 @@ class Job:
     them it `computed` and `reused`.
     """
 
-    law: str
+    law: JobLaw
     table: object
     label: str
     from_file: bool
@@ -128,15 +132,20 @@ def batch_file(source, out, law, *, params: dict | None = None, m: float | None 
       1-D array or number (dicts of numpy arrays, pandas DataFrames), each chunk used as
       given (not `chunk_rows`). A list is read twice (every value checked first); a
       generator once, each chunk checked just before it is computed.
-    - `law`: a name of `LAW_NAMES`. The file's columns give, per row, any of its parameters
-      and `m` (kg), `v0` (m/s), `g` (m/s^2), `separation`; `params`, `m`, `v0`, `g`,
-      `separation` give the rest (SI units; `g` 0 and `separation` "force" where neither
-      gives them). A column and an argument for the same name must agree on every row: a
-      `ValueError` names the first row where they do not.
+    - `law`: a name of `LAW_NAMES`, a law from `jaximpact.law` (its parameters are the
+      values every row takes unless a column or `params` gives them) or a user's law from
+      `custom_law` (the same; and any column other than `m`, `v0`, `g`, `separation` is a
+      parameter it reads, as is every name of `params`: one it does not read is refused,
+      and so is a parameter it reads that nothing gives). The file's columns give, per row,
+      any of its parameters and `m` (kg), `v0` (m/s), `g` (m/s^2), `separation`; `params`,
+      `m`, `v0`, `g`, `separation` give the rest (SI units; `g` 0 and `separation` "force"
+      where neither gives them). A column and an argument for the same name must agree on
+      every row: a `ValueError` names the first row where they do not.
     - `impact_options` (`method`, `rtol`, ...): as in `impact`.
     - `chunk_rows`: rows per chunk (the unit of memory, of work per process and of
       resumption). `resume`: reuse the chunks an interrupted run left in `OUT.parts/` whose
-      inputs and settings have not changed; recompute the others.
+      inputs and settings have not changed (the law among them: a user's law by its
+      function's name, file and code, and its parameters); recompute the others.
     - `progress`: a meter of the checking pass and of the chunks: `True` the default one (on
       stderr), `False` none, or an `AbstractMeter`.
 
@@ -152,21 +161,40 @@ def batch_file(source, out, law, *, params: dict | None = None, m: float | None 
     for bit.
 
     **Example**: `batch_file("bodies.csv", "impacts.csv", "hertz_rate", params={"b1": 800.0},
-    m=1.0)`.
+    m=1.0)`, or with a user's law
+    `batch_file("bodies.csv", "impacts.csv", custom_law(f, c=2e6, b1=800.0), m=1.0)`.
     """
     given = {"m": m, "v0": v0, "g": g, "separation": separation}
     job = plan(source, out, law, params=params, given=given, chunk_rows=chunk_rows,
                resume=resume, progress=progress, mesh=mesh,
                impact_options=impact_options)  # fmt: skip
-    return join(compute(check(job)))
+    with _one_writer(job):
+        return join(compute(check(job)))
+
+
+@contextlib.contextmanager
+def _one_writer(job: Job):
+    """Process 0 holds the lock of `job.out` (`_files.output_lock`) from the check to the
+    join, so that two runs never write one output and its parts: a second run is refused
+    in one line before any work, and every process of this one learns of it."""
+    with contextlib.ExitStack() as stack:
+        problem = None
+        if job.group.index == 0:
+            try:
+                stack.enter_context(output_lock(job.out))
+            except ValueError as error:
+                problem = str(error)
+        problem = next((p for p in job.group.gather(problem) if p is not None), None)
+        if problem is not None:
+            raise ValueError(problem)
+        yield
 
 
 def plan(source, out, law, *, params, given, chunk_rows, resume, progress, mesh,
          impact_options) -> Job:  # fmt: skip
     """The job of `batch_file`'s arguments (`given`: its `m`, `v0`, `g`, `separation`), each
     checked, and the table opened: a one-line `ValueError` before any work."""
-    if law not in LAWS:
-        raise ValueError(unknown_name("law", law, LAW_NAMES))
+    law = job_law(law)
     if mesh not in ("global", "local"):
         raise ValueError(f"mesh must be 'global' or 'local', got {mesh!r}")
     if isinstance(chunk_rows, bool) or not (isinstance(chunk_rows, int) and chunk_rows >= 1):
@@ -177,12 +205,13 @@ def plan(source, out, law, *, params, given, chunk_rows, resume, progress, mesh,
     check_output_file(out, source if from_file else None)
     if is_parquet(out):
         require_pyarrow(out)
-    spec = LAWS[law]
-    fixed, agree = _given_for_every_row(law, params or {}, given)
-    allowed = (*spec.parameters, *KINEMATICS, *TEXT_COLUMNS)
+    params = params or {}
+    fixed, agree = _given_for_every_row(law, params, given)
+    allowed = law.allowed
     table = open_table(source, allowed) if from_file else open_chunks(source, allowed)
     columns = table.columns
-    missing = [k for k in (*spec.parameters, "m", "v0") if k not in columns and k not in fixed]
+    law = law.complete(columns, params, source.name if from_file else "chunks")
+    missing = [k for k in (*law.parameters, "m", "v0") if k not in columns and k not in fixed]
     if missing:
         raise ValueError(
             f"{source if from_file else 'chunks'}: no value for {', '.join(missing)}: give a "
@@ -191,7 +220,7 @@ def plan(source, out, law, *, params, given, chunk_rows, resume, progress, mesh,
     fixed = {k: v for k, v in fixed.items() if k not in columns}
     agree = {k: v for k, v in agree.items() if k in columns}  # checked row by row
     settings = json.dumps(
-        [_FORMAT, law, columns, sorted((k, repr(v)) for k, v in fixed.items()),
+        [_FORMAT, law.identity, columns, sorted((k, repr(v)) for k, v in fixed.items()),
          sorted((k, repr(v)) for k, v in impact_options.items()), is_parquet(out)]
     )  # fmt: skip
     return Job(
@@ -204,12 +233,14 @@ def plan(source, out, law, *, params, given, chunk_rows, resume, progress, mesh,
     )  # fmt: skip
 
 
-def _given_for_every_row(law: str, params: dict, given: dict) -> tuple[dict, dict]:
+def _given_for_every_row(law: JobLaw, params: dict, given: dict) -> tuple[dict, dict]:
     """`(fixed, agree)`: the values every row takes where no column gives them (the law's
     defaults, `params`, `given`; `g` 0 and `separation` "force" by default), each checked,
-    and the arguments the caller gave, which a column of the same name must agree with."""
-    spec = LAWS[law]
-    unknown = sorted(set(params) - set(spec.parameters))
+    and the arguments the caller gave, which a column of the same name must agree with. A
+    user's law takes any name in `params` but `m`, `v0`, `g`, `separation` (what its
+    function reads is checked once the table's columns are known: `JobLaw.complete`)."""
+    named = [k for k in params if k in (*KINEMATICS, *TEXT_COLUMNS)] if law.user else params
+    unknown = sorted(set(named) - set(law.parameters))
     if unknown:
         own = [k for k in unknown if k in (*KINEMATICS, *TEXT_COLUMNS)]
         hint = (
@@ -219,10 +250,11 @@ def _given_for_every_row(law: str, params: dict, given: dict) -> tuple[dict, dic
             if own
             else ""
         )
-        raise ValueError(f"law {law!r} has no parameter {', '.join(unknown)}; it takes "
-                         f"{', '.join(spec.parameters)}{hint}")  # fmt: skip
+        takes = ", ".join(law.parameters) or "what its function reads"
+        raise ValueError(f"law {law.label!r} has no parameter {', '.join(unknown)}; it takes "
+                         f"{takes}{hint}")  # fmt: skip
     agree = {**params, **{k: v for k, v in given.items() if v is not None}}
-    fixed = {**spec.defaults, **params, "separation": given["separation"] or "force"}
+    fixed = {**law.defaults, **params, "separation": given["separation"] or "force"}
     fixed.update({k: given[k] for k in KINEMATICS if given[k] is not None})
     fixed.setdefault("g", 0.0)
     check_fixed(law, fixed)
@@ -286,7 +318,7 @@ def compute(job: Job) -> Job:
     computed = reused = done_rows = 0
     own_rows, start, failed = _own_rows(job, own), time.perf_counter(), True
     try:
-        with metered(job.progress, max(len(own), 1), f"batch {job.law}{job.tag}") as bar:
+        with metered(job.progress, max(len(own), 1), f"batch {job.law.label}{job.tag}") as bar:
             for round_ in _rounds(enumerate(table.chunks(job.chunk_rows)), group.count):
                 check_interrupt()  # a safe point: Ctrl-C or SIGTERM stops here at the latest
                 if job.one_pass:
@@ -354,10 +386,10 @@ def join(job: Job) -> BatchFile:
 def check_output_file(out, source=None, label: str = "out"):
     """Refuse, before any work, an output `out` that `batch_file` cannot write or that
     would destroy the input file `source`: an extension other than `OUT_SUFFIXES`, a
-    directory that does not exist, `out` (or the temporary name it is written under) the
-    same file as `source` however spelled (links included), or `source` inside
-    `OUT.parts/`, which the run writes and removes. A one-line `ValueError` that names the
-    output as `label` (the command line's `--out`)."""
+    directory that does not exist, `out` (or the temporary name it is written under, or
+    its lock `OUT.lock`) the same file as `source` however spelled (links included), or
+    `source` inside `OUT.parts/`, which the run writes and removes. A one-line
+    `ValueError` that names the output as `label` (the command line's `--out`)."""
     out = Path(out)
     check_suffix(out, OUT_SUFFIXES, label)
     if out.parent != Path("") and not out.parent.is_dir():
@@ -366,7 +398,8 @@ def check_output_file(out, source=None, label: str = "out"):
         raise ValueError(f"{label} {out}: is a directory; name the file to write")
     check_outputs(
         [source],
-        {label: out, f"{label} (written first as)": temporary_name(out)},
+        {label: out, f"{label} (written first as)": temporary_name(out),
+         f"{label} (its lock)": lock_name(out)},  # fmt: skip
         {f"{label} (its parts directory)": Parts(out, parquet=is_parquet(out)).dir},
     )
 

@@ -5,10 +5,13 @@ chunk of `rows` data rows as it is on disk (cheap: no number is parsed), and who
 `parse(chunk)` turns one chunk into `Cells`: the columns as arrays (float64; `separation` as
 text), a SHA-256 of the chunk's bytes, the input lines as written (CSV), and where each row
 is in the file (`line N` of a CSV counting the header as 1, `row N` of a Parquet file).
-Memory holds one chunk at a time. A bad header or cell is a one-line `ValueError` naming the
-file, the line (or row) and the column.
+A CSV is read as people save it (`_files.open_text`: UTF-8 with or without a byte-order
+mark, UTF-16, any line ends, a line that is not UTF-8 as cp1252), and each number as
+`_files.cell_number` reads it. Memory holds one chunk at a time. A bad header or cell is a
+one-line `ValueError` naming the file, the line (or row) and the column.
 """
 
+import contextlib
 import csv
 import dataclasses
 import hashlib
@@ -16,6 +19,8 @@ import itertools
 from pathlib import Path
 
 import numpy as np
+
+from .._files import NotText, as_read, cell_number, open_text
 
 TEXT_COLUMNS = ("separation",)  # columns of words, not numbers
 PARQUET_SUFFIXES = (".parquet", ".pq")
@@ -79,10 +84,13 @@ class CsvTable:
         self.path = path
         self.where_header = f"{path}, line 1"
         try:
-            with open(path, newline="") as handle:
-                header = next(csv.reader(handle), None)
+            with open_text(path) as handle:
+                first = as_read(handle.readline())
+        except NotText as error:
+            raise ValueError(f"{path}: {error}") from None
         except (OSError, UnicodeDecodeError) as error:
             raise ValueError(f"{path}: cannot read it as text ({error})") from None
+        header = next(csv.reader([first]), None)
         if not header or not any(name.strip() for name in header):
             raise ValueError(f"{path}: empty file; its first line must name the columns")
         self.columns = tuple(name.strip() for name in header)
@@ -90,30 +98,36 @@ class CsvTable:
     def chunks(self, rows: int):
         """`(first line number, data lines, their line numbers or None if consecutive)` per
         chunk of `rows` data rows, in file order."""
-        with open(self.path, newline=None) as handle:
+        with open_text(self.path) as handle:
             next(handle)
-            number = 2
-            while True:
-                lines, numbers, first = [], None, number
-                for line in itertools.islice(handle, rows):
-                    lines.append(line)
-                number += len(lines)
-                if not lines:
-                    return
-                if any(not line.strip() for line in lines):  # blank lines: keep the numbers
-                    numbers = [first + i for i, line in enumerate(lines) if line.strip()]
-                    lines = [line for line in lines if line.strip()]
-                    while len(lines) < rows:  # fill the chunk up to `rows` data rows
-                        line = handle.readline()
-                        if not line:
-                            break
-                        if line.strip():
-                            lines.append(line)
-                            numbers.append(number)
-                        number += 1
+            number = first = 2
+            try:
+                while True:
+                    lines, numbers, first = [], None, number
+                    for line in itertools.islice(handle, rows):
+                        lines.append(line)
+                    number += len(lines)
                     if not lines:
-                        continue
-                yield first, lines, numbers
+                        return
+                    if any(not line.strip() for line in lines):  # blank lines: keep the numbers
+                        numbers = [first + i for i, line in enumerate(lines) if line.strip()]
+                        lines = [line for line in lines if line.strip()]
+                        while len(lines) < rows:  # fill the chunk up to `rows` data rows
+                            line = handle.readline()
+                            if not line:
+                                break
+                            if line.strip():
+                                lines.append(line)
+                                numbers.append(number)
+                            number += 1
+                        if not lines:
+                            continue
+                    yield first, lines, numbers
+            except UnicodeDecodeError as error:  # UTF-16 or UTF-32 whose bytes are not
+                raise ValueError(
+                    f"{self.path}, lines {first} on: bytes that are not "
+                    f"{error.encoding.upper()}; save the file again as CSV"
+                ) from None
 
     @staticmethod
     def size(chunk) -> int:
@@ -135,7 +149,8 @@ class CsvTable:
         def where(i):
             return f"{path}, line {numbers[i] if numbers else first + i}"
 
-        lines = [line.rstrip("\r\n") for line in lines]
+        # the lines that are not UTF-8 read as cp1252 (`_files.as_read`), one pass over all
+        lines = as_read("\n".join(line.rstrip("\n") for line in lines)).split("\n")
         digest = hashlib.sha256("\n".join(lines).encode()).digest()
         columns, ncol = self.columns, len(self.columns)
         numeric = [j for j, name in enumerate(columns) if name not in TEXT_COLUMNS]
@@ -149,16 +164,15 @@ class CsvTable:
         if any(c != ncol for c in counts):
             i = next(i for i, c in enumerate(counts) if c != ncol)
             raise ValueError(f"{where(i)}: {counts[i]} cells for {ncol} columns")
-        try:
-            if quoted:
-                table = np.array([[cells[j] for j in numeric] for cells in rows], dtype=float)
-            else:
-                table = np.loadtxt(lines, delimiter=",", dtype=float, usecols=numeric, ndmin=2)
-        except ValueError:
-            table = None
+        table = None
+        if not quoted:
+            with contextlib.suppress(ValueError):
+                table = np.loadtxt(lines, delimiter=",", dtype=float, usecols=numeric,
+                                   ndmin=2, comments=None)  # fmt: skip
         if table is None or table.shape != (len(lines), len(numeric)):
-            _name_the_bad_cell(lines, columns, numeric, where)
-            raise ValueError(f"{path}: cannot read the numbers of lines {where(0)} on")
+            # quoted cells, or a cell numpy does not read: each cell as `cell_number` reads
+            # it (as every reader of tables does), the first that is not a number named
+            table = _numbers(rows if quoted else csv.reader(lines), columns, numeric, where)
         values = {columns[j]: table[:, k] for k, j in enumerate(numeric)}
         for j, name in enumerate(columns):
             if name in TEXT_COLUMNS:
@@ -168,18 +182,19 @@ class CsvTable:
         return Cells(values, len(lines), digest, lines, where)
 
 
-def _name_the_bad_cell(lines, columns, numeric, where):
-    """Raise the one-line error for the first cell that is not a number."""
-    for i, cells in enumerate(csv.reader(lines)):
+def _numbers(rows, columns, numeric, where) -> np.ndarray:
+    """The cells `numeric` of `rows` read one by one (`_files.cell_number`); a one-line
+    `ValueError` naming the first that is not a number (its file, line and column)."""
+    table = []
+    for i, cells in enumerate(rows):
+        row = []
         for j in numeric:
-            cell = cells[j].strip()
             try:
-                float(cell)
-            except ValueError:
-                shown = repr(cell) if cell else "an empty cell"
-                raise ValueError(
-                    f"{where(i)}, column {columns[j]}: {shown} is not a number"
-                ) from None
+                row.append(cell_number(cells[j]))
+            except ValueError as error:
+                raise ValueError(f"{where(i)}, column {columns[j]}: {error}") from None
+        table.append(row)
+    return np.array(table, dtype=float).reshape(len(table), len(numeric))
 
 
 class ParquetTable:

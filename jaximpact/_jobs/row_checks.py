@@ -1,29 +1,47 @@
 """The values of a table of bodies checked before any work: every mass `m` (kg) and speed `v0`
 (m/s) finite and > 0, gravity `g` (m/s^2) finite and >= 0, every law parameter as the law
-table requires it (stiffness > 0, dampings >= 0, ...), `separation` one of its two words. The
-first bad value is one line naming its place (line or row) and column."""
+table requires it (stiffness > 0, dampings >= 0, ...; a user's law's: finite), `separation`
+one of its two words. The first bad value is one line naming its place (line or row) and
+column."""
 
 import numpy as np
-
-from .._laws import LAWS, law as make_law
-from .._laws.named_law import invalid_parameter_rows
 
 KINEMATICS = ("m", "v0", "g")
 SEPARATIONS = ("force", "penetration")
 _POSITIVE = ("m", "v0")
 
 
-def _rule(key, positive):
+def _rule(key, positive, signed=()):
     def bad(a):
         with np.errstate(invalid="ignore"):
+            if key in signed:  # a user's law's parameter: any finite number
+                return ~np.isfinite(a)
             return ~np.isfinite(a) | ((a <= 0) if key in positive else (a < 0))
 
     return bad
 
 
-def check_fixed(law: str, fixed: dict):
-    """The values given for every row (`--param`, `--mass`, ...): numbers in range."""
-    positive = (*_POSITIVE, *LAWS[law].positive)
+def _need(key, positive, signed) -> str:
+    return "" if key in signed else (" > 0" if key in positive else " >= 0")
+
+
+def _signed(law, keys) -> tuple:
+    """The parameters among `keys` that may take any sign: a user's law's (it decides)."""
+    return tuple(k for k in keys if k not in KINEMATICS) if law.user else ()
+
+
+def _job_law(law):
+    """`law` as a file job reads it (`job_law.JobLaw`; a name of the table is looked up)."""
+    from .job_law import job_law
+
+    return job_law(law) if isinstance(law, str) else law
+
+
+def check_fixed(law, fixed: dict):
+    """The values given for every row (`--param`, `--mass`, ...): numbers in range (`law`:
+    a `JobLaw`, or a name of the law table)."""
+    law = _job_law(law)
+    positive, signed = (*_POSITIVE, *law.positive), _signed(law, fixed)
     for key, value in fixed.items():
         if key == "separation":
             if value not in SEPARATIONS:
@@ -33,9 +51,9 @@ def check_fixed(law: str, fixed: dict):
             number = float(value)
         except (TypeError, ValueError):
             raise ValueError(f"fixed value {key}: {value!r} is not a number") from None
-        if _rule(key, positive)(np.asarray(number)):
-            need = "> 0" if key in positive else ">= 0"
-            raise ValueError(f"fixed value {key}: {key} = {value!s} must be a finite number {need}")
+        if _rule(key, positive, signed)(np.asarray(number)):
+            need = _need(key, positive, signed)
+            raise ValueError(f"fixed value {key}: {key} = {value!s} must be a finite number{need}")
 
 
 # how a value given for every row is named: the command line's option (Python's argument)
@@ -52,14 +70,14 @@ def option_name(key: str) -> str:
     return _OPTIONS.get(key, f"--param {key}= (params={{{key!r}: ...}})")
 
 
-def check_rows(law: str, values: dict, fixed: dict, where, options=None):
+def check_rows(law, values: dict, fixed: dict, where, options=None):
     """Raise a one-line `ValueError` at the first row (file order) with a bad value in
     `values` (column -> array), or whose column disagrees with the value `options` (name ->
     value, the options the caller gave for every row) holds for it: a column and an option
-    that disagree are refused, never settled silently. `fixed` completes the law's
-    parameters; `where(i)` says where row `i` is."""
-    spec = LAWS[law]
-    positive = (*_POSITIVE, *spec.positive)
+    that disagree are refused, never settled silently. `law`: a `JobLaw` (or a name of the
+    law table); `fixed` completes its parameters; `where(i)` says where row `i` is."""
+    law = _job_law(law)
+    positive, signed = (*_POSITIVE, *law.positive), _signed(law, {**fixed, **values})
     options = options or {}
     rows = len(next(iter(values.values())))
     first, message = rows, None
@@ -67,14 +85,14 @@ def check_rows(law: str, values: dict, fixed: dict, where, options=None):
         if key == "separation":
             bad = ~np.isin(column, SEPARATIONS)
         else:
-            bad = _rule(key, positive)(column)
+            bad = _rule(key, positive, signed)(column)
         if bad[:first].any():
             i = int(np.argmax(bad))
             if key == "separation":
                 text = f"{column[i]!r} is not 'force' or 'penetration'"
             else:
-                need = "> 0" if key in positive else ">= 0"
-                text = f"{key} = {float(column[i])!r} must be a finite number {need}"
+                need = _need(key, positive, signed)
+                text = f"{key} = {float(column[i])!r} must be a finite number{need}"
             first, message = i, f"{where(i)}, column {key}: {text}"
         if key in options:
             given = options[key]
@@ -92,15 +110,11 @@ def check_rows(law: str, values: dict, fixed: dict, where, options=None):
                 )
                 first, message = i, f"{where(i)}, column {key}: {text}"
     params = {k: np.broadcast_to(np.asarray(v, float), (rows,)) for k, v in
-              {**fixed, **values}.items() if k in spec.parameters}  # fmt: skip
-    bad = invalid_parameter_rows(law, params)
+              {**fixed, **values}.items() if k in law.parameters}  # fmt: skip
+    bad = law.invalid_rows(params)
     if bad[:first].any():  # a rule of the law table beyond the signs (e_nominal <= 1, p <= n)
         i = int(np.argmax(bad))
-        try:
-            make_law(law, **{k: float(v[i]) for k, v in params.items()})
-            text = "the law's parameters are out of range"
-        except ValueError as error:
-            text = str(error)
+        text = law.refusal({k: float(v[i]) for k, v in params.items()})
         first, message = i, f"{where(i)}: {text}"
     if message is not None:
         raise ValueError(message)

@@ -6,6 +6,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from .._batch import IMPACT_FIELDS, impacts
+from .._laws import AbstractLaw
 from .._progress import AbstractMeter
 from .job import BatchFile, batch_file
 
@@ -19,7 +20,7 @@ def impact_batch(
     g=0.0,
     separation: str = "force",
     method: str = "auto",
-    rtol: float = 1e-11,
+    rtol: float | None = None,
     peaks: bool = True,
     fields: tuple = IMPACT_FIELDS,
     order: str = "cost",
@@ -39,7 +40,8 @@ def impact_batch(
     - `m` (kg), `v0` (m/s), `g` (m/s^2, along the inward normal): numbers or 1-D arrays.
       Every array is broadcast against the others: `n` rows.
     - `separation`, `method`, `rtol`, `peaks` and `impact_options` (`solver`, `atol`,
-      `max_steps`, `tau_max`, `rest_tol`): as in `jaximpact.impact`.
+      `max_steps`, `tau_max`, `rest_tol`): as in `jaximpact.impact` (`rtol` by default
+      1e-11; to a file, `impact`'s: 1e-11, a user's law 1e-12).
     - `fields`: which `ImpactResult` fields to return (default `e, T, x_max, F_max, status`);
       with `peaks=False` the peak fields are left out.
     - `order`: `"cost"` (default) runs the rows sorted by their dimensionless groups (which
@@ -62,8 +64,9 @@ def impact_batch(
     column -> array, each holding any of the law's parameters and `m`, `v0`, `g`,
     `separation`; a generator is read once) and `out` a CSV or Parquet path, each chunk is
     computed and written as it comes, and a `BatchFile` record is returned (see
-    `batch_file`; `resume=True` reuses the chunks an interrupted run finished). `law` must
-    then be a name.
+    `batch_file`; `resume=True` reuses the chunks an interrupted run finished). `law` is
+    then a name, or a law (`jaximpact.law`, `custom_law`) whose parameters are the values
+    every row takes unless a chunk's column gives them.
 
     **Example**:
     ```python
@@ -81,7 +84,7 @@ def impact_batch(
             g=g,
             separation=separation,
             method=method,
-            rtol=rtol,
+            rtol=1e-11 if rtol is None else rtol,
             peaks=peaks,
             fields=fields,
             order=order,
@@ -92,8 +95,11 @@ def impact_batch(
             invalid=invalid,
             **impact_options,
         )
-    if not isinstance(law, str):
-        raise ValueError("impact_batch with chunks and out= takes a law name (see LAW_NAMES)")
+    if not isinstance(law, (str, AbstractLaw)):
+        raise ValueError(
+            "impact_batch with chunks and out= takes a law name (see LAW_NAMES), a law from "
+            f"jaximpact.law or a user's law from custom_law, got {type(law).__name__}"
+        )
     if out is None:
         raise ValueError("impact_batch over chunks needs out= (a CSV or Parquet path)")
     if params is None:
@@ -105,4 +111,5 @@ def impact_batch(
     default_g = isinstance(g, (int, float)) and not isinstance(g, bool) and g == 0.0
     return batch_file(params, out, law, m=m, v0=v0, g=None if default_g else g,
                       separation=None if separation == "force" else separation,
-                      progress=progress, method=method, rtol=rtol, **impact_options)  # fmt: skip
+                      progress=progress, method=method,
+                      **({} if rtol is None else {"rtol": rtol}), **impact_options)  # fmt: skip

@@ -16,6 +16,7 @@ All in SI units; every function is differentiable and NaN-free, including at cri
 damping (`b^2 = 4 m c`), where the under- and over-damped formulas meet.
 """
 
+import dataclasses
 import functools
 import math
 
@@ -272,8 +273,9 @@ def exact_batch(law, *, m, v0, separation: str, g=0.0, rest_tol=1e-7) -> dict | 
         return None
     params = law.parameters
     shape = np.broadcast_shapes(*(np.shape(v) for v in params.values()))
-    batch = law.replace(**{k: jnp.broadcast_to(jnp.asarray(v, float), shape or (1,))
-                           for k, v in params.items()})  # fmt: skip
+    # checked when `law` was built; `replace` would take one number per parameter
+    batch = dataclasses.replace(law, params={k: jnp.broadcast_to(jnp.asarray(v, float),
+                                shape or (1,)) for k, v in params.items()})  # fmt: skip
     solve = _batch_solve(law.spec.closed_form, separation, rest_tol, float(g))
     out = solve(batch, jnp.asarray(m, float), jnp.asarray(v0, float))
     return {k: np.asarray(out[k]).reshape(shape) for k in ("e", "T", "status")}

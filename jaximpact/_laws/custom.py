@@ -82,6 +82,13 @@ def custom_law(fn: Callable, **params) -> CustomLaw:
     `jnp.maximum(F, 0)` (or `jnp.clip`, `jax.nn.relu`, `jnp.where(F > 0, F, 0)`), is
     integrated as written, and contact ends where the clamped force reaches zero.
 
+    It goes wherever a law of the table goes, files included: `batch_file(...)` and
+    `impact_batch(..., out=)` take it (its parameters are the values every row takes
+    unless a column gives them; a resume checks the function's name, file and code and the
+    parameters). On the command line, `--law FILE.py:NAME --param c=2e6 ...` is
+    `custom_law(NAME, c=2e6, ...)` for the function `NAME(x, v, params)` of a Python file,
+    named `FILE.py:NAME` in the output.
+
     **Example**:
     `custom_law(lambda x, v, p: p["c"] * x**1.5 * (1 + p["a"] * v), c=2e6, a=0.2)`.
     """

@@ -111,13 +111,24 @@ def law(name: str, **params) -> AbstractLaw:
 
     Parameter names are the seed paper's: `c` stiffness, `b` or `b1` damping, `P` dry force,
     `a` Hunt-Crossley damping, `n` exponent, `e_nominal` the restitution a published
-    Hunt-Crossley damping formula is asked for. `jaximpact laws` lists them all.
+    Hunt-Crossley damping formula is asked for. `jaximpact laws` lists them all. Each is one
+    number (an array of several values is refused: `jax.vmap` over the law's construction,
+    or `impact_batch`, computes many).
 
     **Example**: `law("kelvin_voigt", c=2e6, b=400.0)`.
     """
     if name not in LAWS:
         raise ValueError(unknown_name("law", name, LAW_NAMES))
     return table_law(name, checked_parameters(LAWS[name], params))
+
+
+def batch_law(name: str, **params) -> AbstractLaw:
+    """`law(name, **params)` for the library's own batches (`impact_batch`'s checks, the
+    restitution maps): its parameters may be 1-D arrays, one value per member, each value
+    checked as `law` checks it. `law` itself takes one number per parameter."""
+    if name not in LAWS:
+        raise ValueError(unknown_name("law", name, LAW_NAMES))
+    return table_law(name, checked_parameters(LAWS[name], params, batch=True))
 
 
 def table_law(name: str, params: dict) -> AbstractLaw:

@@ -60,10 +60,31 @@ def _concrete_numbers(*values) -> bool:
     return all(not is_traced(v) and jnp.ndim(v) == 0 for v in values)
 
 
-def checked_parameters(spec: LawSpec, params: dict) -> dict:
+def _check_number(name: str, key: str, value, batch: bool):
+    """A parameter is a number: a bool is refused (`TypeError`), and so is an array of
+    several values (`ValueError`) unless `batch` (the library's own batches of laws).
+    Inside `jax.vmap` a parameter is a traced scalar, which passes."""
+    if isinstance(value, (str, bytes)) or value is None:
+        return  # `as_arrays` says what it must be
+    try:
+        array = value if hasattr(value, "shape") and hasattr(value, "dtype") else np.asarray(value)
+    except Exception:  # e.g. a list of traced values: left to `jnp.asarray`
+        return
+    if array.dtype == bool:
+        raise TypeError(f"law {name!r}: {key} must be a number, got {value!r}")
+    if array.shape != () and not batch:
+        raise ValueError(
+            f"law {name!r}: {key} must be one number, got an array of shape {array.shape}; "
+            "for many values use jax.vmap or jaximpact.impact_batch"
+        )
+
+
+def checked_parameters(spec: LawSpec, params: dict, *, batch: bool = False) -> dict:
     """The parameters of the row `spec`'s law, complete (its defaults filled in), in the
     row's order, each checked, as arrays: a `ValueError` names an unknown or missing
-    parameter, exponents outside `0 <= p <= n`, or a value out of range."""
+    parameter, an array of several values (unless `batch`: the library's own batches,
+    one law whose parameters are 1-D arrays, `named_law.batch_law`), exponents outside
+    `0 <= p <= n`, or a value out of range; a `TypeError` a bool."""
     name = spec.name
     unknown = sorted(set(params) - set(spec.parameters))
     if unknown:
@@ -79,6 +100,8 @@ def checked_parameters(spec: LawSpec, params: dict) -> dict:
             + (f" (defaults: {spec.defaults})" if spec.defaults else "")
         )
     given = {k: given[k] for k in spec.parameters}
+    for key, value in params.items():
+        _check_number(name, key, value, batch)
     n, p = (given[q] if isinstance(q, str) else q for q in spec.shape or (1.0, 0.0))
     if _concrete_numbers(n, p) and not 0 <= float(p) <= float(n):  # a row with free exponents
         raise ValueError(f"law {name!r} needs exponents 0 <= p <= n, got n={n}, p={p}")

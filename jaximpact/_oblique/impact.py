@@ -14,7 +14,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._checks import check_nonnegative, check_positive, check_values, is_traced
+from .._checks import MemberChecks, is_traced
 from .._laws import AbstractLaw
 from .._solve.adjoint import (
     auto_adjoint,
@@ -479,9 +479,12 @@ def _differentiated(*trees) -> bool:
     return bool(differentiation_kinds(*trees))
 
 
-def _finite(name, value, unit):
-    return check_values(value, lambda a: a != a,
-                        f"{name} must be a finite number ({unit}), got {value}")  # fmt: skip
+def _never(a):
+    return a != a  # only NaN and inf (`check_values` refuses them) are bad
+
+
+def _not_finite(name, value, unit):
+    return f"{name} must be a finite number ({unit}), got {value}"
 
 
 def _check_laws(law, tangential):
@@ -588,7 +591,9 @@ def oblique_impact(
       unless separated (`eqx.error_if`); `False`: never (failed fields are NaN).
 
     Returns an `ObliqueResult`. Composes with `jax.jit`, `jax.vmap` (scalars in, `vmap`
-    for a batch, e.g. over incidence angles with `incidence`) and `jax.grad`.
+    for a batch, e.g. over incidence angles with `incidence`) and `jax.grad`. Bad values
+    (`m`, `R`, `v_n`, `inertia` not > 0, `g` < 0, not finite) raise a one-line `ValueError`
+    eagerly; under a transformation that member is NaN with status `invalid`.
 
     **Example**:
     `oblique_impact(jaximpact.law("hertz_rate", c=2.6e10, b1=0.0),
@@ -609,13 +614,15 @@ def oblique_impact(
             raise ValueError(f"{name} must be a whole number >= 1, got {value!r}")
     if not (isinstance(tau_max, (int, float)) and tau_max > 0 and math.isfinite(tau_max)):
         raise ValueError(f"tau_max must be a finite number > 0, got {tau_max!r}")
-    m = check_positive("mass m", m, "kg")
-    R = check_positive("radius R", R, "m")
-    v_n = check_positive("normal speed v_n (approaching)", v_n, "m/s")
-    inertia = check_positive("inertia factor (I / (m R^2))", inertia)
-    g = check_nonnegative("gravity g", g, "m/s^2")
-    v_t = _finite("tangential speed v_t", v_t, "m/s")
-    omega = _finite("spin omega", omega, "rad/s")
+    # eager: a one-line ValueError; traced: a bad member is NaN and invalid (`MemberChecks`)
+    checks = MemberChecks()
+    m = checks.positive("mass m", m, "kg")
+    R = checks.positive("radius R", R, "m")
+    v_n = checks.positive("normal speed v_n (approaching)", v_n, "m/s")
+    inertia = checks.positive("inertia factor (I / (m R^2))", inertia, harmless=0.4)
+    g = checks.nonnegative("gravity g", g, "m/s^2")
+    v_t = checks.values(v_t, _never, _not_finite("tangential speed v_t", v_t, "m/s"), 0.0)
+    omega = checks.values(omega, _never, _not_finite("spin omega", omega, "rad/s"), 0.0)
     values = [jnp.asarray(a, dtype=float) for a in (m, R, v_n, v_t, omega, inertia, g)]
     if any(jnp.ndim(a) for a in values):
         raise ValueError(
@@ -646,6 +653,7 @@ def oblique_impact(
         )  # fmt: skip
     else:
         result = solve_oblique(law, tangential, *values, options)
+    result = checks.refuse(result, status=Status.invalid)
     if throw is not False and not is_traced(result.status) and np.ndim(result.status) == 0:
         status = Status(int(result.status))
         if status.is_failure:

@@ -23,7 +23,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array
 
-from .._checks import check_nonnegative, check_positive, check_values, is_traced
+from .._checks import MemberChecks, is_traced
 from .._curves.gravity import WithGravity
 from .._curves.shapes import curve_key
 from .._format import format_fields, format_value, jsonable
@@ -32,7 +32,7 @@ from .._status import Status
 from .adjoint import auto_adjoint, reverse_only, through_forward_jacobian
 from .flight import Flight
 from .impact import CURVES_RTOL, SEPARATIONS, ImpactOptions, gravity_impact, similarity_reason
-from .options import adhesion_table_key
+from .options import adhesion_table_key, default_rtol
 from .phases import integrated_contact
 from .precision import resolvable_tolerances
 from .results import ImpactResult, status_names, status_text
@@ -51,12 +51,16 @@ class BounceStatus(enum.IntEnum):
       right as far as they go.
     - `failed`: a contact solve ran out of steps (`max_steps`); results from that contact
       on are not to be trusted.
+    - `invalid`: under `jit` or `vmap`, a drop whose inputs were refused (not finite, out
+      of range, or `h0 = 0` with `v_drop = 0`): no contact, every result field NaN, while
+      the other members have theirs (an eager call raises a one-line `ValueError`).
     """
 
     t_end = 0
     at_rest = 1
     max_impacts = 2
     failed = 3
+    invalid = 4
 
 
 _RUNNING = -1
@@ -356,7 +360,10 @@ class BounceResult(eqx.Module):
         # any order: the solver's save times must increase, the caller's need not
         order = jnp.argsort(ts)
         back = jnp.argsort(order)
-        return tuple(h[back] for h in _histories(self, ts[order]))
+        refused = jnp.asarray(self.status) == BounceStatus.invalid  # no drop: NaN
+        if refused.ndim:
+            refused = False  # a batch of drops: each drop's own call (`jax.vmap`)
+        return tuple(jnp.where(refused, jnp.nan, h[back]) for h in _histories(self, ts[order]))
 
     def height(self, ts) -> Array:
         """Height of the ball's lowest point above the undeformed floor (m) at `ts` (s);
@@ -379,6 +386,8 @@ def _at_rest_text(t_rest) -> str:
     return format_value(t_rest, "s")
 
 
+# the fields of `BounceResult` that the histories re-run the drop from
+_INPUTS = ("law", "m", "g", "drag", "start", "t_end", "min_flight", "options")
 # the per-contact arrays of `BounceResult.to_dict` (`contact_status` apart, as names)
 _PER_CONTACT = ("impact_times", "release_times", "impact_speeds", "rebound_speeds", "e", "T",
                 "release_heights", "apex_times", "apex_heights", "F_max", "x_max")  # fmt: skip
@@ -586,7 +595,7 @@ def bounce(
     max_impacts: int = 64,
     min_flight=1e-6,
     solver: dfx.AbstractSolver | None = None,
-    rtol: float = 1e-10,
+    rtol: float | None = None,
     atol: float | None = None,
     max_steps: int = 4096,
     tau_max: float = 1e4,
@@ -615,7 +624,8 @@ def bounce(
     - `min_flight` (s): a flight shorter than this ends the sequence with the ball at rest
       (with a speed-independent restitution the bounces accumulate in finite time).
     - `solver`, `rtol`, `atol`, `max_steps`, `tau_max`, `rest_tol`, `peaks`: each contact's
-      solve, as in `impact` (`peaks=False` leaves `F_max` and `x_max` out and integrates each
+      solve, as in `impact` (`rtol` by default 1e-11 for a law of the table, 1e-12 for a
+      user's law: each contact's e, T and x_max within 1e-9; `peaks=False` leaves `F_max` and `x_max` out and integrates each
       contact in one phase; the histories always use the three phases, so they then agree
       with the per-contact arrays to the solver's tolerance rather than exactly); `adjoint`:
       default picks the cheapest diffrax adjoint for the transformation in use
@@ -650,14 +660,18 @@ def bounce(
         ("min_flight", min_flight), ("drag", drag),
     ):  # fmt: skip
         _check_real(name, value)
-    m = jnp.asarray(check_positive("mass m", m, "kg"), dtype=float)
-    h0 = jnp.asarray(check_nonnegative("drop height h0", h0, "m"), dtype=float)
-    t_end = jnp.asarray(check_positive("t_end", t_end, "s"), dtype=float)
-    g = jnp.asarray(check_positive("gravity g", g, "m/s^2"), dtype=float)
-    v_drop = jnp.asarray(check_values(v_drop, lambda a: False, "v_drop must be finite"), float)
-    min_flight = jnp.asarray(check_nonnegative("min_flight", min_flight, "s"), dtype=float)
+    # eager: a one-line ValueError; traced: a bad member is NaN and invalid (`MemberChecks`)
+    checks = MemberChecks()
+    m = jnp.asarray(checks.positive("mass m", m, "kg"), dtype=float)
+    h0 = jnp.asarray(checks.nonnegative("drop height h0", h0, "m", harmless=1.0), dtype=float)
+    t_end = jnp.asarray(checks.positive("t_end", t_end, "s"), dtype=float)
+    g = jnp.asarray(checks.positive("gravity g", g, "m/s^2"), dtype=float)
+    v_drop = checks.values(v_drop, lambda a: False, "v_drop must be finite", harmless=0.0)
+    v_drop = jnp.asarray(v_drop, float)
+    min_flight = jnp.asarray(checks.nonnegative("min_flight", min_flight, "s"), dtype=float)
     if drag is not None:
-        drag = jnp.asarray(check_positive("air drag coefficient drag", drag, "1/m"), dtype=float)
+        drag = checks.positive("air drag coefficient drag", drag, "1/m")
+        drag = jnp.asarray(drag, dtype=float)
         concrete = not any(is_traced(a) for a in (drag, v_drop, g))
         if concrete and float(v_drop) > 0 and float(v_drop) ** 2 * float(drag) >= float(g):
             raise ValueError(
@@ -676,7 +690,7 @@ def bounce(
         if bool(resting):
             raise ValueError(message)
     else:
-        h0 = eqx.error_if(h0, resting, message)
+        h0 = checks.mark(resting, h0, 1.0)
     # jax.grad alone: the forward-mode Jacobian, transposed (`adjoint.by_forward_jacobian`)
     by_forward = adjoint is None and reverse_only(law, m, h0, v_drop, g, drag, t_end)
     if by_forward:
@@ -687,7 +701,7 @@ def bounce(
         separation=separation,
         max_impacts=max_impacts,
         solver=solver,
-        rtol=rtol,
+        rtol=default_rtol(rtol, table_law=law.spec is not None),
         atol=atol,
         max_steps=max_steps,
         tau_max=tau_max,
@@ -704,6 +718,10 @@ def bounce(
         )  # fmt: skip
     else:
         result = solve_bounce(law, m, g, drag, start, t_end, min_flight, options)
+    # the inputs the histories re-run are kept (harmless); `trajectory` gives NaN for them
+    result = checks.refuse(
+        result, keep=_INPUTS, status=BounceStatus.invalid, num_impacts=0, contact_status=-1
+    )
     if throw:
         result = eqx.error_if(
             result,

@@ -11,7 +11,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._checks import check_nonnegative, check_positive, check_scale, is_traced
+from .._checks import MemberChecks, check_scale, is_traced
 from .._curves.gravity import WithGravity, gravity_fields
 from .._curves.similarity import similarity_fields
 from .._laws import AbstractLaw
@@ -267,6 +267,9 @@ def impact(
       NaN in every result field and its status says why. `True`: raise for any ending
       but `separated` (stuck and captured too; `eqx.error_if`, so also under `jit`).
       `False`: never raise (a failed result is NaN with its status).
+    - Bad values (`m` or `v0` not > 0, `g` < 0, not finite): an eager call raises a one-line
+      `ValueError`; under `jit`, `vmap` or `grad` that member has NaN in every result field
+      (and its derivatives) and status `invalid`, and the other members are computed.
 
     **Example**:
     `impact(law("hertz_rate", c=2e6, b1=800.0), m=1.0, v0=2.5).e` is about 0.83.
@@ -278,13 +281,15 @@ def impact(
         )
     rtol = check_choices(separation, method, rtol, table_law=law.spec is not None)
     check_options(rtol=rtol, atol=atol, rest_tol=rest_tol, max_steps=max_steps, tau_max=tau_max)
+    # eager: a one-line ValueError; traced: a bad member is NaN and invalid (`MemberChecks`)
+    checks = MemberChecks()
     # 1e-300 kg is refused as 1e300 kg is: the contact's scales would under- or overflow
-    m = check_scale("mass m", check_positive("mass m", m, "kg"), "kg")
-    v0 = check_scale("impact speed v0", check_positive("impact speed v0", v0, "m/s"), "m/s")
+    m = check_scale("mass m", checks.positive("mass m", m, "kg"), "kg")
+    v0 = check_scale("impact speed v0", checks.positive("impact speed v0", v0, "m/s"), "m/s")
     m = jnp.asarray(m, dtype=float)
     v0 = jnp.asarray(v0, dtype=float)
     given_g = g  # a number 0 is no gravity, a static fact (choose_path)
-    g = jnp.asarray(check_nonnegative("gravity g", g, "m/s^2"), dtype=float)
+    g = jnp.asarray(checks.nonnegative("gravity g", g, "m/s^2"), dtype=float)
     if jnp.ndim(m) or jnp.ndim(v0) or jnp.ndim(g):
         raise ValueError("impact takes scalar m, v0 and g; use jax.vmap for a batch")
     path = choose_path(
@@ -326,6 +331,7 @@ def impact(
             )  # fmt: skip
     if result is None:
         result = solve_impact(law, m, v0, g, ts, options)
+    result = checks.refuse(result, status=Status.invalid)
     if path.name in ("gravity_table", "dry_table") and not is_traced(result.num_steps):
         if int(result.num_steps) > 0:  # outside the table: integrated, and said so
             fields = {f.name: getattr(result, f.name) for f in dataclasses.fields(result)}

@@ -14,6 +14,7 @@ from .._choices import unknown_name
 from .._format import PrintedFields, concrete_units
 from .._laws import LAW_NAMES, LAWS, law
 from .._laws.closed_forms import exact_batch
+from .._laws.named_law import batch_law
 from .._progress import AbstractMeter
 from .._status import Status
 
@@ -149,7 +150,7 @@ def restitution_map(
         params["a"] = np.asarray(factor, dtype=float) / 1.5
         name = "hunt_crossley"
 
-    made = law(name, **params)
+    made = batch_law(name, **params)  # one law, its parameters the grid's arrays
     out = exact_batch(made, m=m, v0=v0, separation=separation) if method == "auto" else None
     path = "closed_form"
     if out is None:

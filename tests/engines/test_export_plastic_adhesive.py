@@ -83,16 +83,17 @@ def test_lammps_jkr_replica_tends_to_its_continuous_impact():
 @pytest.mark.parametrize("geometry, law", [("wall", wall_law), ("spheres", pair_law)])
 def test_jkr_export_to_lammps_realises_the_laws_e_of_v(geometry, law):
     """`export(jkr law, "lammps")` is LAMMPS's jkr model (no damping), promising the law's e
-    and T at v0 (its replica's mean over start phases, to 0.1 %), and the law's e(v) at
-    every speed (0 below the sticking speed) within the step's own error; one warning says
-    how LAMMPS's neck differs from JKR's."""
+    and T at v0 (its replica's, within the export's 0.5 % at every start phase, T on their
+    mean), and the law's e(v) at every speed (0 below the sticking speed) within the step's
+    own error; one warning says how LAMMPS's neck differs from JKR's."""
     law = law()
     V_s = float(law.sticking_speed(M))
     x = ji.export(law, "lammps", m=M, v0=4 * V_s, radius=R, geometry=geometry)
     assert x.engine == "lammps" and x.law.name == "jkr" and x.separation == "force"
-    assert abs(x.e / x.target_e - 1) < 1e-3 and abs(x.T / x.target_T - 1) < 1e-3
+    assert all(abs(e / x.target_e - 1) <= 0.005 for e in x.e_range)
+    assert abs(x.T / x.target_T - 1) <= 0.005
     assert " jkr " in x.parameters["pair_coeff"] and "damping velocity" in x.snippet
-    assert x.parameters["damping"] == 0.0 and x.steps_per_contact >= 400
+    assert x.parameters["damping"] == 0.0 and x.steps_per_contact >= 5
     assert ("fix wall all wall/gran granular jkr" in x.snippet) == (geometry == "wall")
     assert len(x.warnings) == 1 and "least force" in x.warnings[0], x.warnings
     e_engine, e_law = np.array(x.e_engine), np.array(x.e_target)
@@ -123,7 +124,8 @@ def test_jkr_export_refusals_are_one_line():
     law = wall_law()
     V_s = float(law.sticking_speed(M))
     good = ji.export(law, "lammps", m=M, v0=5 * V_s, radius=R, geometry="wall", curves=False)
-    with pytest.raises(UnrealisedExport, match="fewer than 5") as refused:
+    short = r"in only \d\.\d+ steps .*needs at least 5"  # T over the step: 3.63
+    with pytest.raises(UnrealisedExport, match=short) as refused:
         ji.export(law, "lammps", m=M, v0=5 * V_s, radius=R, geometry="wall", timestep=1e-3,
                   curves=False)  # fmt: skip
     assert refused.value.working == good.timestep and "\n" not in str(refused.value)
@@ -242,10 +244,11 @@ def _dmt_law():
 @pytest.mark.parametrize("geometry", ["wall", "spheres"])
 def test_dmt_export_to_lammps_is_the_law_itself(geometry):
     """LAMMPS's `dmt` with `damping viscoelastic` is the `dmt` law: the export's engine law
-    is the law (its c, b and pull-off 2 pi w R to 1e-12, each force scaled back by m/meff;
-    its R is the contact's effective one, R/2 for two spheres), ends contact at x = 0, and its
-    replica at the export's step realises the law's e and T within the stepping's error
-    (0.5 %) above the sticking speed and sticks below it, as the law does."""
+    is the law for the contact's effective mass, as every engine's (its c, b and pull-off
+    2 pi w R the given law's times meff/m to 1e-12: halved for two spheres; its R is the
+    contact's effective one, R/2 for two spheres), ends contact at x = 0, and its replica
+    at the export's step realises the law's e and T within the stepping's error (0.5 %)
+    above the sticking speed and sticks below it, as the law does."""
     law = _dmt_law()
     x = ji.export(law, "lammps", m=M, v0=0.3, radius=R, geometry=geometry, curves=False)
     assert x.separation == "penetration" and "dmt" in x.snippet and "viscoelastic" in x.snippet
@@ -253,9 +256,13 @@ def test_dmt_export_to_lammps_is_the_law_itself(geometry):
     def pulloff(law):
         return float(law.parameters["w"] * law.parameters["R"])
 
+    scale = x.law_m / M  # meff/m: 1 on a wall, 1/2 for two spheres
+    assert scale == (1.0 if geometry == "wall" else 0.5)
     for key in ("c", "b"):
-        assert float(x.law.parameters[key]) == pytest.approx(float(law.parameters[key]), rel=1e-12)
-    assert pulloff(x.law) == pytest.approx(pulloff(law), rel=1e-12)
+        assert float(x.law.parameters[key]) == pytest.approx(
+            scale * float(law.parameters[key]), rel=1e-12
+        )
+    assert pulloff(x.law) == pytest.approx(scale * pulloff(law), rel=1e-12)
     assert x.e == pytest.approx(x.target_e, rel=5e-3) and x.T == pytest.approx(x.target_T, rel=5e-3)
     stepping = {**x.parameters, "timestep": x.timestep}
     for v in (0.02, 0.1, 0.3):
@@ -265,7 +272,7 @@ def test_dmt_export_to_lammps_is_the_law_itself(geometry):
     # the inverse: the engine's parameters give the law back
     back, separation, _, _ = engine_response("lammps", x.parameters, m=M, speeds=[0.3], radius=R)
     assert back.name == "dmt" and separation == "penetration"
-    assert pulloff(back) == pytest.approx(pulloff(law), rel=1e-12)
+    assert pulloff(back) == pytest.approx(scale * pulloff(law), rel=1e-12)
 
 
 def test_dmt_export_refusals_are_one_line():

@@ -32,6 +32,13 @@ WALL_M, WALL_R = 0.004, 0.005
 WALL_PHASES = (0.05, 0.3, 0.55, 0.8, 0.95)
 
 
+def within_a_step(Ts, T, step):
+    """An engine counts a contact in whole steps: its T at each start phase within 0.5 % of
+    the promised T (the phases' mean), or within one step where the recommended step (the
+    coarsest that realises e within 0.5 % at every phase) is longer than 0.5 % of T."""
+    return bool(np.all(np.abs(np.asarray(Ts) - T) <= max(0.005 * T, step)))
+
+
 @pytest.mark.engines
 @pytest.mark.parametrize("e, T", TARGETS)
 @pytest.mark.parametrize("condim", [1, 3])
@@ -40,7 +47,7 @@ def test_mujoco_realises_the_promise(e, T, condim):
     x = ji.export(None, "mujoco", m=0.05, v0=1.0, e=e, T=T, curves=False)
     es, Ts = run_mujoco(x.parameters, v0=1.0, m=0.05, phases=PHASES, condim=condim)
     assert np.all(np.abs(es / x.e - 1) < 0.005), (es, x.e)
-    assert np.all(np.abs(Ts / x.T - 1) < 0.005), (Ts, x.T)
+    assert within_a_step(Ts, x.T, x.timestep), (Ts, x.T)
     assert abs(x.e / e - 1) < 0.005 and abs(x.T / T - 1) < 0.005
     # the replica reproduces MuJoCo's Euler step to round-off, phase by phase
     if condim == 1:
@@ -54,9 +61,8 @@ def test_mujoco_realises_a_fitted_law_export():
     law = ji.law("hertz_rate", c=2e6, b1=800.0)
     x = ji.export(law, "mujoco", m=1.0, v0=2.5, curves=False)
     es, Ts = run_mujoco(x.parameters, v0=2.5, m=1.0, phases=PHASES)
-    assert np.all(np.abs(es / x.target_e - 1) < 0.005) and np.all(
-        np.abs(Ts / x.target_T - 1) < 0.005
-    )
+    assert np.all(np.abs(es / x.target_e - 1) < 0.005)
+    assert within_a_step(Ts, x.target_T, x.timestep), (Ts, x.target_T)
 
 
 @pytest.mark.engines
@@ -85,7 +91,7 @@ def test_lammps_realises_the_promise(e, T, limit_damping):
     )
     es, Ts = run_lammps(x.parameters, m=0.004, v0=1.0, radius=0.005, phases=PHASES)
     assert np.all(np.abs(es / x.e - 1) < 0.005), (es, x.e)
-    assert np.all(np.abs(Ts / x.T - 1) < 0.005), (Ts, x.T)
+    assert within_a_step(Ts, x.T, x.timestep), (Ts, x.T)
     assert abs(x.e / e - 1) < 0.005 and abs(x.T / T - 1) < 0.005
 
 
@@ -159,7 +165,7 @@ def test_liggghts_realises_the_promise(e, T, limit_damping):
                   limit_damping=limit_damping, curves=False)  # fmt: skip
     es, Ts = run_liggghts(x.parameters, m=m, v0=1.0, radius=radius, phases=PHASES)
     assert np.all(np.abs(es / x.e - 1) < 0.005), (es, x.e)
-    assert np.all(np.abs(Ts / x.T - 1) < 0.005), (Ts, x.T)
+    assert within_a_step(Ts, x.T, x.timestep), (Ts, x.T)
     assert abs(x.e / e - 1) < 0.005 and abs(x.T / T - 1) < 0.005
 
 
@@ -172,7 +178,7 @@ def test_liggghts_hard_particles_are_accepted():
     x = ji.export(None, "liggghts", m=m, v0=1.0, radius=radius, e=0.8, T=2e-5, curves=False)
     assert x.parameters["youngs_modulus"] > 1e9 and "hard_particles yes" in x.snippet
     es, Ts = run_liggghts(x.parameters, m=m, v0=1.0, radius=radius, phases=(0.5,))
-    assert abs(es[0] / x.e - 1) < 0.005 and abs(Ts[0] / x.T - 1) < 0.005
+    assert abs(es[0] / x.e - 1) < 0.005 and within_a_step(Ts, x.T, x.timestep)
 
 
 @pytest.mark.engines
@@ -187,7 +193,7 @@ def test_yade_realises_the_promise(e, T):
     phases = (0.1, 0.5, 0.9)
     es, Ts = run_yade(x.parameters, m=m, v0=1.0, radius=radius, phases=phases)
     assert np.all(np.abs(es / x.e - 1) < 0.005), (es, x.e)
-    assert np.all(np.abs(Ts / x.T - 1) < 0.005), (Ts, x.T)
+    assert within_a_step(Ts, x.T, x.timestep), (Ts, x.T)
     assert abs(x.e / e - 1) < 0.005 and abs(x.T / T - 1) < 0.005
     replica_e, _ = yade_engine.replica(x.parameters, m, 1.0, phases=phases)
     np.testing.assert_allclose(es, replica_e, rtol=1e-9)
@@ -233,7 +239,7 @@ def test_lammps_wall_realises_the_promise(e, T, limit_damping):
     es, Ts = run_lammps(x.parameters, m=WALL_M, v0=1.0, radius=WALL_R,
                                     phases=WALL_PHASES)  # fmt: skip
     assert np.all(np.abs(es / x.e - 1) < 0.005), (es, x.e)
-    assert np.all(np.abs(Ts / x.T - 1) < 0.005), (Ts, x.T)
+    assert within_a_step(Ts, x.T, x.timestep), (Ts, x.T)
     assert abs(x.e / e - 1) < 0.005 and abs(x.T / T - 1) < 0.005
     # the replica is LAMMPS's step on the wall to round-off
     replica_e, _ = lammps_engine.replica(
@@ -256,7 +262,7 @@ def test_liggghts_wall_realises_the_promise(e, T, limit_damping):
     es, Ts = run_liggghts(x.parameters, m=WALL_M, v0=1.0, radius=WALL_R,
                                       phases=WALL_PHASES)  # fmt: skip
     assert np.all(np.abs(es / x.e - 1) < 0.005), (es, x.e)
-    assert np.all(np.abs(Ts / x.T - 1) < 0.005), (Ts, x.T)
+    assert within_a_step(Ts, x.T, x.timestep), (Ts, x.T)
     assert abs(x.e / e - 1) < 0.005 and abs(x.T / T - 1) < 0.005
 
 
@@ -273,7 +279,7 @@ def test_yade_wall_realises_the_promise(e, T):
     phases = (0.1, 0.5, 0.9)
     es, Ts = run_yade(x.parameters, m=m, v0=1.0, radius=radius, phases=phases)
     assert np.all(np.abs(es / x.e - 1) < 0.005), (es, x.e)
-    assert np.all(np.abs(Ts / x.T - 1) < 0.005), (Ts, x.T)
+    assert within_a_step(Ts, x.T, x.timestep), (Ts, x.T)
     assert abs(x.e / e - 1) < 0.005 and abs(x.T / T - 1) < 0.005
     replica_e, _ = yade_engine.replica(x.parameters, m, 1.0, phases=phases)
     np.testing.assert_allclose(es, replica_e, rtol=1e-9)

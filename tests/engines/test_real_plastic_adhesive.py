@@ -30,9 +30,9 @@ def _law(geometry):
 @pytest.mark.parametrize("geometry", ["wall", "spheres"])
 def test_lammps_jkr_realises_the_promise_above_and_below_sticking(geometry):
     """Exported at 4 V_s: LAMMPS equals the replica phase by phase (1e-9) at 0.8, 1.5 and
-    4 V_s; at 4 V_s its e and T are the promise within 0.5 %; at each speed its mean e is
-    `stepped_response`'s (0.5 %) and jaximpact's exact JKR e within 0.005 (0 below V_s,
-    where the neck holds the body)."""
+    4 V_s; at 4 V_s its e is the promise within 0.5 % and T within 0.5 % or a step; at each
+    speed its mean e is `stepped_response`'s (0.5 %) and jaximpact's exact JKR e within 0.005
+    (0 below V_s, where the neck holds the body)."""
     require("lammps")
     law = _law(geometry)
     V_s = float(law.sticking_speed(M))
@@ -50,7 +50,8 @@ def test_lammps_jkr_realises_the_promise_above_and_below_sticking(geometry):
         assert abs(es.mean() - exact) < 5e-3, (factor, es, exact)
         if factor == 4.0:
             assert np.all(np.abs(es / x.e - 1) < 0.005), (es, x.e)
-            assert np.all(np.abs(Ts / x.T - 1) < 0.005), (Ts, x.T)
+            # counted in whole steps: within 0.5 % or one step of the promise
+            assert np.all(np.abs(Ts - x.T) <= max(0.005 * x.T, x.timestep)), (Ts, x.T)
         if factor < 1.0:
             assert exact == 0.0 and np.all(es == 0.0)
 

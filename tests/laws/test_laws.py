@@ -155,6 +155,39 @@ def test_bad_values_are_a_clear_value_error(name, params, needle):
     assert name in message
 
 
+@pytest.mark.parametrize("c", [[1e6, 2e6], np.array([1e6, 2e6]), jnp.array([1e6, 2e6])])
+def test_an_array_of_several_values_is_refused_at_once(c):
+    """A parameter is one number: an array was accepted, then failed inside `impact`
+    ("mul got incompatible shapes for broadcasting"); issue 34 item 7."""
+    with pytest.raises(ValueError) as excinfo:
+        ji.law("hertz_rate", c=c, b1=800.0)
+    assert _one_line(excinfo) == (
+        "law 'hertz_rate': c must be one number, got an array of shape (2,); "
+        "for many values use jax.vmap or jaximpact.impact_batch"
+    )
+    with pytest.raises(ValueError, match="b1 must be one number, got an array of shape"):
+        ji.law("hertz_rate", c=2e6, b1=800.0).replace(b1=[1.0, 2.0])
+
+
+def test_a_bool_is_not_a_number():
+    """`c=True` was taken as 1."""
+    with pytest.raises(TypeError) as excinfo:
+        ji.law("hertz_rate", c=True, b1=800.0)
+    assert _one_line(excinfo) == "law 'hertz_rate': c must be a number, got True"
+    with pytest.raises(TypeError, match="b1 must be a number, got"):
+        ji.law("hertz_rate", c=2e6, b1=np.array(False))
+
+
+def test_many_values_through_vmap_and_the_batches():
+    """What the refusal points to: `jax.vmap` builds the law from traced scalars, and
+    `impact_batch` takes the arrays as rows."""
+    cs = jnp.array([1e6, 2e6])
+    law_e = jax.vmap(lambda c: ji.impact(ji.law("hertz_rate", c=c, b1=800.0), m=1.0, v0=2.5).e)
+    batch = ji.impact_batch("hertz_rate", {"c": cs, "b1": 800.0}, m=1.0, v0=2.5,
+                            progress=False)  # fmt: skip
+    assert_rel(law_e(cs), batch["e"], 1e-12, "vmap vs impact_batch")
+
+
 def test_bad_values_survive_jit():
     build = jax.jit(lambda c: ji.law("kelvin_voigt", c=c, b=400.0).force(1e-3, 0.0))
     assert_rel(build(2e6), 2e3, 1e-14, "jit-built law")

@@ -491,4 +491,27 @@ def test_bad_law_is_a_type_error():
 
 
 def test_status_enum_names():
-    assert [s.name for s in BounceStatus] == ["t_end", "at_rest", "max_impacts", "failed"]
+    names = ["t_end", "at_rest", "max_impacts", "failed", "invalid"]
+    assert [s.name for s in BounceStatus] == names
+
+
+@pytest.mark.slow  # compiles a user's law's drop and two references
+def test_a_drop_at_its_defaults_meets_1e_9():
+    """Each contact's e at `bounce`'s defaults within 1e-9 of the same drop integrated at
+    rtol 1e-13, for a user's Hunt-Crossley law and the table's (read off the gravity
+    table), and Thornton's first contact against `impact` with gravity (issue 34, item 11:
+    at the old default rtol 1e-10 the table's third contact was 1.1e-8 off, the user's
+    law's 7.6e-9)."""
+    plain = ji.custom_law(lambda x, v, p: p["c"] * x**1.5 * (1 + 1.5 * p["a"] * v), c=2e6, a=0.2)
+    table = ji.law("hunt_crossley", c=2e6, a=0.2, n=1.5)
+    reference = ji.bounce(table, m=1.0, h0=0.6, t_end=1.5, rtol=1e-13)
+    n = 5
+    assert int(reference.num_impacts) >= n
+    for law in (plain, table):
+        drop = ji.bounce(law, m=1.0, h0=0.6, t_end=1.5)
+        np.testing.assert_allclose(drop.e[:n], reference.e[:n], rtol=0, atol=1e-9)
+    thornton = ji.law("thornton", c=2e6, x_y=1e-4)
+    first = ji.bounce(thornton, m=1.0, h0=0.6, t_end=0.4).e[0]
+    v_in = (2 * 9.81 * 0.6) ** 0.5
+    exact = ji.impact(thornton, m=1.0, v0=v_in, g=9.81, rtol=1e-13).e
+    assert abs(float(first) - float(exact)) <= 1e-9
