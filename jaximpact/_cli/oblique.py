@@ -12,6 +12,7 @@ Or a video track of the ball bouncing across a floor, one row per frame: `t` (s)
 """
 
 import math
+import textwrap
 from pathlib import Path
 
 from .._files import cell_number
@@ -180,11 +181,38 @@ def check_oblique_arguments(args) -> None:
         raise CLIError("an oblique impact takes one --v0 (the speed); sweep --angle instead")
     if not math.isfinite(args.omega):
         raise CLIError(f"--omega must be a finite number (rad/s), got {args.omega:g}")
+    _warn_unlikely_spin(args.omega, args.radius, args.v0[0])
     if not (math.isfinite(args.inertia) and args.inertia > 0):
         raise CLIError(f"--inertia must be a finite number > 0 (I / (m R^2)), got {args.inertia:g}")
     if args.max_segments < 1:
         raise CLIError(f"--max-segments must be at least 1, got {args.max_segments}")
     warn_sphere_density(args.mass, args.radius)
+
+
+# a spin whose surface speed is this many times the impact speed is likely a unit slip
+LIKELY_SPIN_RATIO = 100.0
+
+
+def _warn_unlikely_spin(omega: float, R: float, v0: float) -> None:
+    """A warning where the surface speed `R omega` (m/s) of the spin is more than
+    `LIKELY_SPIN_RATIO` times the impact speed: a unit is likely wrong (rad/s, not rpm)."""
+    import warnings
+
+    if math.isfinite(v0) and v0 > 0 and abs(omega) * R > LIKELY_SPIN_RATIO * v0:
+        warnings.warn(
+            f"--omega {omega:g} rad/s turns the sphere's surface at R omega = "
+            f"{abs(omega) * R:.3g} m/s, {abs(omega) * R / v0:.3g} times the impact speed: "
+            "check the units (--omega in rad/s, --radius in m)",
+            stacklevel=2,
+        )
+
+
+# what the oblique fields mean, printed under them
+_OBLIQUE_LEGEND = (
+    "e_t = v_t_out / v_t (the centre's), e_t_contact = u_out / u (the contact point's slip, "
+    "u = v_t - R omega; Chung & Ooi's beta = -e_t_contact); angle_out from the normal: the "
+    "centre's rebound, angle_out_contact the contact point's"
+)
 
 
 def run_oblique_impact(args, law, head: list[str]) -> int:
@@ -234,6 +262,7 @@ def run_oblique_impact(args, law, head: list[str]) -> int:
             for d in runs
         ]  # fmt: skip
         lines += format_table(header + ["status"], rows)
+    lines += ["", *textwrap.wrap(_OBLIQUE_LEGEND, 92)]
     if args.plot is not None:
         lines.append(f"plot written to {args.plot}")
     failed = [d for d in runs if Status[d["status"]].is_failure]

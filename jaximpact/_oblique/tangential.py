@@ -43,10 +43,12 @@ Damping on the slip while sticking, in the two conventions the engines use:
 
 import abc
 import dataclasses
+import warnings
 from typing import ClassVar
 
 import equinox as eqx
 import jax.numpy as jnp
+import numpy as np
 from jaxtyping import Array
 
 from .._checks import check_nonnegative, check_positive, is_traced
@@ -485,6 +487,23 @@ def _check_poisson(name, key, value):
         raise ValueError(f"{name}: Poisson's ratio {key} must lie in (-1, 0.5), got {value}")
 
 
+# friction coefficients of real dry contacts: about 0.05 (PTFE) to 1.5 (clean metals, rubber)
+LIKELY_MU = 2.0
+
+
+def _warn_unlikely_friction(mu):
+    """A warning where a concrete `mu` is above `LIKELY_MU` (a slip of a digit or a unit):
+    such a contact sticks wherever it can, and a fit from it fixes no friction."""
+    if is_traced(mu) or np.ndim(mu) != 0:
+        return
+    if float(mu) > LIKELY_MU:
+        warnings.warn(
+            f"mu = {float(mu):g} is far above the friction of real dry contacts (about 0.05 "
+            f"to 1.5): such a contact sticks wherever it can; check the value",
+            stacklevel=3,
+        )
+
+
 def tangential_law(name: str, **params) -> AbstractTangentialLaw:
     """Build the tangential law `name` of `TANGENTIAL_LAW_NAMES` (SI units).
 
@@ -530,6 +549,7 @@ def tangential_law(name: str, **params) -> AbstractTangentialLaw:
             checked[key] = check_positive(f"{name}: {key}", value, unit)
         else:
             checked[key] = check_nonnegative(f"{name}: {key}", value, unit)
+    _warn_unlikely_friction(checked["mu"])
     arrays = {k: jnp.asarray(v, dtype=float) for k, v in checked.items()}
     cls = _CLASSES[name]
     return cls(arrays) if cls is LinearHistoryLaw else cls(name, arrays)

@@ -235,6 +235,7 @@ def test_simulate_an_oblique_impact_is_the_library_s(capsys, tmp_path):
     assert "angle             = 20 deg" in out and "status            = separated" in out
     assert f"e_t               = {float(want.e_t):.4g}" in out
     assert f"{math.degrees(float(want.angle_out)):.4g} deg" in out
+    assert "e_t_contact = u_out / u (the contact point's slip" in out  # the fields explained
     plot = tmp_path / "sweep.png"
     status, out, err = run_cli(capsys, [*SIMULATE, *MINDLIN, "--radius", "2.5e-3", "--angle",
                                         "5", "20", "--json", "--plot", str(plot)])  # fmt: skip
@@ -289,3 +290,38 @@ def test_a_sphere_of_implausible_density_is_warned(capsys, m, R, warned):
         assert len(lines) == 2 and "check the units (--mass in kg, --radius in m)" in lines[0]
     else:
         assert len(lines) == 1
+
+
+def test_a_spin_of_a_wrong_unit_is_warned_before_any_work():
+    """`--omega 1e9` (rad/s) on a 2.5 mm sphere turns its surface at 2.5e6 m/s: a warning
+    that names the units, before the solve (it ran without a word); a spin of 100 rad/s
+    does not warn."""
+    import argparse
+    import warnings
+
+    from jaximpact._cli.oblique import check_oblique_arguments
+
+    def args(omega):
+        return argparse.Namespace(
+            tangential="mindlin", radius=2.5e-3, angle=[30.0], v0=[3.9], omega=omega,
+            inertia=0.4, max_segments=16, tparam=[], mass=2.6e-4,
+        )  # fmt: skip
+
+    with pytest.warns(UserWarning, match=r"--omega 1e\+09 rad/s turns the sphere's surface"):
+        check_oblique_arguments(args(1e9))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_oblique_arguments(args(100.0))
+
+
+def test_a_friction_coefficient_far_above_real_contacts_is_warned():
+    """`mu=100` (a slip of a digit) warns that no real dry contact has it; 0.9 does not."""
+    import warnings
+
+    import jaximpact as ji
+
+    with pytest.warns(UserWarning, match="mu = 100 is far above the friction of real dry"):
+        ji.tangential_law("linear_history", kt=1e7, mu=100.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ji.tangential_law("linear_history", kt=1e7, mu=0.9)
