@@ -154,9 +154,9 @@ class TqdmMeter(AbstractMeter):
     """tqdm's bar (`pip install tqdm`); `options` go to `tqdm.auto.tqdm` (default: on
     stderr, kept at the end)."""
 
-    def __init__(self, **options):
-        self.options = options
-        self._bar = None
+    def __init__(self, heartbeat: float | None = 1.0, **options):
+        self.options, self.heartbeat = options, heartbeat
+        self._bar, self._stop, self._thread = None, threading.Event(), None
 
     @property
     def total(self):
@@ -172,6 +172,14 @@ class TqdmMeter(AbstractMeter):
         from tqdm.auto import tqdm
 
         self._bar = tqdm(total=total, desc=label, **{"file": sys.stderr, **self.options})
+        self._stop.clear()
+        if self.heartbeat is not None:  # the clock moves while one step takes long
+            self._thread = threading.Thread(target=self._beat, daemon=True)
+            self._thread.start()
+
+    def _beat(self):
+        while not self._stop.wait(self.heartbeat):
+            self._bar.refresh()
 
     def update(self, n=1, note=""):
         if note:
@@ -179,17 +187,23 @@ class TqdmMeter(AbstractMeter):
         self._bar.update(n)
 
     def close(self):
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
         self._bar.close()
 
 
 def default_meter() -> AbstractMeter:
     """What `progress=True` reports with: none when `JAXIMPACT_PROGRESS` is off; tqdm's bar
-    where tqdm is installed and stderr is a terminal; else a `TextMeter` on stderr."""
+    where tqdm is installed and stderr is a terminal; else a `TextMeter` on stderr. Both
+    keep their clock moving while one step takes long (a first compilation, a table built
+    on first use): a bar at 0/1 with a frozen clock read as a hang."""
     if not progress_enabled():
         return NoMeter()
     if is_terminal(sys.stderr) and importlib.util.find_spec("tqdm") is not None:
         return TqdmMeter()
-    return TextMeter()
+    return TextMeter(heartbeat=1.0)
 
 
 def as_meter(progress) -> AbstractMeter:

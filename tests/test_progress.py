@@ -3,6 +3,7 @@ elsewhere (logs, pipes, CI); `progress=` takes True, False or a meter; tqdm's me
 tqdm is installed."""
 
 import io
+import time
 
 import numpy as np
 import pytest
@@ -102,3 +103,23 @@ def test_tqdm_meter():
         for label in ("a", "b", "c", "d"):
             bar.update(1, label)
     assert "fitting" in stream.getvalue() and "4/4" in stream.getvalue()
+
+
+def test_the_default_meter_keeps_its_clock_moving_through_a_long_step(monkeypatch):
+    """A step that takes long (a first compilation, curves built on first use) once left
+    `0/1` and a frozen clock for minutes: the default meter redraws while it runs."""
+    stream = io.StringIO()
+    monkeypatch.delenv("JAXIMPACT_PROGRESS", raising=False)
+    monkeypatch.setattr("sys.stderr", stream)  # not a terminal: the text meter
+    meter = default_meter()
+    assert meter.heartbeat is not None
+    meter.delay, meter.interval, meter.heartbeat = 0.05, 0.1, 0.05
+    with metered(meter, 1, "building curves") as bar:
+        time.sleep(0.45)
+        bar.update(1)
+    lines = stream.getvalue().splitlines()
+    waiting = [line for line in lines if " 0/1 " in line]
+    assert len(waiting) >= 2, lines
+    clocks = [float(line.split(" 0/1 ")[1].split("s")[0]) for line in waiting]
+    assert clocks == sorted(clocks) and clocks[-1] > clocks[0]
+    assert "1/1" in lines[-1]
