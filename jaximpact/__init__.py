@@ -107,7 +107,10 @@ __all__ = sorted([*_PUBLIC, *_SUBMODULES])
 
 
 def __getattr__(name):
-    if name in _PUBLIC:
+    if name == "__version__":  # importlib.metadata, read on first use: the command line's
+        # Ctrl-C handling is installed right after this package loads (`_cli`)
+        from ._version import __version__ as value
+    elif name in _PUBLIC:
         value = getattr(_importlib.import_module(f".{_PUBLIC[name]}", __name__), name)
     elif name in _SUBMODULES:
         value = _importlib.import_module(f".{name}", __name__)
@@ -121,7 +124,4 @@ def __dir__():
     """The public names (`__all__`) and the module's dunder attributes: not the modules
     it imports for itself, nor the private subpackages that loading a name brings in."""
     dunder = [k for k in globals() if k.startswith("__") and k.endswith("__")]
-    return sorted({*__all__, *dunder})
-
-
-from ._version import __version__ as __version__  # noqa: E402
+    return sorted({*__all__, *dunder, "__version__"})
