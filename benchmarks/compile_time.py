@@ -101,7 +101,7 @@ def cli(cache):
     env = dict(os.environ, TF_CPP_MIN_LOG_LEVEL="3", JAXIMPACT_CACHE_DIR=cache)
     cmd = [
         "jaximpact", "simulate", "--law", "hertz_rate", "--param", "c=2e6", "b1=800",
-        "--v0", "2.5", "--json",
+        "--v0", "2.5", "--mass", "1", "--json",
     ]
     start = time.perf_counter()
     subprocess.run(cmd, capture_output=True, env=env, check=True)
@@ -231,7 +231,7 @@ def report(results):
     if results.get("cli"):
         c = results["cli"]
         lines += [
-            "`jaximpact simulate --law hertz_rate --param c=2e6 b1=800 --v0 2.5 --json` (whole "
+            "`jaximpact simulate --law hertz_rate --param c=2e6 b1=800 --v0 2.5 --mass 1 --json` (whole "
             "process, its own cache in `JAXIMPACT_CACHE_DIR`): "
             f"cold {statistics.median(x['cold_s'] for x in c):.1f} s, warm "
             f"{statistics.median(x['warm_s'] for x in c):.1f} s, warm again "

@@ -159,7 +159,7 @@ def measure_cold(repeats):
         "ji.impact(ji.law('hertz_rate', c=2e6, b1=800.0), m=1.0, v0=2.5).e.block_until_ready()",
     ]
     cli = [python, "-m", "jaximpact._cli", "simulate", "--law", "hertz_rate", "--param",
-           "c=2e6", "b1=800", "--v0", "2.5"]  # fmt: skip
+           "c=2e6", "b1=800", "--v0", "2.5", "--mass", "1"]  # fmt: skip
     main_job = [python, "examples/calibrate_e_and_T.py", "--plot",
                 os.path.join(tempfile.gettempdir(), "similarity_bench.png")]  # fmt: skip
     rows = []

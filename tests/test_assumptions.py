@@ -372,7 +372,7 @@ def test_simulate_sweeps_several_speeds(capsys, monkeypatch):
 
 
 def test_simulate_sweep_checks_every_speed_first(capsys):
-    argv = ["simulate", "--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "1", "-2"]
+    argv = ["simulate", "--mass", "1", "--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "1", "-2"]
     assert_one_line_error(*run_cli(capsys, argv), contains="--v0 -2: the impact speed v0")
 
 

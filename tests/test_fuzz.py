@@ -543,7 +543,7 @@ def test_cli_simulate_answers_or_says_why(capsys, c, v0):
     status, out, err = run_cli(
         capsys,
         [
-            "simulate",
+            "simulate", "--mass", "1",
             "--law",
             "hertz_rate",
             "--param",
@@ -570,7 +570,7 @@ def test_cli_calibrate_on_any_file(capsys, tmp_path_factory, content):
     else:
         path.write_text(content)
     status, out, err = run_cli(
-        capsys, ["calibrate", "--law", "hertz_rate", "--data", str(path), "--json"]
+        capsys, ["calibrate", "--mass", "1", "--law", "hertz_rate", "--data", str(path), "--json"]
     )
     if status != 0:
         assert_one_line_error(status, out, err)
@@ -646,7 +646,7 @@ def test_cli_calibrate_with_any_duration(capsys, T):
     """T = 1e300 s once ended in an OverflowError (exit status 1). A warning may come
     before the error: each on its own line, `jaximpact: warning: ...`."""
     status, out, err = run_cli(
-        capsys, ["calibrate", "--law", "hertz_rate", "--v0", "2.5", "--e", "0.8", "--T", T]
+        capsys, ["calibrate", "--mass", "1", "--law", "hertz_rate", "--v0", "2.5", "--e", "0.8", "--T", T]
     )
     lines = err.splitlines()
     assert all(line.startswith("jaximpact: warning: ") for line in lines[:-1]), err

@@ -118,7 +118,7 @@ def test_cli_refuses_an_output_that_is_an_input_before_any_work(capsys, tmp_path
         assert_one_line_error(status, out_text, err, contains="is the input")
     Path("data.csv").write_text("v0,e\n2.5,0.8\n")
     status, out_text, err = run_cli(
-        capsys, ["calibrate", "--law", "hertz_rate", "--data", "data.csv", "--plot",
+        capsys, ["calibrate", "--mass", "1", "--law", "hertz_rate", "--data", "data.csv", "--plot",
                  "./data.csv"],
     )  # fmt: skip
     assert_one_line_error(status, out_text, err, contains="is the input")
@@ -353,14 +353,14 @@ def test_check_scale_refuses_tiny_and_huge_alike(exponent, sign):
 
 @pytest.mark.parametrize("m", ["1e-300", "1e300", "1e-151", "1e151"])
 def test_cli_refuses_a_mass_float64_cannot_carry(capsys, m):
-    argv = ["simulate", "--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "2.5"]
+    argv = ["simulate", "--mass", "1", "--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "2.5"]
     status, out, err = run_cli(capsys, [*argv, "--mass", m])
     assert_one_line_error(status, out, err, contains="1e-150 to 1e150")
 
 
 def test_cli_refuses_contact_scales_float64_cannot_carry(capsys):
     """Each input within range, their product not: m v0^2 = 1e-240 J."""
-    argv = ["simulate", "--law", "hertz_rate", "--param", "c=2e6", "b1=800"]
+    argv = ["simulate", "--mass", "1", "--law", "hertz_rate", "--param", "c=2e6", "b1=800"]
     status, out, err = run_cli(capsys, [*argv, "--v0", "1e-120", "--mass", "1"])
     assert_one_line_error(status, out, err, contains="energy m v0^2")
 

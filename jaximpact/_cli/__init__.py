@@ -88,7 +88,7 @@ def build_parser() -> argparse.ArgumentParser:
             "Impact force laws integrated with JAX and diffrax. All quantities in SI units."
         ),
         epilog="example:\n  jaximpact laws\n"
-        "  jaximpact simulate --law hertz_rate --param c=2e6 --param b1=800 --v0 2.5\n\n"
+        "  jaximpact simulate --law hertz_rate --param c=2e6 --param b1=800 --v0 2.5 --mass 1\n\n"
         "'jaximpact COMMAND --help' describes each command.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -17,6 +17,7 @@ from .._interrupt import check_interrupt, set_note
 from .._plotting import new_figure, save_figure
 from .._progress import metered
 from .common import (
+    MASS_HELP,
     CLIError,
     add_law_arguments,
     add_output_arguments,
@@ -29,6 +30,7 @@ from .common import (
     is_file_law,
     parse_params,
     read_table,
+    require_mass,
 )
 from .laws import concrete_units
 
@@ -54,7 +56,7 @@ def add_calibrate(subparsers):
         "residuals). The first fit of a law compiles it (10-30 s); later runs reuse JAX's "
         "persistent compilation cache.",
         example="jaximpact calibrate --law hertz_rate --mass 1 --v0 2.5 --e 0.85 --T 7.8e-3\n"
-        "jaximpact calibrate --law kelvin_voigt --v0 2.5 --e 0.7 --T 2e-3 --free c,b --json\n"
+        "jaximpact calibrate --law kelvin_voigt --mass 1 --v0 2.5 --e 0.7 --T 2e-3 --free c,b --json\n"
         "jaximpact calibrate --law hertz_rate --mass 0.0027 --data drops.csv --plot fit.png\n"
         "jaximpact calibrate --law all --mass 0.0027 --data drops.csv",
     )
@@ -68,9 +70,7 @@ def add_calibrate(subparsers):
                 "--param c=1e6 b1=100 (default: jaximpact.starting_law, then the law's "
                 "restitution table where it has one)"
             )
-    parser.add_argument(
-        "--mass", type=float, default=1.0, metavar="KG", help="(effective) mass, kg (default 1)"
-    )
+    parser.add_argument("--mass", type=float, metavar="KG", help=MASS_HELP)
     parser.add_argument("--v0", type=float, metavar="M/S", help="impact speed, m/s (> 0)")
     parser.add_argument("--e", type=float, metavar="E", help="measured restitution, in (0, 1]")
     parser.add_argument("--T", type=float, metavar="S", help="measured contact duration, s")
@@ -231,6 +231,7 @@ def _middle(data):
 
 def run_calibrate(args):
     check_plot_path(args.plot, inputs=[args.data])
+    require_mass(args)
     if not (math.isfinite(args.mass) and args.mass > 0):
         raise CLIError(f"--mass must be a finite number > 0 kg, got {args.mass:g}")
     if args.max_iter < 1:

@@ -163,11 +163,26 @@ def tangential_from_args(args):
     return tangential_law(args.tangential, **parse_params(args.tparam, "--tparam"))
 
 
+MASS_HELP = (
+    "mass, kg (> 0; for two bodies their effective mass m1 m2 / (m1 + m2)): required, "
+    "every result depends on it"
+)
+
+
+def require_mass(args) -> float:
+    """`--mass`, or a one-line `CLIError` where it was not given: a mass is never assumed
+    (DESIGN.md, "What a user touches")."""
+    if args.mass is None:
+        raise CLIError(
+            "--mass is required: the body's mass in kg (for two bodies their effective mass "
+            "m1 m2 / (m1 + m2)); e, T and a fitted law all depend on it"
+        )
+    return args.mass
+
+
 def add_impact_arguments(parser):
     """`--mass`, `--v0`, `--separation` and `--gravity`, the conditions of one impact."""
-    parser.add_argument(
-        "--mass", type=float, default=1.0, metavar="KG", help="mass, kg (default 1)"
-    )
+    parser.add_argument("--mass", type=float, metavar="KG", help=MASS_HELP)
     parser.add_argument(
         "--v0", type=float, required=True, metavar="M/S", help="impact speed, m/s (> 0)"
     )

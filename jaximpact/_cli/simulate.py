@@ -17,6 +17,7 @@ from .common import (
     format_table,
     law_from_args,
     parse_params,
+    require_mass,
     terminal_width,
 )
 from .laws import concrete_units
@@ -56,11 +57,11 @@ def add_simulate(subparsers):
         "largest force F_max, the energy dissipated and how the contact ended. Several "
         "speeds (--v0 0.5 1 2 4) give a sweep: one row per speed with units in the header "
         "(--json: a list of the one-speed objects; --plot: e and T against v0).",
-        example="jaximpact simulate --law hertz_rate --param c=2e6 --param b1=800 --v0 2.5\n"
+        example="jaximpact simulate --law hertz_rate --param c=2e6 --param b1=800 --v0 2.5 --mass 1\n"
         "jaximpact simulate --law kelvin_voigt --param c=2e6 b=400 --mass 1 --v0 2.5 "
         "--separation penetration --json\n"
-        "jaximpact simulate --law bingham --param c=2e6 b=200 P=400 --v0 2.5 --plot bingham.png\n"
-        "jaximpact simulate --law hertz_rate --param c=2e6 b1=800 --v0 0.5 1 2 4",
+        "jaximpact simulate --law bingham --param c=2e6 b=200 P=400 --v0 2.5 --mass 1 --plot bingham.png\n"
+        "jaximpact simulate --law hertz_rate --param c=2e6 b1=800 --mass 1 --v0 0.5 1 2 4",
     )
     add_law_arguments(parser)
     add_impact_arguments(parser)
@@ -85,6 +86,8 @@ def _run_simulate(args):
     for v0 in speeds:  # every speed checked before any work
         if not (math.isfinite(v0) and v0 > 0):
             raise CLIError(f"--v0 {v0:g}: the impact speed v0 must be a finite number > 0 (m/s)")
+    require_mass(args)  # after the law and the speeds: their mistakes are told first
+    for v0 in speeds:
         check_contact_scales(args.law, parse_params(args.param), args.mass, v0)
     if args.tangential is not None:
         params = {k: float(v) for k, v in law.parameters.items()}

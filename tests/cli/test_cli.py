@@ -25,7 +25,7 @@ from jaximpact._cli import common, laws as cli_laws  # noqa: E402
 from jaximpact._plotting import plot_impact  # noqa: E402
 
 LAW = dict(c=2e6, b1=800.0)
-SIMULATE = ["simulate", "--law", "hertz_rate", "--param", "c=2e6", "--param", "b1=800"]
+SIMULATE = ["simulate", "--mass", "1", "--law", "hertz_rate", "--param", "c=2e6", "--param", "b1=800"]
 SIMULATE += ["--mass", "1", "--v0", "2.5"]
 
 
@@ -119,7 +119,7 @@ def test_simulate_text(capsys):
 def test_simulate_json_and_plot(capsys, tmp_path):
     # Kelvin-Voigt has a closed form (no solve), so only the plot's history costs a solve
     png = tmp_path / "impact.png"
-    argv = ["simulate", "--law", "kelvin_voigt", "--param", "c=2e6", "b=400", "--v0", "2.5"]
+    argv = ["simulate", "--mass", "1", "--law", "kelvin_voigt", "--param", "c=2e6", "b=400", "--v0", "2.5"]
     argv += ["--separation", "penetration", "--json", "--plot", str(png)]
     status, out, err = run_cli(capsys, argv)
     assert status == 0 and err == ""
@@ -177,7 +177,7 @@ def test_simulate_bad_input(capsys, argv, contains):
 def test_a_number_with_a_unit_is_told_what_to_give(capsys, extra, contains):
     """Found by using the command as a new user: `--radius 5mm` or `--mass 10 g` said only
     `invalid float value` or `unrecognized arguments: g`."""
-    argv = ["simulate", "--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "2.5"]
+    argv = ["simulate", "--mass", "1", "--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "2.5"]
     assert_one_line_error(*run_cli(capsys, [*argv, *extra]), contains=contains)
 
 
@@ -310,3 +310,11 @@ def test_console_script_environment():
     assert run_as("/usr/bin/jaximpact") == ["None", "nan", "3", "nan"]
     _, eqx_env, _, eqx_mode = run_as("analysis.py")
     assert (eqx_env, eqx_mode) == ("None", "raise")
+
+
+def test_simulate_asks_for_the_mass(capsys):
+    """A mass is asked for, never assumed (it was 1 kg by default: a 10 g ball simulated
+    without --mass gave a 1 kg body's contact without a word)."""
+    argv = ["simulate", "--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "2.5"]
+    status, out, err = run_cli(capsys, argv)
+    assert_one_line_error(status, out, err, contains="--mass is required: the body's mass in kg")

@@ -114,7 +114,7 @@ def test_progress_bar(capsys, monkeypatch):
 
 def test_data_file_with_missing_T_and_plot(capsys, tmp_path, law14_csv):
     png = tmp_path / "fit.png"
-    argv = ["calibrate", "--law", "hertz_rate", "--data", str(law14_csv), "--json"]
+    argv = ["calibrate", "--mass", "1", "--law", "hertz_rate", "--data", str(law14_csv), "--json"]
     status, out, err = run_cli(capsys, [*argv, "--plot", str(png)])
     assert status == 0 and err == ""
     data = json.loads(out)
@@ -140,7 +140,7 @@ def test_model_choice(capsys, monkeypatch, law14_csv):
         return compare_laws(laws=laws, **kwargs)
 
     monkeypatch.setattr(_model_choice, "compare_laws", failing_maxwell)
-    status, out, err = run_cli(capsys, ["calibrate", "--law", "all", "--data", str(law14_csv)])
+    status, out, err = run_cli(capsys, ["calibrate", "--mass", "1", "--law", "all", "--data", str(law14_csv)])
     assert status == 0 and err == ""
     lines = out.splitlines()
     header = next(line.split() for line in lines if line.startswith("rank"))
@@ -155,7 +155,7 @@ def test_model_choice(capsys, monkeypatch, law14_csv):
     assert "failed: maxwell (RuntimeError: boom)" in out
     monkeypatch.setattr(_cli_calibrate, "MODEL_CHOICE_LAWS", ("kelvin_voigt", "hertz_rate"))
     status, out, _ = run_cli(
-        capsys, ["calibrate", "--law", "all", "--data", str(law14_csv), "--json"]
+        capsys, ["calibrate", "--mass", "1", "--law", "all", "--data", str(law14_csv), "--json"]
     )
     data = json.loads(out)
     assert data["best"] == "hertz_rate" and data["criterion"] == "sum_sq"
@@ -170,7 +170,7 @@ def test_model_choice_warns_when_the_best_law_fits_badly(capsys, monkeypatch, la
     """Kelvin-Voigt alone on law 14's falling e: its optimiser converges, it is the best
     of one, and it fits badly (RMS of e_fit - e above 0.01, no sigmas): a warning line."""
     monkeypatch.setattr(_cli_calibrate, "MODEL_CHOICE_LAWS", ("kelvin_voigt",))
-    status, out, err = run_cli(capsys, ["calibrate", "--law", "all", "--data", str(law14_csv)])
+    status, out, err = run_cli(capsys, ["calibrate", "--mass", "1", "--law", "all", "--data", str(law14_csv)])
     assert status == 0 and err == ""
     assert "best: kelvin_voigt" in out
     (line,) = [line for line in out.splitlines() if line.startswith("warning:")]
@@ -200,12 +200,16 @@ BAD = [
     (["--v0", "2.5", "--e", "0.8", "--sigma-T", "1e-4"], "sigma_T is given without any T"),
     (["--v0", "2.5", "--e", "0.8", "--plot", "fit.xyz"], "unknown figure format"),
     (["--v0", "2.5", "--e", "0.8", "--max-iter", "0"], "--max-iter"),
+    (["--v0", "2.5", "--e", "0.8"], "--mass is required: the body's mass in kg"),
 ]
 
 
 @pytest.mark.parametrize("argv, contains", BAD, ids=[c for _, c in BAD])
 def test_bad_input_is_one_line(capsys, argv, contains):
+    """Each as one line; a mass is asked for, never assumed (it was 1 kg by default)."""
     law = ["--law", "hertz_rate"]
+    if "--mass" not in [*argv, contains.split()[0]]:  # the mass is what the case is about
+        argv = [*argv, "--mass", "1"]
     assert_one_line_error(*run_cli(capsys, ["calibrate", *law, *argv]), contains=contains)
 
 
@@ -224,19 +228,19 @@ BAD_FILES = [
 
 @pytest.mark.parametrize("text, contains", BAD_FILES, ids=[c for _, c in BAD_FILES])
 def test_bad_data_file_is_one_line(capsys, tmp_path, text, contains):
-    argv = ["calibrate", "--law", "hertz_rate", "--data", _csv(tmp_path, text)]
+    argv = ["calibrate", "--mass", "1", "--law", "hertz_rate", "--data", _csv(tmp_path, text)]
     assert_one_line_error(*run_cli(capsys, argv), contains=contains)
 
 
 def test_conflicting_and_missing_sources(capsys, tmp_path):
     path = _csv(tmp_path, "v0,e\n1,0.8\n")
-    argv = ["calibrate", "--law", "hertz_rate", "--data", path, "--e", "0.8"]
+    argv = ["calibrate", "--mass", "1", "--law", "hertz_rate", "--data", path, "--e", "0.8"]
     assert_one_line_error(*run_cli(capsys, argv), contains="give either --data or --e, not both")
-    argv = ["calibrate", "--law", "hertz_rate", "--data", str(tmp_path / "none.csv")]
+    argv = ["calibrate", "--mass", "1", "--law", "hertz_rate", "--data", str(tmp_path / "none.csv")]
     assert_one_line_error(*run_cli(capsys, argv), contains="cannot read --data")
-    argv = ["calibrate", "--law", "all", "--data", path, "--free", "c"]
+    argv = ["calibrate", "--mass", "1", "--law", "all", "--data", path, "--free", "c"]
     assert_one_line_error(*run_cli(capsys, argv), contains="drop --free and --param")
-    argv = ["calibrate", "--law", "no_such_law", "--v0", "1", "--e", "0.8"]
+    argv = ["calibrate", "--mass", "1", "--law", "no_such_law", "--v0", "1", "--e", "0.8"]
     assert_one_line_error(*run_cli(capsys, argv), contains="unknown law 'no_such_law'")
 
 
@@ -256,5 +260,5 @@ def test_model_choice_when_every_law_fails(capsys, monkeypatch, tmp_path):
         raise RuntimeError("boom")
 
     monkeypatch.setattr(_model_choice, "compare_laws", failing)
-    argv = ["calibrate", "--law", "all", "--data", _csv(tmp_path, "v0,e\n1,0.8\n2,0.7\n")]
+    argv = ["calibrate", "--mass", "1", "--law", "all", "--data", _csv(tmp_path, "v0,e\n1,0.8\n2,0.7\n")]
     assert_one_line_error(*run_cli(capsys, argv), contains="no law could be fitted: maxwell")

@@ -50,7 +50,7 @@ def law_file(tmp_path_factory):
 
 def test_simulate_runs_a_users_law_and_names_it(capsys, law_file):
     _, law = law_file
-    status, out, err = run_cli(capsys, ["simulate", "--law", law, *PARAMS, "--v0", "2.5",
+    status, out, err = run_cli(capsys, ["simulate", "--mass", "1", "--law", law, *PARAMS, "--v0", "2.5",
                                         "--json"])  # fmt: skip
     assert status == 0, err
     data = json.loads(out)
@@ -59,7 +59,7 @@ def test_simulate_runs_a_users_law_and_names_it(capsys, law_file):
     want = ji.impact(ji.law("hertz_rate", c=2e6, b1=800.0), m=1.0, v0=2.5)
     for key in ("e", "T", "x_max", "F_max"):
         assert_rel(data[key], getattr(want, key), 1e-9, key)
-    status, out, err = run_cli(capsys, ["simulate", "--law", law, *PARAMS, "--v0", "2.5"])
+    status, out, err = run_cli(capsys, ["simulate", "--mass", "1", "--law", law, *PARAMS, "--v0", "2.5"])
     assert status == 0, err
     assert out.splitlines()[0] == f"law        {law}"
 
@@ -118,7 +118,7 @@ def test_a_bad_law_file_is_one_line(capsys, law_file, law, params, message):
     (folder / "broken.py").write_text("def f(x, v, p):\n    return undefined * x\n")
     (folder / "law.txt").write_text("")
     fill = {"file": str(path), "dir": str(folder)}
-    argv = ["simulate", "--law", law.format(**fill), *(["--param", *params] if params else []),
+    argv = ["simulate", "--mass", "1", "--law", law.format(**fill), *(["--param", *params] if params else []),
             "--v0", "1"]  # fmt: skip
     assert_one_line_error(*run_cli(capsys, argv), contains=message.format(**fill))
 
@@ -126,7 +126,7 @@ def test_a_bad_law_file_is_one_line(capsys, law_file, law, params, message):
 def test_commands_that_need_the_law_table_refuse_a_users_law(capsys, law_file):
     _, law = law_file
     assert_one_line_error(*run_cli(capsys, ["laws", law]), contains=f"{law} is a user's law")
-    result = run_cli(capsys, ["calibrate", "--law", law, "--param", "c=2e6", "--v0", "2",
+    result = run_cli(capsys, ["calibrate", "--mass", "1", "--law", law, "--param", "c=2e6", "--v0", "2",
                               "--e", "0.8"])  # fmt: skip
     assert_one_line_error(*result, contains='reads params["b1"]: give it with --param b1=...')
 
@@ -136,7 +136,7 @@ def test_calibrate_fits_a_users_law(capsys, law_file):
     _, law = law_file
     truth = ji.impact(ji.law("hertz_rate", c=2e6, b1=800.0), m=1.0, v0=2.5)
     status, out, err = run_cli(capsys, [
-        "calibrate", "--law", law, "--param", "c=1.5e6", "b1=500", "--v0", "2.5",
+        "calibrate", "--mass", "1", "--law", law, "--param", "c=1.5e6", "b1=500", "--v0", "2.5",
         "--e", repr(float(truth.e)), "--T", repr(float(truth.T)), "--json",
     ])  # fmt: skip
     assert status == 0, err
@@ -145,7 +145,7 @@ def test_calibrate_fits_a_users_law(capsys, law_file):
     assert data["params"]["c"] == pytest.approx(2e6, rel=1e-6)
     assert data["params"]["b1"] == pytest.approx(800.0, rel=1e-6)
     status, out, err = run_cli(capsys, [
-        "calibrate", "--law", law, "--param", "c=1.5e6", "b1=500", "--v0", "2.5",
+        "calibrate", "--mass", "1", "--law", law, "--param", "c=1.5e6", "b1=500", "--v0", "2.5",
         "--e", repr(float(truth.e)), "--T", repr(float(truth.T)),
     ])  # fmt: skip
     assert status == 0, err
