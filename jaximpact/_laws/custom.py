@@ -13,6 +13,7 @@ from .._checks import check_values
 from .base import AbstractLaw, LawSpec
 from .clamps import unclamped
 from .dynamics import scaled_dynamics
+from .fast_powers import fast_powers
 from .parameters import as_arrays
 
 
@@ -44,8 +45,10 @@ class CustomLaw(AbstractLaw):
         `x > 0`, at the smallest positive float where `0 <= x` is smaller (its limit at
         first touch, e.g. `b v` for `c x + b v`), and below the surface the force is 0 with
         gradient 0. So `x**1.5`, `jnp.sqrt(x)` or `jnp.power(x, n)` need no guard: neither
-        the value nor the gradient is ever NaN."""
-        return _inside_surface(self.fn, x, v, self.params)
+        the value nor the gradient is ever NaN. A constant power that is a multiple of 1/2
+        (`x**1.5`, `jnp.power(x, 2.5)`) is evaluated as `x * sqrt(x)` and multiplies,
+        10x cheaper than `pow` and within a few ulps of it (`fast_powers`)."""
+        return _inside_surface(fast_powers(self.fn), x, v, self.params)
 
     def edge_force(self, x, v):
         """The force whose first zero inside the surface ends contact under the force
@@ -58,7 +61,7 @@ class CustomLaw(AbstractLaw):
         peeled = unclamped(self.fn, self.params)
         if peeled is None:
             return self.force(x, v)
-        return _inside_surface(peeled, x, v, self.params)
+        return _inside_surface(fast_powers(peeled), x, v, self.params)
 
 
 def _inside_surface(fn, x, v, params):
