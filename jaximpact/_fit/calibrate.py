@@ -27,6 +27,7 @@ from .._laws import AbstractLaw, damping_parameter, shape_of
 from .._solve.impact import CURVES_RTOL, ImpactOptions, similarity_reason, solve_impact
 from .._solve.options import is_no_gravity, table_key
 from .._status import Status
+from .._xla_log import quietly_compiled
 from .forward_jacobian import value_and_jacobian, with_forward_jacobian
 from .parameters import default_free, law_with, to_unbounded
 from .restitution_tables import restitution_table
@@ -573,6 +574,7 @@ def _run_lm(residuals, theta0, data, max_iter, tol):
     return solution.value, solution.stats["num_steps"], stopped
 
 
+@quietly_compiled
 def calibrate(
     law: AbstractLaw,
     *,

@@ -34,6 +34,7 @@ import numpy as np
 from .._laws import AbstractLaw
 from .._solve.bounce import bounce_options
 from .._solve.options import default_rtol
+from .._xla_log import quietly_compiled
 from .bounce_fit import BounceFit, Measurements, find_outliers, finish
 from .bounce_model import (
     BounceProblem,
@@ -140,6 +141,7 @@ def _guess_trajectory(t, h, g):
     return dict(release=release, t1=t1, v1=slope / scale, scale=scale, floor=floor0, e=e0)
 
 
+@quietly_compiled
 def fit_bounces(
     law: AbstractLaw,
     *,

@@ -14,6 +14,7 @@ from jax.scipy.special import gammaln
 from .._format import format_fields, format_value, jsonable
 from .._laws import LAWS, AbstractLaw, exponents, law
 from .._progress import AbstractMeter, metered
+from .._xla_log import quietly_compiled
 from .calibrate import Fit, calibrate
 from .parameters import default_free
 
@@ -214,6 +215,7 @@ def fits_badly(fit: Fit, *, max_rms_e=MAX_RMS_E, max_rms_T=MAX_RMS_T) -> str | N
     )
 
 
+@quietly_compiled
 def compare_laws(
     *,
     m,
