@@ -3,7 +3,10 @@ gravities, arrays in and arrays out. The rows are checked once (`prepare_rows`),
 `run_impacts` computes them through `run_batch` with no further check, on the path that
 `choose_path` decides once for the batch (`solve_impact` per row); a cost key (the
 dimensionless groups that fix an impact's step count) orders the integrated rows so that
-each chunk holds members of similar cost. Files of rows are `_jobs`'.
+each chunk holds members of similar cost. An integrated batch of a law whose force is a
+function of `(x, v)` first runs every row on the grid (`_solve.grid`: no event search), then
+integrates, in a second batched pass, only the rows the grid did not serve. Files of rows
+are `_jobs`'.
 """
 
 import functools
@@ -22,6 +25,7 @@ from .._choices import unknown_name
 from .._laws import LAW_NAMES, LAWS, AbstractLaw, CustomLaw, custom_law
 from .._laws.named_law import batch_law, invalid_parameter_rows, table_law
 from .._progress import AbstractMeter
+from .._solve.grid import GRID_FIELDS, grid_contact, grid_serves
 from .._solve.impact import check_custom_law, solve_impact
 from .._solve.options import (
     check_choices,
@@ -31,7 +35,7 @@ from .._solve.options import (
 )
 from .._solve.precision import resolvable_tolerances
 from .._status import Status
-from .runner import run_batch
+from .runner import GLOBAL, run_batch
 
 IMPACT_FIELDS = ("e", "T", "x_max", "F_max", "status")
 
@@ -46,6 +50,7 @@ _ALL_FIELDS = (
     "v_out",
     "status",
     "num_steps",
+    "path",  # the path that served each row (a string per row)
 )
 
 
@@ -89,6 +94,19 @@ def _impact_member(skeleton, fields: tuple, options, gravity: bool):
         g = row["g"] if gravity else jnp.asarray(0.0, dtype=float)
         result = solve_impact(law, row["m"], row["v0"], g, None, options)
         return {name: getattr(result, name) for name in fields if getattr(result, name) is not None}
+
+    return member
+
+
+@functools.lru_cache(maxsize=64)
+def _grid_member(skeleton, fields: tuple, separation: str):
+    """One checked row (no gravity) -> the `fields` of its contact on the grid
+    (`grid_contact`) and `served`, whether the grid served it; cached as `_impact_member`."""
+
+    def member(row):
+        law = build_law(skeleton, row["params"])
+        out = grid_contact(law, row["m"], row["v0"], separation=separation)
+        return {name: out[name] for name in (*fields, "served")}
 
     return member
 
@@ -154,8 +172,8 @@ def batch_path(law, separation, *, method="auto", rtol=1e-11, g=0.0, **impact_op
     params = {k: np.atleast_1d(np.asarray(v, dtype=float)) for k, v in law.parameters.items()}
     skeleton, params = _fix_shape(law_skeleton(law), params)
     gravity = not (isinstance(g, (int, float)) and g == 0)
-    path = _member_path(skeleton, params, gravity, separation=separation, method=method,
-                        solver=impact_options.get("solver"), rtol=rtol)  # fmt: skip
+    path, _ = _member_path(skeleton, params, gravity, separation=separation, method=method,
+                           solver=impact_options.get("solver"), rtol=rtol)  # fmt: skip
     return _LABELS.get(path.name, path.name)
 
 
@@ -258,11 +276,14 @@ def _invalid_rows(skeleton, params, kinematics) -> np.ndarray:
 
 class Impacts(NamedTuple):
     """What `run_impacts` computed: `out` (field -> one value per row), `lost` (the rows
-    whose results float64 cannot hold) and `path`, the way every row went (`batch_path`)."""
+    whose results float64 cannot hold), `path`, the way the batch went (`batch_path`;
+    `"grid"` where the grid served every row), and `paths`, the way each row went (`"grid"`
+    for the rows the grid served, the others on `path`)."""
 
     out: dict
     lost: np.ndarray
     path: str
+    paths: np.ndarray
 
 
 def run_impacts(
@@ -303,9 +324,14 @@ def run_impacts(
     if gravity:
         rows["g"] = kinematics["g"]
     solver = impact_options.get("solver")
-    path = _member_path(skeleton, params, gravity, separation=separation, method=method,
-                        solver=solver, rtol=rtol)  # fmt: skip
+    path, plain = _member_path(skeleton, params, gravity, separation=separation, method=method,
+                               solver=solver, rtol=rtol)  # fmt: skip
     atol = rtol if limits["atol"] is None else limits["atol"]
+    # one program over every process's devices pairs the processes' calls: each gives the
+    # same rows, which a second pass over each one's own left rows would not
+    spans = isinstance(devices, str) and devices == GLOBAL
+    grid = not spans and grid_serves(path, plain, method=method, solver=solver, rtol=rtol,
+                                     gravity=gravity)  # fmt: skip
     rtol, atol, rest_tol = resolvable_tolerances(rtol, atol, limits["rest_tol"])
     options = make_options(
         path,
@@ -320,32 +346,62 @@ def run_impacts(
         peaks=peaks,
         gravity=gravity,
     )
+    computed = tuple(name for name in fields if name != "path")
     try:
-        member = _impact_member(skeleton, tuple(fields), options, gravity)
+        member = _impact_member(skeleton, computed, options, gravity)
     except TypeError:  # an option that cannot be hashed (an array): compiled for this call
-        member = _impact_member.__wrapped__(skeleton, tuple(fields), options, gravity)
-    cost = None
-    if order == "cost" and path.integrates:
-        cost = cost_key(skeleton, params, **kinematics)
+        member = _impact_member.__wrapped__(skeleton, computed, options, gravity)
     label = skeleton[1] if skeleton[0] == "law" else "custom law"
-    out = run_batch(
-        member,
-        rows,
-        chunk_size=(1024 if path.integrates else 65536) if chunk_size is None else chunk_size,
-        progress=progress,
-        devices=devices,
-        cost=cost,
-        exact=exact,
-        description=f"impacts ({label})",
-    )
-    out = {name: out[name] for name in fields if name in out}
-    return Impacts(out, _not_representable(out), _LABELS.get(path.name, path.name))
+    chunk = (1024 if path.integrates else 65536) if chunk_size is None else chunk_size
+    batch = dict(progress=progress, devices=devices, exact=exact)
+    name = _LABELS.get(path.name, path.name)
+    paths = np.full(rows["m"].shape, name)
+    if grid:  # every row on the grid, then the rows it did not serve integrated
+        on_grid = _grid_member(skeleton, _grid_fields(computed, plain, peaks), separation)
+        out = run_batch(on_grid, rows, chunk_size=chunk, cost=None,
+                        description=f"impacts ({label}) on the grid", **batch)  # fmt: skip
+        served = out.pop("served")
+        paths = np.where(served, "grid", name)
+        left = np.flatnonzero(~served)  # gathered on the host: one more batched pass
+        if left.size:
+            part = jax.tree.map(lambda a: a[left], rows)
+            cost = None
+            if order == "cost":
+                kept = {k: v[left] for k, v in kinematics.items()}
+                cost = cost_key(skeleton, part["params"], **kept)
+            rest = run_batch(member, part, chunk_size=chunk, cost=cost,
+                             description=f"impacts ({label}) the grid left", **batch)  # fmt: skip
+            for key, values in rest.items():
+                out[key][left] = values
+        name = "grid" if served.all() else name
+    else:
+        cost = None
+        if order == "cost" and path.integrates:
+            cost = cost_key(skeleton, params, **kinematics)
+        out = run_batch(member, rows, chunk_size=chunk, cost=cost,
+                        description=f"impacts ({label})", **batch)  # fmt: skip
+    out = {key: out[key] for key in computed if key in out}
+    if "path" in fields:
+        out["path"] = paths
+    return Impacts(out, _not_representable(out), name, paths)
+
+
+def _grid_fields(fields: tuple, law, peaks: bool) -> tuple:
+    """The `fields` the grid gives, as the integrated member gives them: without `peaks`
+    no `F_max`, and `x_max`, `t_max` only for a law split at maximum compression (its row's
+    `split`)."""
+    dropped = set() if peaks else {"F_max"}
+    if not peaks and not (law.spec and law.spec.split):
+        dropped |= {"x_max", "t_max"}
+    return tuple(name for name in fields if name in GRID_FIELDS and name not in dropped)
 
 
 def _member_path(skeleton, params, gravity: bool, **choice):
     """`choose_path` for the law as every member of the batch sees it (one row, its
     parameters traced values, the shape that `_fix_shape` fixed as numbers), and a user's
-    force function tried (`check_custom_law`): once for the batch, with no numbers."""
+    force function tried (`check_custom_law`): once for the batch, with no numbers. Returns
+    the path and the law built from the first row's numbers (what the grid reads of it:
+    `has_state`, `spec`)."""
     decided = []
 
     def member(row):
@@ -356,7 +412,7 @@ def _member_path(skeleton, params, gravity: bool, **choice):
 
     row = {"params": {k: v[0] for k, v in params.items()}, "v0": 1.0, "g": 1.0}
     jax.eval_shape(member, row)
-    return decided[0]
+    return decided[0], build_law(skeleton, row["params"])
 
 
 def mark_invalid(out: dict, rows: np.ndarray) -> dict:

@@ -68,7 +68,7 @@ def compute_chunk(law, cells, fixed: dict, options: dict, group: ProcessGroup | 
         for k in FLOAT_OUTPUTS:
             results[k][idx] = out[k][mine]
         status[idx] = _STATUS_NAMES[out["status"][mine]]
-        path[idx] = done.path
+        path[idx] = done.paths[mine]  # "grid" for the rows the grid served
     return {**results, "status": status.tolist(), "path": path.tolist()}
 
 

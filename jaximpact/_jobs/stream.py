@@ -43,7 +43,13 @@ def impact_batch(
       `max_steps`, `tau_max`, `rest_tol`): as in `jaximpact.impact` (`rtol` by default
       1e-11; to a file, `impact`'s: 1e-11, a user's law 1e-12).
     - `fields`: which `ImpactResult` fields to return (default `e, T, x_max, F_max, status`);
-      with `peaks=False` the peak fields are left out.
+      with `peaks=False` the peak fields are left out. `"path"` adds each row's path, a
+      string: an integrated batch of a law whose force is a function of `(x, v)` (a user's
+      law, a law of the table off the curves) without gravity, at `method="auto"` and the
+      default tolerances, runs every row on a fixed grid of the contact's phase-plane angle
+      first (no event search; `"grid"` where it served the row to 1e-9), then integrates
+      only the rows it could not serve (heavy damping, a force that pulls, a body held),
+      with their path `"integrated"`; `method="integrate"` integrates every row.
     - `order`: `"cost"` (default) runs the rows sorted by their dimensionless groups (which
       fix the step count; see `run_batch`) and returns them in the given order; `"given"`
       runs them as given.

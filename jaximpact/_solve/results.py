@@ -34,7 +34,8 @@ class ImpactResult(eqx.Module):
     - `x_max`, `t_max`, `F_max` are `None` under `impact(..., peaks=False)`, which skips the
       events that find them (a law split at maximum compression still gives `x_max`).
     - `path`: `"similarity"` (read off the universal curves), `"closed_form"` or
-      `"integrated"`.
+      `"integrated"`; a row of `impact_batch` (its field `"path"`, one string per row) may
+      also say `"grid"`: served by the fixed grid of the phase-plane angle (`_solve.grid`).
     - `ts`, `x`, `v`, `F`: time histories, only when `impact(..., ts=...)` asked for them.
     """
 

@@ -67,12 +67,12 @@ def test_batch_file_takes_a_users_law(whole, tmp_path):
     assert record.statuses["separated"] == N
     out = _read(path)
     assert list(out) == [*COLUMNS, *FIELDS, "status", "path"]
-    assert set(out["status"]) == {"separated"} and set(out["path"]) == {"integrated"}
+    assert set(out["status"]) == {"separated"} and set(out["path"]) == {"grid"}
     got = {k: np.asarray(out[k], float) for k in FIELDS}
-    for i in (0, 3, 5):  # `impact` of the same law, row by row
+    for i in (0, 3, 5):  # `impact` of the same law, row by row (the file: the grid)
         r = ji.impact(LAW.replace(c=COLUMNS["c"][i]), m=COLUMNS["m"][i], v0=COLUMNS["v0"][i])
         for k in FIELDS:
-            assert_rel(got[k][i], getattr(r, k), 1e-10, f"row {i}: {k}")
+            assert_rel(got[k][i], getattr(r, k), 1e-9, f"row {i}: {k}")  # grid vs events
     _write_bodies(tmp_path / "in.csv")  # the table's law 14, the same force
     _run(tmp_path, "table.csv", law="hertz_rate", params={"b1": B1})
     table = _read(tmp_path / "table.csv")

@@ -81,7 +81,7 @@ def test_batch_runs_a_users_law_with_parameters_from_the_columns(capsys, law_fil
     want = ji.impact_batch("hertz_rate", {"c": c, "b1": 800.0}, m=m, v0=v0, progress=False)
     for key in got:  # the table's law 14, the same force
         assert_rel(got[key], want[key], 1e-9, key)
-    assert {r[header.index("path")] for r in rows} == {"integrated"}
+    assert {r[header.index("path")] for r in rows} == {"grid"}
     result = run_cli(capsys, [*argv[:4], "--out", str(tmp_path / "o.csv")])  # no b1
     assert_one_line_error(*result, contains=f'{law} reads params["b1"]: give a column b1')
     assert not (tmp_path / "o.csv").exists()
