@@ -1,6 +1,6 @@
 """A file job: a table of bodies on disk (CSV or Parquet) or a script's chunks in, one impact
-per row out, written with the inputs beside `e`, `T`, `x_max`, `t_max`, `F_max`, `status`
-and `path`.
+per row out, written with the inputs (the columns the job does not read carried through
+unchanged, in their places) beside `e`, `T`, `x_max`, `t_max`, `F_max`, `status` and `path`.
 
 `batch_file` drives it in four steps, each a function of the job's record `Job`:
 
@@ -39,9 +39,11 @@ from .chunks import compute_chunk
 from .job_law import JobLaw, job_law
 from .parts import Parts
 from .processes import ProcessGroup
+from .parts import OUTPUTS
 from .readers import (
     PARQUET_SUFFIXES,
     TEXT_COLUMNS,
+    carried_columns,
     is_parquet,
     open_chunks,
     open_table,
@@ -126,18 +128,24 @@ def batch_file(source, out, law, *, params: dict | None = None, m: float | None 
     """Run `impact_batch` over the rows of the file `source` and write `out`.
 
     - `source`, `out`: CSV files, or Parquet (`.parquet`, `.pq`; needs pyarrow). `out`
-      holds the input columns (a CSV's text as written) and `e`, `T` (s), `x_max` (m),
-      `t_max` (s), `F_max` (N), `status` (a `Status` name) and `path` per row, in file
-      order. `source` may also be an iterable of chunks from a script: mappings column ->
-      1-D array or number (dicts of numpy arrays, pandas DataFrames), each chunk used as
-      given (not `chunk_rows`). A list is read twice (every value checked first); a
-      generator once, each chunk checked just before it is computed.
+      holds the input columns in their order (a CSV's text as written) and `e`, `T` (s),
+      `x_max` (m), `t_max` (s), `F_max` (N), `status` (a `Status` name) and `path` per row,
+      in file order. A column the job does not read (an `id`, a `name`, a `note` in free
+      text: neither a parameter the law reads nor `m`, `v0`, `g`, `separation`) is carried
+      through as text, unchanged (a string column in Parquet), and its cells are part of the
+      inputs a resume compares; one whose name is close to a column the job reads
+      (`separaton`, `V0`, `b_1`) or that names a result (`e`, `status`, ...) is refused, a
+      `ValueError` naming the likely column. `source` may also be an iterable of chunks
+      from a script: mappings column -> 1-D array or number (dicts of numpy arrays, pandas
+      DataFrames), each chunk used as given (not `chunk_rows`). A list is read twice (every
+      value checked first); a generator once, each chunk checked just before it is computed.
     - `law`: a name of `LAW_NAMES`, a law from `jaximpact.law` (its parameters are the
       values every row takes unless a column or `params` gives them) or a user's law from
-      `custom_law` (the same; and any column other than `m`, `v0`, `g`, `separation` is a
-      parameter it reads, as is every name of `params`: one it does not read is refused,
-      and so is a parameter it reads that nothing gives). The file's columns give, per row,
-      any of its parameters and `m` (kg), `v0` (m/s), `g` (m/s^2), `separation`; `params`,
+      `custom_law` (the same; and a column other than `m`, `v0`, `g`, `separation` that its
+      function reads is a parameter, as is every name of `params`: a name of `params` it
+      does not read is refused, and so is a parameter it reads that nothing gives; a column
+      it does not read is carried through). The file's columns give, per row, any of its
+      parameters and `m` (kg), `v0` (m/s), `g` (m/s^2), `separation`; `params`,
       `m`, `v0`, `g`, `separation` give the rest (SI units; `g` 0 and `separation` "force"
       where neither gives them). A column and an argument for the same name must agree on
       every row: a `ValueError` names the first row where they do not.
@@ -207,15 +215,17 @@ def plan(source, out, law, *, params, given, chunk_rows, resume, progress, mesh,
         require_pyarrow(out)
     params = params or {}
     fixed, agree = _given_for_every_row(law, params, given)
-    allowed = law.allowed
-    table = open_table(source, allowed) if from_file else open_chunks(source, allowed)
+    table = open_table(source) if from_file else open_chunks(source)
     columns = table.columns
     law = law.complete(columns, params, source.name if from_file else "chunks")
+    carried = carried_columns(columns, law.known_columns, table.where_header, OUTPUTS)
+    table.carry(carried)  # read as text, written unchanged (a Parquet file's types checked)
     missing = [k for k in (*law.parameters, "m", "v0") if k not in columns and k not in fixed]
     if missing:
+        unread = f" (carried through unread: {', '.join(carried)})" if carried else ""
         raise ValueError(
             f"{source if from_file else 'chunks'}: no value for {', '.join(missing)}: give a "
-            "column or a fixed value (--param NAME=VALUE, --mass, --v0)"
+            f"column or a fixed value (--param NAME=VALUE, --mass, --v0){unread}"
         )
     fixed = {k: v for k, v in fixed.items() if k not in columns}
     agree = {k: v for k, v in agree.items() if k in columns}  # checked row by row

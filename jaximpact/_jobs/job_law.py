@@ -1,8 +1,9 @@
 """The law of a file job, as the job reads it (`JobLaw`): a name of the law table, a law of
 the table (`jaximpact.law`: its parameters are the values every row takes unless a column
 or `params` gives them) or a user's law (`custom_law`: its parameters are those it holds,
-those `params` gives and the table's columns that are not `m`, `v0`, `g`, `separation`;
-every one of them that a column or `params` gives must be read by its function).
+those `params` gives and the table's columns that are not `m`, `v0`, `g`, `separation` and
+that its function reads; every one that `params` gives, or a column naming one it holds,
+must be read by its function; any other column is carried through to the output).
 
 A resumed job reuses a chunk only where the law is the same (`JobLaw.identity`, hashed with
 each chunk's inputs): a table law's name; for a user's law its name, the function's module,
@@ -26,7 +27,7 @@ from .._batch import law_skeleton
 from .._choices import unknown_name
 from .._laws import LAW_NAMES, LAWS, AbstractLaw, law as make_law
 from .._laws.named_law import invalid_parameter_rows
-from .readers import TEXT_COLUMNS
+from .readers import TEXT_COLUMNS, close_column
 from .row_checks import KINEMATICS, option_name
 
 
@@ -65,13 +66,6 @@ def parameters_read(fn: Callable, names) -> tuple[str, ...]:
     return tuple(read)
 
 
-class _Every:
-    """Every column name: a user's law's table may name any parameter (checked after)."""
-
-    def __contains__(self, name):
-        return True
-
-
 @dataclasses.dataclass(frozen=True)
 class JobLaw:
     """What a file job reads of its law: `label` (its name in messages and meters: the
@@ -97,10 +91,9 @@ class JobLaw:
         return self.fn is not None
 
     @property
-    def allowed(self):
-        """The columns a table may have (a user's law: any, checked by `complete`)."""
-        if self.user:
-            return _Every()
+    def known_columns(self) -> tuple:
+        """The columns a job reads (a user's law: once `complete`d); any other is carried
+        through to the output (`readers.carried_columns`)."""
         return (*self.parameters, *KINEMATICS, *TEXT_COLUMNS)
 
     def invalid_rows(self, params: dict) -> np.ndarray:
@@ -121,10 +114,11 @@ class JobLaw:
 
     def complete(self, columns, params: dict, where: str) -> "JobLaw":
         """A user's law with its `parameters` named by its own, by `params` and by the
-        table's `columns` (those not `m`, `v0`, `g`, `separation`), each checked against
-        what its function reads: a one-line `ValueError` for a parameter it reads that none
-        gives, and for a column or a value of `params` it does not read (`where`: the
-        table, for messages). A table law as it is."""
+        table's `columns` that its function reads (those not `m`, `v0`, `g`,
+        `separation`; the others are carried through), each checked against what its
+        function reads: a one-line `ValueError` for a parameter it reads that none gives,
+        and for a value of `params`, or a column naming a parameter it holds, that it does
+        not read (`where`: the table, for messages). A table law as it is."""
         if not self.user:
             return self
         own = (*KINEMATICS, *TEXT_COLUMNS)
@@ -134,13 +128,15 @@ class JobLaw:
             read = parameters_read(self.fn, names)
         except MissingParameter as error:
             key = error.args[0]
+            near = close_column(key, from_columns)
+            hint = f" (column {near!r} is not {key})" if near is not None else ""
             raise ValueError(
                 f"{self.label} reads params[{json.dumps(key)}]: give a column {key} or a "
-                f"value for every row, {option_name(key)}"
+                f"value for every row, {option_name(key)}{hint}"
             ) from None
         reads = f"it reads {', '.join(read)}" if read else "it reads no parameter"
         for key in from_columns:
-            if key not in read:
+            if key not in read and (key in self.defaults or key in params):
                 raise ValueError(
                     f"{where}: column {key!r} is not a parameter of {self.label} ({reads}; "
                     f"the other columns may be {', '.join(own)})"
@@ -149,7 +145,8 @@ class JobLaw:
             if key not in read:
                 raise ValueError(f"{option_name(key)}: {self.label} does not read "
                                  f"params[{json.dumps(key)}] ({reads})")  # fmt: skip
-        return dataclasses.replace(self, parameters=names)
+        carried = [k for k in from_columns if k not in read]  # `readers.carried_columns`
+        return dataclasses.replace(self, parameters=tuple(k for k in names if k not in carried))
 
 
 def job_law(law) -> JobLaw:

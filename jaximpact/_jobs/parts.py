@@ -50,7 +50,8 @@ class Parts:
         return [json.loads(self._record(i).read_text()) for i in range(chunks)]
 
     def write(self, index: int, digest: str, columns, cells, results: dict) -> dict:
-        """Write chunk `index`: the inputs (`cells`, columns `columns`) and `results` (each
+        """Write chunk `index`: the inputs (`cells`, columns `columns`, those carried
+        through included, in their input order) and `results` (each
         of `OUTPUTS` -> one array or list per row), then its record. Returns the record."""
         record_path = self._record(index)
         record_path.unlink(missing_ok=True)  # a stale record never outlives its part
@@ -85,7 +86,7 @@ class Parts:
                         writer.close()
             else:
                 with open(temporary, "w", newline="") as handle:
-                    handle.write(",".join((*columns, *OUTPUTS)) + "\n")
+                    handle.write(",".join(map(_csv_cell, (*columns, *OUTPUTS))) + "\n")
                     for index in range(chunks):
                         with open(self.part(index), newline="") as part:
                             shutil.copyfileobj(part, handle, 1 << 20)
@@ -94,12 +95,23 @@ class Parts:
         shutil.rmtree(self.dir, ignore_errors=True)
 
 
+def _csv_cell(text) -> str:
+    """A carried cell as a CSV writes it: quoted where it holds a comma, a quote or a line
+    end (or starts or ends with a space); an empty Parquet cell (None) empty."""
+    if text is None:
+        return ""
+    if any(ch in text for ch in ',"\r\n') or text != text.strip():
+        return '"' + text.replace('"', '""') + '"'
+    return text
+
+
 def _write_csv(path: Path, columns, cells, results):
-    if cells.lines is not None:  # the inputs exactly as written
+    if cells.lines is not None:  # the inputs exactly as written (carried columns included)
         inputs = cells.lines
     else:
         texts = [
-            cells.values[c].tolist() if cells.values[c].dtype == object
+            list(map(_csv_cell, cells.carried[c].tolist())) if c in cells.carried
+            else cells.values[c].tolist() if cells.values[c].dtype == object
             else list(map(repr, cells.values[c].tolist()))
             for c in columns
         ]  # fmt: skip
@@ -116,6 +128,9 @@ def _write_parquet(path: Path, columns, cells, results):
 
     data = {}
     for c in columns:
+        if c in cells.carried:  # carried through: a string column, whatever its input type
+            data[c] = pa.array(cells.carried[c].tolist(), pa.string())
+            continue
         value = cells.values[c]
         data[c] = pa.array(value.tolist() if value.dtype == object else value)
     for k in FLOAT_OUTPUTS:

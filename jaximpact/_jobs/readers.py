@@ -3,8 +3,10 @@
 `open_table(path)` checks the header and returns a reader whose `chunks(rows)` yields every
 chunk of `rows` data rows as it is on disk (cheap: no number is parsed), and whose
 `parse(chunk)` turns one chunk into `Cells`: the columns as arrays (float64; `separation` as
-text), a SHA-256 of the chunk's bytes, the input lines as written (CSV), and where each row
-is in the file (`line N` of a CSV counting the header as 1, `row N` of a Parquet file).
+text), the columns the job does not read as text (`carry`: carried through to the output
+unchanged, `carried_columns` says which), a SHA-256 of the chunk's bytes (carried columns
+included), the input lines as written (CSV), and where each row is in the file (`line N` of
+a CSV counting the header as 1, `row N` of a Parquet file).
 A CSV is read as people save it (`_files.open_text`: UTF-8 with or without a byte-order
 mark, UTF-16, any line ends, a line that is not UTF-8 as cp1252), and each number as
 `_files.cell_number` reads it. Memory holds one chunk at a time. A bad header or cell is a
@@ -14,6 +16,7 @@ one-line `ValueError` naming the file, the line (or row) and the column.
 import contextlib
 import csv
 import dataclasses
+import difflib
 import hashlib
 import itertools
 from pathlib import Path
@@ -44,32 +47,81 @@ def require_pyarrow(path):
 
 @dataclasses.dataclass
 class Cells:
-    """One parsed chunk: `values` (column -> array of its `rows`), `digest` (SHA-256 of the
-    chunk's bytes), `lines` (a CSV's data lines as written, without line ends; None for
-    Parquet) and `where(i)`: the place of row `i` in the file, for messages."""
+    """One parsed chunk: `values` (column -> array of its `rows`: the columns the job
+    reads), `digest` (SHA-256 of the chunk's bytes), `lines` (a CSV's data lines as written,
+    without line ends; None for Parquet), `where(i)`: the place of row `i` in the file, for
+    messages, and `carried` (column -> object array of text, None for a Parquet null: the
+    columns carried through to the output unchanged)."""
 
     values: dict
     rows: int
     digest: bytes
     lines: list | None
     where: object
+    carried: dict = dataclasses.field(default_factory=dict)
 
 
-def open_table(path, allowed):
-    """A `CsvTable` or `ParquetTable` for `path`, its header checked: every column in
-    `allowed`, none repeated."""
+def _plain(name: str) -> str:
+    """A column's name but for case, spaces, `_` and `-` (`V_0` -> `v0`)."""
+    return "".join(ch for ch in str(name).lower() if ch not in " _-")
+
+
+def close_column(name: str, known) -> str | None:
+    """The column of `known` that `name` most likely misspells: the same but for case,
+    spaces, `_` or `-` (`V0`, `v_0`, `Separation`), else the closest spelling (difflib,
+    cutoff 0.75: `separaton`); None where none is close (`id`, `note`, `name`)."""
+    by_plain = {_plain(k): k for k in known}
+    plain = _plain(name)
+    if plain in by_plain:
+        return by_plain[plain]
+    close = difflib.get_close_matches(plain, list(by_plain), n=1, cutoff=0.75)
+    return by_plain[close[0]] if close else None
+
+
+def carried_columns(columns, known, where_header: str, outputs=()) -> tuple:
+    """The columns of `columns` that the job does not read (not in `known`), carried through
+    to the output unchanged; a one-line `ValueError` for one whose name is close to a column
+    of `known` (`close_column`: a misspelt column silently ignored would change every
+    answer), naming the likely column, and for one named as a result the output writes
+    (`outputs`)."""
+    carried = []
+    for name in columns:
+        if name in known:
+            continue
+        near = close_column(name, known)
+        if near is not None:
+            raise ValueError(
+                f"{where_header}: unknown column {name!r} (did you mean {near}?); the columns "
+                f"read are {', '.join(known)}, any other is carried through to the output"
+            )
+        if name in outputs:
+            raise ValueError(
+                f"{where_header}: column {name!r} is a result the output writes "
+                f"({', '.join(outputs)}); rename it"
+            )
+        carried.append(name)
+    return tuple(carried)
+
+
+def _text(value) -> str | None:
+    """A carried cell as text (None stays None: an empty Parquet cell)."""
+    return None if value is None else str(value)
+
+
+def _text_digest(array) -> bytes:
+    return "\n".join("\0" if s is None else s for s in array).encode()
+
+
+def open_table(path):
+    """A `CsvTable` or `ParquetTable` for `path`, its header checked: no column repeated.
+    Which columns the job reads and which it carries is the job's to say: it calls `carry`
+    (which checks a Parquet file's column types) before reading a chunk."""
     path = Path(path)
     if not path.exists():
         raise ValueError(f"{path}: no such file")
     if path.is_dir():
         raise ValueError(f"{path}: is a directory, not a file of bodies")
     table = ParquetTable(path) if is_parquet(path) else CsvTable(path)
-    for name in table.columns:
-        if name not in allowed:
-            raise ValueError(
-                f"{table.where_header}: unknown column {name!r}; the columns may be "
-                f"{', '.join(allowed)}"
-            )
     repeated = sorted({n for n in table.columns if table.columns.count(n) > 1})
     if repeated:
         raise ValueError(f"{table.where_header}: column {repeated[0]!r} appears twice")
@@ -94,6 +146,11 @@ class CsvTable:
         if not header or not any(name.strip() for name in header):
             raise ValueError(f"{path}: empty file; its first line must name the columns")
         self.columns = tuple(name.strip() for name in header)
+        self.carried = ()
+
+    def carry(self, names):
+        """Read the columns `names` as text, carried through to the output unchanged."""
+        self.carried = tuple(names)
 
     def chunks(self, rows: int):
         """`(first line number, data lines, their line numbers or None if consecutive)` per
@@ -153,7 +210,9 @@ class CsvTable:
         lines = as_read("\n".join(line.rstrip("\n") for line in lines)).split("\n")
         digest = hashlib.sha256("\n".join(lines).encode()).digest()
         columns, ncol = self.columns, len(self.columns)
-        numeric = [j for j, name in enumerate(columns) if name not in TEXT_COLUMNS]
+        carried = self.carried
+        numeric = [j for j, name in enumerate(columns)
+                   if name not in TEXT_COLUMNS and name not in carried]  # fmt: skip
         quoted = any('"' in line for line in lines)
         rows = None
         if quoted:
@@ -174,12 +233,16 @@ class CsvTable:
             # it (as every reader of tables does), the first that is not a number named
             table = _numbers(rows if quoted else csv.reader(lines), columns, numeric, where)
         values = {columns[j]: table[:, k] for k, j in enumerate(numeric)}
+        texts = {}
         for j, name in enumerate(columns):
-            if name in TEXT_COLUMNS:
+            if name in TEXT_COLUMNS or name in carried:
                 if rows is None:
                     rows = [line.split(",") for line in lines]
-                values[name] = np.array([cells[j].strip() for cells in rows], dtype=object)
-        return Cells(values, len(lines), digest, lines, where)
+                if name in carried:  # the cell's text as read (csv's unquoting only)
+                    texts[name] = np.array([cells[j] for cells in rows], dtype=object)
+                else:
+                    values[name] = np.array([cells[j].strip() for cells in rows], dtype=object)
+        return Cells(values, len(lines), digest, lines, where, texts)
 
 
 def _numbers(rows, columns, numeric, where) -> np.ndarray:
@@ -198,8 +261,8 @@ def _numbers(rows, columns, numeric, where) -> np.ndarray:
 
 
 class ParquetTable:
-    """A Parquet file (pyarrow): numeric columns (integers or floats; `separation` text),
-    read in record batches."""
+    """A Parquet file (pyarrow): numeric columns (integers or floats; `separation` text; a
+    carried column of any type, read as text), read in record batches."""
 
     def __init__(self, path: Path):
         pq = require_pyarrow(path)
@@ -215,7 +278,18 @@ class ParquetTable:
         self.columns = tuple(schema.names)
         if not self.columns:
             raise ValueError(f"{path}: empty file; it has no columns")
-        for field in schema:
+        self.carried = ()  # the types are checked by `carry`, once the job knows its columns
+
+    def carry(self, names):
+        """Read the columns `names` as text, carried through to the output unchanged; the
+        others' types checked (numbers; `separation` text)."""
+        import pyarrow as pa
+
+        self.carried = tuple(names)
+        path = self.path
+        for field in self.file.schema_arrow:
+            if field.name in self.carried:
+                continue
             text = field.name in TEXT_COLUMNS
             ok = (
                 pa.types.is_string(field.type) or pa.types.is_large_string(field.type)
@@ -261,8 +335,14 @@ class ParquetTable:
             return f"{path}, row {start + i + 1}"
 
         values, digest = {}, hashlib.sha256()
+        texts = {}
         for name in self.columns:
             column = table.column(name)
+            if name in self.carried:  # as text, an empty cell kept empty (None)
+                array = np.array([_text(s) for s in column.to_pylist()], dtype=object)
+                digest.update(name.encode() + b"\0" + _text_digest(array))
+                texts[name] = array
+                continue
             if column.null_count:
                 i = int(np.flatnonzero(column.is_null().to_numpy(zero_copy_only=False))[0])
                 raise ValueError(f"{where(i)}, column {name}: an empty cell")
@@ -273,20 +353,13 @@ class ParquetTable:
                 array = column.to_numpy(zero_copy_only=False).astype(float)
                 digest.update(array.tobytes())
             values[name] = array
-        return Cells(values, table.num_rows, digest.digest(), None, where)
+        return Cells(values, table.num_rows, digest.digest(), None, where, texts)
 
 
-def open_chunks(source, allowed):
-    """A `ChunkTable` for `source`, an iterable of chunks, its columns checked as a file's
-    header is."""
-    table = ChunkTable(source)
-    for name in table.columns:
-        if name not in allowed:
-            raise ValueError(
-                f"{table.where_header}: unknown column {name!r}; the columns may be "
-                f"{', '.join(allowed)}"
-            )
-    return table
+def open_chunks(source):
+    """A `ChunkTable` for `source`, an iterable of chunks (which columns the job reads and
+    which it carries is the job's to say: `carry`)."""
+    return ChunkTable(source)
 
 
 class ChunkTable:
@@ -313,6 +386,12 @@ class ChunkTable:
         self.where_header = "chunk 0"
         self._source = source if self.replayable else itertools.chain([first], iterator)
         self._used = False
+        self.carried = ()
+
+    def carry(self, names):
+        """Read the columns `names` as text (one value, or one per row), carried through to
+        the output unchanged."""
+        self.carried = tuple(names)
 
     def chunks(self, rows: int):
         """`(index, first row, chunk)` per chunk, as given (`rows` is not used)."""
@@ -347,9 +426,20 @@ class ChunkTable:
         def where(i):
             return f"chunk {index}, row {i} (row {start + i} of all)"
 
-        out, digest = {}, hashlib.sha256()
+        out, texts, digest = {}, {}, hashlib.sha256()
         for name, value in values.items():
             digest.update(name.encode() + b"\0")
+            if name in self.carried:
+                array = np.asarray(value, dtype=object)
+                if array.ndim > 1 or (array.ndim == 1 and array.size not in (1, rows)):
+                    raise ValueError(
+                        f"chunk {index}, column {name}: {array.size} values for {rows} rows "
+                        "(give one per row, or one value)"
+                    )
+                array = np.broadcast_to(array, (rows,))
+                texts[name] = np.array([_text(s) for s in array], dtype=object)
+                digest.update(_text_digest(texts[name]))
+                continue
             if name in TEXT_COLUMNS:
                 array = np.broadcast_to(np.asarray(value, dtype=object), (rows,))
                 array = np.array([str(s).strip() for s in array], dtype=object)
@@ -369,7 +459,7 @@ class ChunkTable:
                 array = np.array(np.broadcast_to(array, (rows,)))
                 digest.update(array.tobytes())
             out[name] = array
-        return Cells(out, rows, digest.digest(), None, where)
+        return Cells(out, rows, digest.digest(), None, where, texts)
 
 
 def _columns_of(chunk, index: int) -> dict:

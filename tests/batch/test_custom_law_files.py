@@ -138,9 +138,14 @@ def test_columns_and_params_are_parameters_the_users_law_reads(tmp_path):
     (tmp_path / "in.csv").write_text("c,m,v0\n2e6,1,1\n")
     with pytest.raises(ValueError, match=r'custom reads params\["b1"\]: give a column b1'):
         _run(tmp_path, law=ji.custom_law(hertz_rate, c=2e6))
-    (tmp_path / "in.csv").write_text("c,zz,m,v0\n2e6,1,1,1\n")
-    with pytest.raises(ValueError, match="column 'zz' is not a parameter of custom .*reads c"):
+    (tmp_path / "in.csv").write_text("c,b_1,m,v0\n2e6,1,1,1\n")  # `zz` would be carried through
+    with pytest.raises(ValueError, match=r"unknown column 'b_1' \(did you mean b1\?\)"):
         _run(tmp_path)
+    (tmp_path / "in.csv").write_text("c,B1,m,v0\n2e6,1,1,1\n")
+    with pytest.raises(ValueError, match=r'reads params\["b1"\]: .* \(column \'B1\' is not b1\)'):
+        _run(tmp_path, law=ji.custom_law(hertz_rate, c=2e6))
+    with pytest.raises(ValueError, match="column 'c' is not a parameter of custom .*reads c2"):
+        _run(tmp_path, law=ji.custom_law(lambda x, v, p: p["c2"] * x**1.5, c=2e6, c2=2e6))
     (tmp_path / "in.csv").write_text("c,m,v0\n2e6,1,1\n")
     with pytest.raises(ValueError, match=r'custom does not read params\["zz"\]'):
         _run(tmp_path, params={"zz": 1.0})
