@@ -88,7 +88,7 @@ def _evaluate(jaxpr, consts, args, constants=None):
     for eqn in jaxpr.eqns:
         invals = [read(a) for a in eqn.invars]
         k = constant_half_steps(eqn, constants)
-        body = _call_body(eqn)
+        body = call_body(eqn)
         with eqn.ctx.manager:
             if k is not None:
                 values = [_as(half_power(invals[0], k), eqn.outvars[0].aval.dtype)]
@@ -112,9 +112,11 @@ def _as(value, dtype):
     return value if value.dtype == dtype else value.astype(dtype)
 
 
-def _call_body(eqn):
-    """`(jaxpr, consts)` of a call primitive's body, or `None`."""
-    key = _CALLS.get(eqn.primitive.name)
+def call_body(eqn, calls=None):
+    """`(jaxpr, consts)` of the body of a call primitive named in `calls` (primitive name
+    -> the parameter that holds its body; default: the `jit` calls evaluated inline here),
+    or `None`."""
+    key = (_CALLS if calls is None else calls).get(eqn.primitive.name)
     if key is None or key not in eqn.params:
         return None
     body = eqn.params[key]
