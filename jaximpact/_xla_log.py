@@ -13,6 +13,7 @@ exactly that: nothing is changed then.
 import contextlib
 import functools
 import os
+import warnings
 
 # absl's levels: 0 info, 1 warning, 2 error, 3 fatal (jax._src.logging_config._tf_cpp_map)
 _FATAL_ONLY = 3
@@ -55,11 +56,19 @@ def quiet_compiler():
 
 
 def quietly_compiled(fn):
-    """`fn` run inside `quiet_compiler` (for the public entry points that compile fits)."""
+    """`fn` run inside `quiet_compiler` (for the public entry points that compile fits).
+    The warnings `fn` gives are raised again from here once it returns, so that they name
+    the caller's line as `fn`'s own `stacklevel=2` did, under the user's filters (`error`
+    included)."""
 
     @functools.wraps(fn)
     def wrapper(*args, **kwargs):
-        with quiet_compiler():
-            return fn(*args, **kwargs)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            with quiet_compiler():
+                result = fn(*args, **kwargs)
+        for warning in caught:
+            warnings.warn(warning.message, warning.category, stacklevel=2)
+        return result
 
     return wrapper

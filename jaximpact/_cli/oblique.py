@@ -50,7 +50,8 @@ def add_fit_oblique(subparsers):
         "(m) to rebounds measured at several incidences, read from FILE.csv: columns "
         "theta_deg (with --speed) or v_n,v_t, optionally omega (spin before, rad/s), and "
         "e_t and/or omega_out (an empty cell: not measured). The normal law --law with "
-        "--param is held fixed (fit it first with 'jaximpact calibrate'). Each impact is "
+        "--param (or --from FIT.json, the output of 'jaximpact calibrate --json') is held "
+        "fixed (fit it first with 'jaximpact calibrate'). Each impact is "
         "integrated with stick and slip as segments ended by events, so the fit's "
         "derivatives are exact through the transitions. Prints the parameters with "
         "standard errors and the goodness of fit (rms of e_t and of the spin). Or FILE.csv "
@@ -60,10 +61,19 @@ def add_fit_oblique(subparsers):
         "--law tsuji --param c=1.1e9 b=0.5 --tangential mindlin --tparam G_star=1.35e10 "
         "mu=0.092\n"
         "jaximpact fit-oblique rebounds.csv --mass 2.6e-4 --radius 2.5e-3 --law hunt_crossley "
-        "--param c=1.1e9 a=0 --tangential linear_history --tparam kt=1e6 mu=0.1 --json",
+        "--param c=1.1e9 a=0 --tangential linear_history --tparam kt=1e6 mu=0.1 --json\n"
+        "jaximpact calibrate --law tsuji --mass 2.6e-4 --v0 3.9 --e 0.98 --T 1.3e-5 --json "
+        "> normal.json; jaximpact fit-oblique rebounds.csv --speed 3.9 --from normal.json "
+        "--mass 2.6e-4 --radius 2.5e-3 --tangential mindlin --tparam G_star=1.35e10 mu=0.1",
     )
     parser.add_argument("file", type=Path, metavar="FILE.csv", help="the measured rebounds")
-    add_law_arguments(parser)
+    add_law_arguments(parser, required=False)
+    parser.add_argument(
+        "--from", dest="source", metavar="FIT.json",
+        help="the normal law from a fit: the JSON of 'jaximpact calibrate --json' (one "
+        "law, or --law all's ranking: its best, or the one --law names), instead of --law "
+        "and --param; its mass must be --mass",
+    )  # fmt: skip
     add_tangential_arguments(
         parser,
         required=True,
@@ -418,15 +428,24 @@ def run_fit_oblique(args):
     g = args.g
     if g is not None and not (math.isfinite(g) and g >= 0):
         raise CLIError(f"--g must be a finite number >= 0 (m/s^2), got {g:g}")
+    normal = {}
+    if args.source is not None:
+        if args.param:
+            raise CLIError("--param conflicts with --from: the fit gives the parameters")
+        law, normal = normal_law_from_fit(args.source, args.law, args.mass)
+    elif args.law is None:
+        raise CLIError("give the normal law: --law NAME (with --param) or --from FIT.json")
     data = read_rebounds(args.file, args.speed, 9.81 if g is None else g)
     track = "sigma_e_t" in data
     g = (9.81 if track else 0.0) if g is None else g
-    law = law_from_args(args)
+    if args.source is None:
+        law = law_from_args(args)
     tangential = tangential_from_args(args)
     free = free_names(args.free)
     if free is None:
-        stiffness = "G_star" if "G_star" in tangential.params else "kt"
-        free = (stiffness, "mu")
+        from .._oblique.fit import default_free
+
+        free = default_free(tangential)
     rows = {k: np.asarray(data.get(k, []), dtype=float) for k in (*COLUMNS, "theta")}
     measured = {k: rows[k] if np.any(np.isfinite(rows[k])) else None for k in MEASURED}
     sigmas = {k: np.asarray(data[k]) for k in ("sigma_e_t", "sigma_omega") if k in data}
@@ -436,13 +455,79 @@ def run_fit_oblique(args):
             law, tangential, m=args.mass, R=args.radius, v_n=rows["v_n"], v_t=rows["v_t"],
             omega=rows["omega"], e_t=measured["e_t"], omega_out=measured["omega_out"],
             free=free, inertia=args.inertia, g=g, contact_point=args.contact_point, **sigmas,
+            **({"separation": normal["separation"]} if normal else {}),
         )  # fmt: skip
         bar.update(1, "done")
     if args.plot is not None:
         _plot(args.plot, rows, fit)
     check = _sanity(law, args.mass, float(np.max(rows["v_n"])))
-    emit(args, {**fit.to_dict(), "check": check}, lambda: _report(fit, rows, check))
+    record = {**fit.to_dict(), "check": check, **({"normal": normal} if normal else {})}
+    emit(args, record, lambda: _report(fit, rows, check, normal))
     return 0
+
+
+def normal_law_from_fit(path: Path, name: str | None, mass: float):
+    """`(law, record)`: the normal law of the fit in the JSON file `path` that `jaximpact
+    calibrate --json` writes (one law, or `--law all`'s ranking: its best, or the law
+    `name` names), and what the output says of it (`law`, `params`, `separation`, `from`).
+    Its mass must be `mass` (kg); each missing or mismatched field is a one-line
+    `CLIError`, a fit that did not converge a warning."""
+    import json
+    import warnings
+
+    from .common import make_law
+
+    where = f"--from {path}"
+    try:
+        data = json.loads(Path(path).read_text())
+    except OSError as error:
+        raise CLIError(f"{where}: cannot read it ({error.strerror or error})") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as error:
+        raise CLIError(
+            f"{where}: not JSON ({getattr(error, 'msg', error)}); write it with 'jaximpact "
+            "calibrate ... --json > FILE'"
+        ) from None
+    if not isinstance(data, dict):
+        raise CLIError(f"{where}: expected the JSON object of 'jaximpact calibrate --json'")
+    record = data
+    if isinstance(data.get("ranking"), list):  # calibrate --law all
+        ranked = [r for r in data["ranking"] if isinstance(r, dict)]
+        names = [r.get("law") for r in ranked]
+        wanted = name if name is not None else data.get("best", names[0] if names else None)
+        if wanted not in names:
+            raise CLIError(
+                f"{where}: its ranking has no law {wanted!r}; it has {', '.join(map(str, names))}"
+            )
+        record = ranked[names.index(wanted)]
+    law_name, params = record.get("law"), record.get("params")
+    if not isinstance(law_name, str):
+        raise CLIError(f"{where}: no law name ('law'); is it the output of calibrate --json?")
+    if name is not None and name != law_name:
+        raise CLIError(f"--law {name} but {path} holds a fit of {law_name}")
+    if not isinstance(params, dict) or not params:
+        raise CLIError(f"{where}: no parameters ('params': an object NAME -> number)")
+    for key, value in params.items():
+        number = isinstance(value, (int, float)) and not isinstance(value, bool)
+        if not number or not math.isfinite(value):
+            raise CLIError(f"{where}: parameter {key} = {value!r} is not a finite number")
+    m = data.get("m", record.get("m"))
+    if m is not None and not (isinstance(m, (int, float)) and math.isclose(m, mass, rel_tol=1e-12)):
+        raise CLIError(
+            f"--mass {mass:g} but {path} was fitted for m = {m!r} kg: the normal law's e and "
+            "T depend on the mass; give the sphere's mass the law was fitted for"
+        )
+    separation = data.get("separation", record.get("separation", "force"))
+    if separation not in ("force", "penetration"):
+        raise CLIError(f"{where}: separation {separation!r} is not 'force' or 'penetration'")
+    try:
+        law = make_law(law_name, {k: float(v) for k, v in params.items()})
+    except ValueError as error:
+        raise CLIError(f"{where}: {error}") from None
+    if record.get("converged") is False:
+        warnings.warn(f"the fit in {path} did not converge", stacklevel=2)
+    out = {"law": law_name, "params": {k: float(v) for k, v in params.items()},
+           "separation": separation, "from": str(path)}  # fmt: skip
+    return law, out
 
 
 def _sanity(law, m: float, v_n: float) -> dict:
@@ -455,12 +540,15 @@ def _sanity(law, m: float, v_n: float) -> dict:
     return {"v_n": v_n, "T": float(r.T), "x_max": float(r.x_max), "F_max": float(r.F_max)}
 
 
-def _report(fit, rows, check) -> str:
+def _report(fit, rows, check, normal=None) -> str:
     import numpy as np
 
     from .._format import format_quantity
 
     lines = [
+        *([f"normal law {normal['law']} from {normal['from']} ("
+           + ", ".join(f"{k} = {v:g}" for k, v in normal["params"].items())
+           + f"; separation by {normal['separation']})"] if normal else []),
         fit.summary(),
         f"check: at v_n = {check['v_n']:.4g} m/s the normal law with this mass gives a contact "
         f"time of {format_quantity(check['T'], 's')}, x_max {format_quantity(check['x_max'], 'm')}"
@@ -477,7 +565,7 @@ def _report(fit, rows, check) -> str:
             f"   {w_f:11.1f}"
         )
     if not bool(fit.converged):
-        lines.append("the optimiser did not converge: try other start values (--tparam)")
+        lines.append("the fit did not converge (see the notes): try other start values (--tparam)")
     return "\n".join(lines)
 
 
