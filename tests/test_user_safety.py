@@ -318,7 +318,8 @@ def test_an_interrupted_batch_stops_says_what_it_kept_and_resume_completes_it(
 )
 def test_an_interrupted_calibrate_all_stops_with_one_line(signum, after, fitting):
     """At several moments (importing JAX; the fits under way) and for both signals."""
-    child = _cli("calibrate", "--law", "all", "--v0", "2.5", "--e", "0.8", "--T", "7.8e-3")
+    child = _cli("calibrate", "--law", "all", "--mass", "1", "--v0", "2.5", "--e", "0.8",
+                 "--T", "7.8e-3")
     time.sleep(after)
     assert child.poll() is None
     start = time.perf_counter()
