@@ -153,6 +153,17 @@ def _arrows(ax, x, y, count: int = 2):
         )
 
 
+def plain_log_axis(axis):
+    """A log-scaled axis (`ax.xaxis`) labelled with plain numbers at 1, 2 and 5 of each
+    decade (`0.3`, `2`, not `3x10^-1`, whose minor labels ran into each other over a short
+    range)."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
+    axis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+    axis.set_minor_formatter(NullFormatter())
+
+
 def new_figure(**kwargs):
     """A matplotlib Figure drawn by the Agg backend (no display needed)."""
     import matplotlib

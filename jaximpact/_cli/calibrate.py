@@ -14,7 +14,7 @@ from .._choices import unknown_name
 from .._files import cell_number
 from .._format import format_number, format_quantity
 from .._interrupt import check_interrupt, set_note
-from .._plotting import new_figure, save_figure
+from .._plotting import new_figure, plain_log_axis, save_figure
 from .._progress import metered
 from .common import (
     MASS_HELP,
@@ -744,6 +744,7 @@ def _plot(args, data, fits):
         axes[1].set_ylabel("contact duration T [ms]")
     for ax in axes:
         ax.set_xscale("log")
+        plain_log_axis(ax.xaxis)
         ax.set_xlabel("impact speed v0 [m/s]")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)

@@ -262,3 +262,23 @@ def test_model_choice_when_every_law_fails(capsys, monkeypatch, tmp_path):
     monkeypatch.setattr(_model_choice, "compare_laws", failing)
     argv = ["calibrate", "--mass", "1", "--law", "all", "--data", _csv(tmp_path, "v0,e\n1,0.8\n2,0.7\n")]
     assert_one_line_error(*run_cli(capsys, argv), contains="no law could be fitted: maxwell")
+
+
+@pytest.mark.parametrize("limits", [(0.3, 0.4), (0.7, 4.5), (0.05, 20.0)])
+def test_the_speed_axis_is_labelled_with_plain_numbers(limits):
+    """`calibrate --plot`'s log speed axis: plain numbers (0.3, 2), not `3x10^-1`, whose
+    minor labels ran into each other over a short range (`3×10⁻¹4×10⁻¹`)."""
+    from jaximpact._plotting import new_figure, plain_log_axis
+
+    fig = new_figure()
+    ax = fig.add_subplot()
+    ax.set_xscale("log")
+    plain_log_axis(ax.xaxis)
+    ax.set_xlim(*limits)
+    locs = [x for x in ax.xaxis.get_major_locator()() if limits[0] <= x <= limits[1]]
+    labels = ax.xaxis.get_major_formatter().format_ticks(locs)
+    assert labels, "no labelled tick"
+    for where, text in zip(locs, labels, strict=True):  # each the plain number at its tick
+        assert float(text) == pytest.approx(where), labels
+    minor = ax.xaxis.get_minor_formatter().format_ticks(list(ax.xaxis.get_minor_locator()()))
+    assert not any(minor)  # no minor labels to run into the major ones
