@@ -82,7 +82,10 @@ INVERTED = ["drake", "lammps spheres", "lammps wall", "lammps spheres limit_damp
             "chrono spheres", "chrono wall", "lammps dmt spheres", "lammps dmt wall"]  # fmt: skip
 
 
-@pytest.mark.parametrize("case", INVERTED)
+@pytest.mark.parametrize(
+    "case",
+    [pytest.param(c, marks=pytest.mark.slow) if "dmt" in c else c for c in INVERTED],
+)  # dmt's adhesive impacts compile programs of their own (the fast suite: 3 minutes)
 def test_export_law_at_the_effective_mass_is_the_engine_s_contact(case):
     """`impact(x.law, m=<effective mass>, v0=x.v0)` gives the target e and T (1e-6) and the
     engine's e and T within the export's 0.5 %; `law_m` is that mass. LAMMPS's dmt law was

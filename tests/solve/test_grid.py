@@ -96,6 +96,7 @@ def _rate_grid(b1, v0):
 RATE_CASES = [(20.0, 1.0), (150.0, 2.9), (400.0, 1.7), (800.0, 2.5), (800.0, 1.2), (1500.0, 2.2)]
 
 
+@pytest.mark.slow  # its own program (the fast batch tests run the grid: path 'grid')
 def test_a_users_law_on_the_grid_meets_scipy_to_1e_9():
     b1 = jnp.asarray([b for b, _ in RATE_CASES])
     v0 = jnp.asarray([v for _, v in RATE_CASES])

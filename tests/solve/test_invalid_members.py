@@ -39,6 +39,7 @@ def test_vmap_over_masses_computes_the_good_member_and_refuses_the_bad():
     assert batch.to_dict()["status"] == ["separated", "invalid"]
 
 
+@pytest.mark.slow  # three programs of their own (the vmap test above keeps the rule fast)
 def test_jit_with_a_negative_mass_gives_nan_and_invalid():
     result = jax.jit(lambda m: ji.impact(LAW, m=m, v0=2.5))(-1.0)
     _assert_refused(result)
