@@ -703,3 +703,58 @@ def heartbeat_meter(delay=None):
     if delay is None:
         delay = 0.5 if is_terminal(sys.stderr) else 3.0
     return TextMeter(interval=10.0, delay=delay, heartbeat=0.2)
+
+
+def read_fit_record(path: str, law: str | None = None):
+    """`(data, record)` of the JSON file `path` ('-': stdin) that `jaximpact calibrate
+    --json` writes: the whole object, and the one fit in it (one law; of `--law all`'s
+    ranking its best, or the law `law` names), whose `law` is a name and whose `params`
+    are finite numbers. Each missing or mismatched field is a one-line `CLIError` (the one
+    reading of a fit's file, for `export --from` and `fit-oblique --from`)."""
+    import json
+    import math
+
+    where = f"--from {path}"
+    try:
+        if path == "-":
+            text = sys.stdin.read()
+        else:
+            with open(path, encoding="utf-8") as handle:
+                text = handle.read()
+    except OSError as error:
+        raise CLIError(f"{where}: cannot read it ({error.strerror or error})") from None
+    except UnicodeDecodeError as error:
+        raise CLIError(f"{where}: not JSON ({error.reason}); write it with 'jaximpact "
+                       "calibrate ... --json > FILE'") from None  # fmt: skip
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as error:
+        raise CLIError(
+            f"{where}: not JSON ({error.msg}, line {error.lineno}); write it with "
+            "'jaximpact calibrate ... --json > FILE'"
+        ) from None
+    if not isinstance(data, dict):
+        raise CLIError(f"{where}: expected the JSON object of 'jaximpact calibrate --json'")
+    record = data
+    if isinstance(data.get("ranking"), list):  # calibrate --law all
+        ranked = [r for r in data["ranking"] if isinstance(r, dict)]
+        names = [r.get("law") for r in ranked]
+        wanted = law if law is not None else data.get("best", names[0] if names else None)
+        if wanted not in names:
+            raise CLIError(
+                f"{where}: its ranking has no law {wanted!r}; it has {', '.join(map(str, names))}"
+            )
+        record = ranked[names.index(wanted)]
+    name = record.get("law")
+    if not isinstance(name, str):
+        raise CLIError(f"{where}: no law name ('law'); is it the output of calibrate --json?")
+    if law is not None and law != name:
+        raise CLIError(f"--law {law} but {path} holds a fit of {name}")
+    params = record.get("params")
+    if not isinstance(params, dict) or not params:
+        raise CLIError(f"{where}: no parameters ('params': an object NAME -> number)")
+    for key, value in params.items():
+        number = isinstance(value, (int, float)) and not isinstance(value, bool)
+        if not number or not math.isfinite(value):
+            raise CLIError(f"{where}: parameter {key} = {value!r} is not a finite number")
+    return data, record

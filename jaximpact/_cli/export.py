@@ -3,7 +3,6 @@ engine realises) and `jaximpact engine-e` (engine parameters -> e(v), T(v)). The
 names and what the help says of each come from the one registry, `_engines.export.ENGINES`."""
 
 import json
-import sys
 
 from .._choices import unknown_name
 from .._format import format_number
@@ -16,6 +15,7 @@ from .common import (
     is_file_law,
     make_law,
     parse_params,
+    read_fit_record,
     tangential_from_args,
     warn_sphere_density,
 )
@@ -306,47 +306,11 @@ def read_fit(path: str, args):
     from .._laws import LAWS
 
     where = f"--from {path}"
-    try:
-        if path == "-":
-            text = sys.stdin.read()
-        else:
-            with open(path) as handle:
-                text = handle.read()
-    except OSError as error:
-        raise CLIError(f"{where}: cannot read it ({error.strerror or error})") from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as error:
-        raise CLIError(
-            f"{where}: not JSON ({error.msg}, line {error.lineno}); write it with "
-            "'jaximpact calibrate ... --json > FILE'"
-        ) from None
-    if not isinstance(data, dict):
-        raise CLIError(f"{where}: expected the JSON object of 'jaximpact calibrate --json'")
-    record = data
-    if isinstance(data.get("ranking"), list):  # calibrate --law all
-        ranked = [r for r in data["ranking"] if isinstance(r, dict)]
-        names = [r.get("law") for r in ranked]
-        wanted = args.law if args.law is not None else data.get("best", names[0] if names else None)
-        if wanted not in names:
-            raise CLIError(
-                f"{where}: its ranking has no law {wanted!r}; it has {', '.join(map(str, names))}"
-            )
-        record = ranked[names.index(wanted)]
-    name = record.get("law")
-    if not isinstance(name, str):
-        raise CLIError(f"{where}: no law name ('law'); is it the output of calibrate --json?")
+    data, record = read_fit_record(path, args.law)
+    name, params = record["law"], record["params"]
     user = is_file_law(name)  # a fit of a user's law, FILE.py:NAME: its file is read again
     if name not in LAWS and not user:
         raise CLIError(f"{where}: law {name!r} is not one of 'jaximpact laws'")
-    if args.law is not None and args.law != name:
-        raise CLIError(f"--law {args.law} but {path} holds a fit of {name}")
-    params = record.get("params")
-    if not isinstance(params, dict) or not params:
-        raise CLIError(f"{where}: no parameters ('params': an object NAME -> number)")
-    for key, value in params.items():
-        if not _number(value) or not math.isfinite(value):
-            raise CLIError(f"{where}: parameter {key} = {value!r} is not a finite number")
     unknown = [] if user else sorted(set(params) - set(LAWS[name].parameters))
     if unknown:
         raise CLIError(f"{where}: law {name} has no parameter {', '.join(unknown)}")

@@ -472,44 +472,13 @@ def normal_law_from_fit(path: Path, name: str | None, mass: float):
     `name` names), and what the output says of it (`law`, `params`, `separation`, `from`).
     Its mass must be `mass` (kg); each missing or mismatched field is a one-line
     `CLIError`, a fit that did not converge a warning."""
-    import json
     import warnings
 
-    from .common import make_law
+    from .common import make_law, read_fit_record
 
     where = f"--from {path}"
-    try:
-        data = json.loads(Path(path).read_text())
-    except OSError as error:
-        raise CLIError(f"{where}: cannot read it ({error.strerror or error})") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as error:
-        raise CLIError(
-            f"{where}: not JSON ({getattr(error, 'msg', error)}); write it with 'jaximpact "
-            "calibrate ... --json > FILE'"
-        ) from None
-    if not isinstance(data, dict):
-        raise CLIError(f"{where}: expected the JSON object of 'jaximpact calibrate --json'")
-    record = data
-    if isinstance(data.get("ranking"), list):  # calibrate --law all
-        ranked = [r for r in data["ranking"] if isinstance(r, dict)]
-        names = [r.get("law") for r in ranked]
-        wanted = name if name is not None else data.get("best", names[0] if names else None)
-        if wanted not in names:
-            raise CLIError(
-                f"{where}: its ranking has no law {wanted!r}; it has {', '.join(map(str, names))}"
-            )
-        record = ranked[names.index(wanted)]
-    law_name, params = record.get("law"), record.get("params")
-    if not isinstance(law_name, str):
-        raise CLIError(f"{where}: no law name ('law'); is it the output of calibrate --json?")
-    if name is not None and name != law_name:
-        raise CLIError(f"--law {name} but {path} holds a fit of {law_name}")
-    if not isinstance(params, dict) or not params:
-        raise CLIError(f"{where}: no parameters ('params': an object NAME -> number)")
-    for key, value in params.items():
-        number = isinstance(value, (int, float)) and not isinstance(value, bool)
-        if not number or not math.isfinite(value):
-            raise CLIError(f"{where}: parameter {key} = {value!r} is not a finite number")
+    data, record = read_fit_record(path, name)
+    law_name, params = record["law"], record["params"]
     m = data.get("m", record.get("m"))
     if m is not None and not (isinstance(m, (int, float)) and math.isclose(m, mass, rel_tol=1e-12)):
         raise CLIError(
