@@ -49,7 +49,10 @@ def _is_literal_zero(atom, consts_by_var, zeros) -> bool:
     if isinstance(atom, jex_core.Literal):
         return bool(np.all(np.asarray(atom.val) == 0))
     if atom in consts_by_var:
-        return bool(np.all(np.asarray(consts_by_var[atom]) == 0))
+        value = consts_by_var[atom]
+        if isinstance(value, jax.core.Tracer):  # a traced value closed over: not known zero
+            return False
+        return bool(np.all(np.asarray(value) == 0))
     return zeros.get(atom, False)
 
 

@@ -98,3 +98,20 @@ def test_gradients_through_a_clamped_law_are_the_table_laws():
     want = jax.jacfwd(lambda c: e_and_T(table, c))(2e6)
     np.testing.assert_allclose(got[1], want[1], rtol=1e-6)
     np.testing.assert_allclose(got[0], want[0], rtol=3e-5)
+
+
+def test_a_law_closing_over_a_traced_value_is_read():
+    """A law that closes over a traced value (as `jax.grad` through the forward Jacobian
+    builds one) holds a tracer among its jaxpr's constants: it is not a known zero, and
+    the clamp is still found (it raised TracerArrayConversionError)."""
+
+    @jax.jit
+    def pulling_force(c):
+        def fn(x, v, p):  # c, traced, goes through a broadcast inside the law
+            stiffness = jnp.broadcast_to(c, (1,))[0]
+            return jnp.maximum(stiffness * x**1.5 + p["b"] * x**0.5 * v, 0.0)
+
+        peeled = unclamped(fn, {"b": 800.0})
+        return peeled(*PULLING, {"b": 800.0})
+
+    np.testing.assert_allclose(pulling_force(2e6), _force(*PULLING, PARAMS), rtol=1e-15)
