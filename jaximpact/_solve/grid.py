@@ -221,6 +221,20 @@ def _secant(a, fa, b, fb):
     return jnp.where(jnp.isfinite(sigma), sigma, 0.5 * (a + b))
 
 
+def _first_crossing(track, flips, y, k, value):
+    """`track = (y, k, (value before, value after), found, last value)` of the step where
+    a condition first crossed (the force peak, the force's end), updated by this step:
+    where `flips`, the state `y` and index `k` at its start and the values either side."""
+    y_at, k_at, pair, found, last = track
+    return (
+        jnp.where(flips, y, y_at),
+        jnp.where(flips, k, k_at),
+        jnp.where(flips, jnp.stack([last, value]), pair),
+        found | flips,
+        value,
+    )
+
+
 def grid_contact(law, m, v0, *, separation: str, steps: int = GRID_STEPS) -> dict:
     """One contact of `law` (a force `law.force(x, v)`, `has_state` False) without gravity
     on the grid: a dict of `ImpactResult` fields (SI units; `e`, `T`, `x_max`, `t_max`,
@@ -255,30 +269,17 @@ def grid_contact(law, m, v0, *, separation: str, steps: int = GRID_STEPS) -> dic
         compressing = k < half
         y1, dy, low = contact.step(s, y, h, compressing)
         # the first force peak in compression: dF/dtau turns from > 0 to <= 0 in this step
-        y_pk, k_pk, rates, found_pk, rate = peak
-        rate1 = contact.force_rate(y1, compressing)
-        turns = compressing & ~found_pk & (rate > 0) & (rate1 <= 0)
-        peak = (
-            jnp.where(turns, y, y_pk),
-            jnp.where(turns, k, k_pk),
-            jnp.where(turns, jnp.stack([rate, rate1]), rates),
-            found_pk | turns,
-            rate1,
-        )
-        y_end, k_end, edges, ended, edge = end
+        rate, rate1 = peak[4], contact.force_rate(y1, compressing)
+        turns = compressing & ~peak[3] & (rate > 0) & (rate1 <= 0)
+        peak = _first_crossing(peak, turns, y, k, rate1)
+        ended = end[3]
         live = ~ended  # after the end nothing counts (a pulling force may stall the angle)
         err = err + jnp.where(live, jnp.abs(dy), 0.0)
         least = jnp.where(live, jnp.minimum(least, low), least)
         if force_end:  # the force's own zero inside the surface, in restitution
             edge1 = contact.edge(y1[0], y1[1])
             crosses = live & ~compressing & (edge1 < 0)
-            end = (
-                jnp.where(crosses, y, y_end),
-                jnp.where(crosses, k, k_end),
-                jnp.where(crosses, jnp.stack([edge, edge1]), edges),
-                ended | crosses,
-                edge1,
-            )
+            end = _first_crossing(end, crosses, y, k, edge1)
             y1 = jnp.where(ended | crosses, y, y1)  # frozen at the step that holds the end
         y_mid = jnp.where(k == half - 1, y1, y_mid)
         return (y1, err, least, y_mid, peak, end), None
