@@ -216,19 +216,25 @@ def test_shipped_file():
 
 @pytest.mark.slow
 def test_build_is_reproducible():
-    """Rebuilding a shape gives the shipped table: the same pieces, and the same outputs to
-    1e-9 where both tables hold (`gamma Q`, the relative change of each output). Each
-    piece's gamma range is a lower bound from a capture search whose solves count running
-    out of a short budget as captured; that decision moves with XLA's compiler flags (the
-    suite sets its own): measured up to 2x on one piece of 13 (0.0045 against 0.0091), so
-    the ranges are compared as lower bounds only."""
+    """Rebuilding a shape gives the shipped table: the same pieces where both tables hold,
+    and the same outputs to 1e-9 there (`gamma Q`, the relative change of each output).
+
+    Each piece's gamma range, and so where the table ends, comes from a capture search whose
+    solves count running out of a short budget as captured; that decision moves with XLA's
+    compiler flags (the suite sets its own) and with the last bits of the force: measured up
+    to 2x on one piece's range (0.0045 against 0.0091), and for this shape the table ended
+    after 12, 13 or 15 pieces (beta 3.1, 3.8, 5.8) by the flags and by whether `x^1.5` was
+    `pow` or `x sqrt(x)`. So the ranges are compared as lower bounds, the breaks where both
+    tables have them, and each table must reach beta = 3 (past the pieces that never moved)."""
     key = curve_key(1.5, 0.5, "force")
     built = gravity.build_gravity(key, progress=False)
     shipped = gravity.table_for(key)
-    np.testing.assert_array_equal(built.breaks, shipped.breaks)
+    both = min(len(built.breaks), len(shipped.breaks))
+    np.testing.assert_array_equal(built.breaks[:both], shipped.breaks[:both])
+    assert built.beta_max > 3.0 and shipped.beta_max > 3.0
     assert np.all(built.gamma_max > 0) and np.all(shipped.gamma_max > 0)
     rng = np.random.default_rng(7)
-    k = rng.integers(0, len(shipped.gamma_max), 64)
+    k = rng.integers(0, both - 1, 64)
     s = shipped.breaks[k] + rng.uniform(0, 1, 64) * np.diff(shipped.breaks)[k]
     gamma = np.minimum(built.gamma_max[k], shipped.gamma_max[k]) * rng.uniform(0, 1, 64)
     outputs = tuple(range(built.coefficients.shape[-1]))
