@@ -1,5 +1,5 @@
 """Print the MuJoCo tables of docs/oblique.md ("MuJoCo's friction"): what MuJoCo realises
-(its Euler step, the pyramidal cone, replicated: jaximpact/_engines/mujoco_friction.py) when
+(its Euler step, the pyramidal cone, replicated: jaximpact/_engines/mujoco/friction.py) when
 a normal law and a tangential law are exported to it, beside the laws' own e_t, for a
 nearly elastic stiff contact (Kharaz's alumina sphere) and a soft, damped one.
 

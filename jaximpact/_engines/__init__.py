@@ -1,12 +1,16 @@
 """The engines people run (MuJoCo, Drake, LAMMPS, LIGGGHTS, Chrono, Yade): material inputs,
 and exports of a law to an engine's own contact parameters with the e and T the engine
-realises (docs/engines.md). `base.AbstractEngine` is what an engine declares and provides;
-`export.ENGINES` is the one registry of them (docs/layout.md, "Adding an engine")."""
+realises (docs/engines.md). `base.AbstractEngine` is what an engine declares, its tables
+of normal and tangential models (`base.AbstractNormalModel`, `base.AbstractTangentialModel`)
+included; `export.ENGINES` is the one registry of them (docs/layout.md, "Adding an engine")."""
 
 from .base import (
     AbstractEngine as AbstractEngine,
+    AbstractNormalModel as AbstractNormalModel,
+    AbstractTangentialModel as AbstractTangentialModel,
     Design as Design,
     Key as Key,
+    Scene as Scene,
     Stepping as Stepping,
 )
 from .export import (

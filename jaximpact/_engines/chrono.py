@@ -23,8 +23,10 @@ a large one). (3) `cr_eff` is the smaller of the two materials' restitutions.
 
 import math
 
-from . import _stepping, lammps
-from .base import AbstractEngine, Design, Key, Stepping
+from . import _stepping
+from .base import AbstractEngine, AbstractNormalModel, Design, Key, Scene, Stepping
+from .lammps import hertz
+from .lammps.engine import Lammps
 
 # A fixed body still enters eff_mass = m1 m2/(m1 + m2) with its own mass (ChContactSMC.cpp,
 # GetContactableMass): the snippet gives the ground 1e6 m, so eff_mass = m (1 - 1e-6) and gn
@@ -45,45 +47,41 @@ def _ground(parameters) -> list[str]:
     ]
 
 
-class Chrono(AbstractEngine):
+class SMCHertz(AbstractNormalModel):
     """Chrono's SMC Hertz contact from material properties (`ChContactMaterialSMC`), its force
     always kept non-attractive; its stepper is not replicated (the module's docstring has
     the formulas, sources and pitfalls)."""
 
-    NAME = "chrono"
-    LABEL = "Chrono"
-    SCENES = {
-        "spheres": lammps.Lammps.SCENES["spheres"],
-        "wall": "a sphere of mass m and radius `radius` hitting a fixed ground box (a flat "
-        "wall) of its material (mass 1e6 m) head-on at speed v0 (by Chrono's source, not run "
-        "here)",
-    }
-    TWO_SPHERES = True
-    MASS_DEPENDS = "its Young's modulus scales with the mass"
+    NAME = "ChSystemSMC.Hertz"
+    LAW = hertz.HertzMaterial.LAW
     KEYS = (
-        *(key for key in lammps.Lammps.KEYS if key.name in ("E", "coeff_restitution", "poisson")),
+        *(key for key in hertz.HertzMaterial.KEYS
+          if key.name in ("E", "coeff_restitution", "poisson")),
         Key("limit_damping", "true or false; its force is always kept non-attractive", False),
-    )
-    LAW = lammps.Lammps.LAW
+    )  # fmt: skip
     STEPPING = (
         "its implicit stepper is not replicated: the continuous law's e and T, at a "
         "recommended step of T/100 or less"
     )
-    CONTINUOUS_PLANT = False
+    MASS_DEPENDS = "its Young's modulus scales with the mass"
+    ALLOWS_LIMIT_DAMPING = True
+    NEAREST = "its tsuji law"
+    SCENES = None
 
-    def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
-               limit_damping=False, geometry=None) -> Design:  # fmt: skip
+    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
+               limit_damping=False) -> Design:  # fmt: skip
         """`ChContactMaterialSMC` inputs for target `e` and `T` (s): two spheres of mass `m`
         (kg) and radius `radius` (m) at relative speed `v0` (m/s), or with `geometry="wall"`
         a sphere on a fixed ground box of its material (`E_eff = E/(2 (1 - nu^2))`,
         `eff_radius = R`, `eff_mass` = m up to the ground's mass, 1e6 m). Its force is
         always kept non-attractive, whatever `limit_damping`."""
-        coefficient = lammps.coefficient_for(e, limit_damping=True)
-        realised_e, tau = lammps.impact_at_unit_scales(coefficient, "force")
-        m_eff, R_eff = lammps.effective(m, radius, geometry)
+        m, v0, radius, geometry = scene.m, scene.v0, scene.radius, scene.geometry
+        coefficient = hertz.coefficient_for(e, limit_damping=True)
+        realised_e, tau = hertz.impact_at_unit_scales(coefficient, "force")
+        m_eff, R_eff = hertz.effective(m, radius, geometry)
         c = m_eff * v0**2 * (tau / (T * v0)) ** 2.5
         E = c * 3.0 / (4.0 * math.sqrt(R_eff)) * 2.0 * (1.0 - poisson**2)
-        b = lammps.damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
+        b = hertz.damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
         h = _stepping.nice_down(T / 100.0) if timestep is None else float(timestep)
         warnings = [
             f"set the effective curvature radius to {R_eff:.6g} m (the snippet does): "
@@ -126,11 +124,28 @@ class Chrono(AbstractEngine):
 
     def response(self, parameters, *, m, radius=None):
         """`(law, separation)`: the Tsuji form with the force always kept non-attractive."""
-        return lammps.tsuji_response(self, parameters, m=m, radius=radius, clamped=True)
+        return hertz.tsuji_response("chrono", parameters, m=m, radius=radius, clamped=True)
 
     def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
         """None: Chrono's implicit stepper is not replicated."""
         return None
+
+
+class Chrono(AbstractEngine):
+    """Chrono's SMC contact; no tangential export yet."""
+
+    NAME = "chrono"
+    LABEL = "Chrono"
+    SCENES = {
+        "spheres": Lammps.SCENES["spheres"],
+        "wall": "a sphere of mass m and radius `radius` hitting a fixed ground box (a flat "
+        "wall) of its material (mass 1e6 m) head-on at speed v0 (by Chrono's source, not run "
+        "here)",
+    }
+    TWO_SPHERES = True
+    CONTINUOUS_PLANT = False
+    NORMAL = {"tsuji": SMCHertz()}
+    TANGENTIAL = {}
 
     def snippet(self, parameters) -> str:
         return "\n".join(

@@ -228,9 +228,9 @@ def modulus_warnings(c, tangential, *, radius: float, poisson: float, two_sphere
             "and radius"
         )
     shear = [] if tangential is None else [
-        (name, float(tangential.params[name]))
-        for name, unit in tangential.spec.units.items()
-        if unit == "Pa" and name in tangential.params
+        (key, float(tangential.params[key]))
+        for key, unit in tangential.spec.units.items()
+        if unit == "Pa" and key in tangential.params
     ]  # fmt: skip
     expected = E_star * (1.0 - poisson) / (2.0 * (2.0 - poisson))
     for name, G_star in shear:

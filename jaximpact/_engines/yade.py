@@ -41,8 +41,10 @@ import math
 
 import numpy as np
 
-from . import _stepping, mujoco
-from .base import AbstractEngine, Design, Key, Stepping
+from . import _stepping
+from .base import AbstractEngine, AbstractNormalModel, AbstractTangentialModel, Design, Key, Scene
+from .base import Stepping
+from .mujoco.solref import continuous, dampratio_for
 from .materials import check_positive, check_restitution
 
 CUNDALL_DEFAULT = 0.2  # NewtonIntegrator.damping's default (pkg/dem/NewtonIntegrator.hpp)
@@ -67,7 +69,7 @@ def inputs_for(e: float, T: float, geometry: str = "spheres") -> tuple[float, fl
         return 1.0, T if geometry != "wall" else T / math.sqrt(2.0), 0.0
     wall = geometry == "wall"
     top = 1.0 / math.sqrt(2.0) if wall else 1.0  # the largest damping ratio en -> 0 gives
-    floor = mujoco.continuous(top)[0] if wall else math.exp(-2.0)
+    floor = continuous(top)[0] if wall else math.exp(-2.0)
     if e <= floor:
         where = " on a wall of mass 0" if wall else ""
         value = f"{floor:.4f}" if wall else f"exp(-2) = {floor:.4f}"
@@ -75,8 +77,8 @@ def inputs_for(e: float, T: float, geometry: str = "spheres") -> tuple[float, fl
             f"Yade's ViscElMat cannot realise e = {e:g}{where}: its force is kept "
             f"non-attractive and en -> 0 gives e = {value} (use kn and cn directly for less)"
         )
-    zeta = mujoco.dampratio_for(e)
-    omega0 = mujoco.continuous(zeta)[1] / T
+    zeta = dampratio_for(e)
+    omega0 = continuous(zeta)[1] / T
     z = zeta / top  # Pournin's damping ratio for massR: sqrt(2) zeta on a wall
     en = math.exp(-math.pi * z / math.sqrt(1.0 - z**2))
     tc = math.pi / (omega0 * math.sqrt(1.0 - z**2)) * top
@@ -114,73 +116,35 @@ def _with_cundall(params, m, v0) -> float:
     return float(es.mean())
 
 
-class Yade(AbstractEngine):
+class ViscElMat(AbstractNormalModel):
     """Yade's `ViscElMat(tc=, en=)` between two spheres or a sphere and a fixed wall, at
     `NewtonIntegrator`'s leapfrog (the module's docstring has the formulas and sources)."""
 
-    NAME = "yade"
-    LABEL = "Yade"
-    SCENES = {
-        "spheres": "two equal spheres of ViscElMat, each of mass m and radius `radius`, "
-        "colliding head-on at relative speed v0 (no gravity, NewtonIntegrator(damping=0))",
-        "wall": "a sphere of ViscElMat, mass m and radius `radius`, hitting a fixed wall body "
-        "(utils.wall, mass 0) head-on at speed v0 (no gravity, NewtonIntegrator(damping=0))",
-    }
-    TWO_SPHERES = True
-    MASS_DEPENDS = "its density (and kn, cn) scale with the mass"
+    NAME = "ViscElMat"
+    LAW = "kelvin_voigt"
     KEYS = (
         Key("tc", "s"),
         Key("en", "in (0, 1]"),
         Key("timestep", "s; without it, no stepping", needed=False),
         Key("damping", "NewtonIntegrator's, in [0, 1), default 0", needed=False),
     )
-    LAW = "kelvin_voigt"
     STEPPING = (
         "with a timestep, NewtonIntegrator's leapfrog and its Cundall damping (default 0 "
         "here): replicated"
     )
-    CONTINUOUS_PLANT = False
-    TANGENTIAL = ("linear_history",)
-    # ScGeom's contactPoint: halfway through the overlap between spheres
-    # (Ig2_Sphere_Sphere_ScGeom), the sphere's centre projected on a wall (Ig2_Wall_Sphere)
-    CONTACT_POINT = {"wall": 1.0, "spheres": 0.5}
+    MASS_DEPENDS = "its density (and kn, cn) scale with the mass"
+    ALLOWS_LIMIT_DAMPING = True
+    NEAREST = "its kelvin_voigt law"
+    SCENES = None
 
-    def check_tangential(self, tangential, *, radius, timestep):
-        """Yade's ViscElMat shear is a constant spring without a damper in Coulomb's test."""
-        if tangential.name not in self.TANGENTIAL:
-            raise ValueError(
-                "Yade's ViscElMat shear is a constant spring (ks), not "
-                f"{tangential.name!r}: export a linear_history law"
-            )
-        ct = float(tangential.params.get("ct", 0.0))
-        if ct != 0.0:
-            raise ValueError(
-                "Yade adds its shear damper cs outside Coulomb's test, not as "
-                f"linear_history's ct = {ct:g} N s/m (inside it): export with ct=0"
-            )
-
-    def with_tangential(self, parameters, tangential):
-        """`parameters` with ViscElMat's explicit `kn`, `cn` (the design's) and `ks` = kt,
-        `cs` = 0, `frictionAngle` = atan(mu), each material's value twice the contact's
-        (two equal ones in series)."""
-        self.check_tangential(tangential, radius=None, timestep=None)
-        kt, mu = float(tangential.params["kt"]), float(tangential.params["mu"])
-        angle = math.atan(mu)
-        material = (
-            f"ViscElMat(kn={2.0 * parameters['kn']!r}, cn={2.0 * parameters['cn']!r}, "
-            f"ks={2.0 * kt!r}, cs=0.0, density={parameters['density']!r}, "
-            f"frictionAngle={angle!r})"
-        )
-        return dict(parameters, ks=kt, frictionAngle=angle, material=material)
-
-    def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
-               limit_damping=False, geometry=None) -> Design:  # fmt: skip
+    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
+               limit_damping=False) -> Design:  # fmt: skip
         """ViscElMat inputs and O.dt for target `e` and `T` (s), two spheres of mass `m`
         (kg) and radius `radius` (m) at relative speed `v0` (m/s) or (`geometry="wall"`) one
         such sphere on a fixed wall of mass 0; `e` and `T` of the design are the replica's
         mean over start phases. Its force is always kept non-attractive (`limit_damping`
         does not apply), and it takes no Poisson's ratio."""
-        wall = geometry == "wall"
+        m, v0, radius, wall = scene.m, scene.v0, scene.radius, scene.wall
         en, tc, zeta = inputs_for(e, T, "wall" if wall else "spheres")
         params = {"tc": tc, "en": en, "damping": 0.0}
         if wall:
@@ -190,7 +154,7 @@ class Yade(AbstractEngine):
             e,
             T,
             timestep,
-            engine=self.LABEL,
+            engine="Yade",
             step="O.dt =",
         )
         params["timestep"] = h
@@ -259,6 +223,70 @@ class Yade(AbstractEngine):
         stepping = {"tc": tc, "en": en, "timestep": h, "damping": damping,
                     "geometry": parameters.get("geometry", "spheres")}  # fmt: skip
         return Stepping(h, lambda v: replica(stepping, m, v))
+
+
+class ViscElShear(AbstractTangentialModel):
+    """ViscElMat's shear for a `linear_history` law: its constant spring `ks`, no damper in
+    Coulomb's test (the module's docstring)."""
+
+    MODEL = "Yade's ViscElMat shear is a constant spring (ks)"
+    FRICTION = None
+    # ScGeom's contactPoint: halfway through the overlap between spheres
+    # (Ig2_Sphere_Sphere_ScGeom), the sphere's centre projected on a wall (Ig2_Wall_Sphere)
+    CONTACT_POINT = {"wall": 1.0, "spheres": 0.5}
+
+    def check(self, tangential, *, timestep) -> None:
+        """Yade's ViscElMat shear is a constant spring without a damper in Coulomb's test."""
+        ct = float(tangential.params.get("ct", 0.0))
+        if ct != 0.0:
+            raise ValueError(
+                "Yade adds its shear damper cs outside Coulomb's test, not as "
+                f"linear_history's ct = {ct:g} N s/m (inside it): export with ct=0"
+            )
+
+    def poisson(self, design: Design, tangential) -> None:
+        return None
+
+    def parameters(self, design: Design, tangential) -> dict:
+        """The design's parameters with ViscElMat's explicit `kn`, `cn` (the design's) and
+        `ks` = kt,
+        `cs` = 0, `frictionAngle` = atan(mu), each material's value twice the contact's
+        (two equal ones in series)."""
+        parameters = design.parameters
+        kt, mu = float(tangential.params["kt"]), float(tangential.params["mu"])
+        angle = math.atan(mu)
+        material = (
+            f"ViscElMat(kn={2.0 * parameters['kn']!r}, cn={2.0 * parameters['cn']!r}, "
+            f"ks={2.0 * kt!r}, cs=0.0, density={parameters['density']!r}, "
+            f"frictionAngle={angle!r})"
+        )
+        return dict(parameters, ks=kt, frictionAngle=angle, material=material)
+
+    def realised(self, parameters, tangential):
+        return tangential
+
+    def notes(self, parameters, tangential) -> list[str]:
+        return []
+
+    def oblique(self, parameters, *, m, radius, v_n, v_t):
+        return None
+
+
+class Yade(AbstractEngine):
+    """Yade's ViscElMat contact and its shear."""
+
+    NAME = "yade"
+    LABEL = "Yade"
+    SCENES = {
+        "spheres": "two equal spheres of ViscElMat, each of mass m and radius `radius`, "
+        "colliding head-on at relative speed v0 (no gravity, NewtonIntegrator(damping=0))",
+        "wall": "a sphere of ViscElMat, mass m and radius `radius`, hitting a fixed wall body "
+        "(utils.wall, mass 0) head-on at speed v0 (no gravity, NewtonIntegrator(damping=0))",
+    }
+    TWO_SPHERES = True
+    CONTINUOUS_PLANT = False
+    NORMAL = {"kelvin_voigt": ViscElMat()}
+    TANGENTIAL = {"linear_history": ViscElShear()}
 
     def snippet(self, parameters) -> str:
         wall = parameters.get("geometry") == "wall"  # the wall z = 0 (mass 0, fixed)

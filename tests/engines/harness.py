@@ -20,7 +20,7 @@ import tempfile
 import numpy as np
 import pytest
 
-from jaximpact._engines.liggghts import particle_range_line
+from jaximpact._engines.liggghts.normal import particle_range_line
 
 
 def require(module: str) -> None:

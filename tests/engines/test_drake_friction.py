@@ -1,4 +1,4 @@
-"""Drake's friction (jaximpact/_engines/drake_friction.py): its continuous plant's oblique
+"""Drake's friction (jaximpact/_engines/drake/friction.py): its continuous plant's oblique
 impact (point contact, Stribeck-regularised Coulomb friction) integrated here against Drake
 itself (`pytest.mark.engines`), and the export of a tangential law to Drake as its Coulomb
 mu, with what Drake then realises (fast tests)."""
@@ -9,7 +9,7 @@ import pytest
 from harness import require, run_drake_oblique
 
 import jaximpact as ji
-from jaximpact._engines.drake_friction import stribeck
+from jaximpact._engines.drake.friction import stribeck
 
 M, R, V0 = 0.05, 0.01, 1.0
 LAW = ji.law("point_contact", c=2e5, d=0.5)  # Drake's own law: e = 0.75 at 1 m/s

@@ -9,14 +9,14 @@ import numpy as np
 import pytest
 
 import jaximpact as ji
-from jaximpact._engines import (
-    drake as drake_engine,
-    liggghts as liggghts_engine,
-    mujoco as mujoco_engine,
-)
+from jaximpact._engines.drake import normal as drake_engine
+from jaximpact._engines.liggghts import normal as liggghts_engine
+from jaximpact._engines.mujoco import solref as mujoco_engine
+from jaximpact._engines.base import Scene
 from jaximpact._engines.export import ENGINES, engine_response, stepped_response
 
-MUJOCO = ENGINES["mujoco"]
+SOLREF = ENGINES["mujoco"].NORMAL["kelvin_voigt"]  # MuJoCo's normal model
+UNIT = Scene(m=1.0, v0=1.0, radius=None, geometry="wall")
 WALL_M, WALL_R = 0.004, 0.005
 
 
@@ -40,7 +40,7 @@ def test_mujoco_refsafe_raises_timeconst():
 
 @pytest.mark.parametrize("e, T", [(0.75, 0.01), (0.3, 2e-3)])
 def test_mujoco_design_hits_targets_through_the_replica(e, T):
-    out = MUJOCO.design(e, T, m=1.0, v0=1.0)
+    out = SOLREF.design(e, T, UNIT)
     assert abs(out.e / e - 1) < 1e-3 and abs(out.T / T - 1) < 2e-3
     lo, hi = out.e_range
     assert lo <= out.e <= hi and (hi - lo) / 2 < 0.005 * e
@@ -49,7 +49,7 @@ def test_mujoco_design_hits_targets_through_the_replica(e, T):
 
 
 def test_mujoco_coarse_step_is_warned():
-    out = MUJOCO.design(0.5, 2e-3, m=1.0, v0=1.0, timestep=2e-4)
+    out = SOLREF.design(0.5, 2e-3, UNIT, timestep=2e-4)
     assert any("steps per contact" in w or "refsafe" in w for w in out.warnings)
 
 
@@ -180,7 +180,7 @@ def test_yade_export_inverts_its_clamped_law():
     separation by force) gives the target, and e <= exp(-2) is refused in one line."""
     x = ji.export(None, "yade", m=0.01, v0=1.0, e=0.5, T=1e-3, radius=0.01, curves=False)
     assert x.parameters["en"] < 0.5 and x.parameters["NewtonIntegrator_damping"] == 0.0
-    law = ENGINES["yade"].law(x.parameters, 0.01)
+    law = ENGINES["yade"].NORMAL["kelvin_voigt"].law(x.parameters, 0.01)
     r = ji.impact(law, m=0.005, v0=1.0, separation="force")
     assert abs(float(r.e) / 0.5 - 1) < 1e-6 and abs(float(r.T) / 1e-3 - 1) < 1e-6
     assert "NewtonIntegrator(damping=0.0)" in x.snippet
@@ -295,7 +295,7 @@ def test_yade_wall_export_uses_yades_mass_convention():
     inverts that (kelvin_voigt with Yade's kn, cn on mass m gives the target), and what
     the clamped law cannot reach on a wall (e <= 0.2079) is refused in one line."""
     x = ji.export(None, "yade", m=0.01, v0=1.0, e=0.5, T=1e-3, radius=0.01, geometry="wall")
-    law = ENGINES["yade"].law(x.parameters, 0.01)
+    law = ENGINES["yade"].NORMAL["kelvin_voigt"].law(x.parameters, 0.01)
     r = ji.impact(law, m=0.01, v0=1.0, separation="force")
     assert float(r.e) == pytest.approx(0.5, rel=1e-6)
     assert float(r.T) == pytest.approx(1e-3, rel=1e-6)
@@ -338,9 +338,19 @@ def test_liggghts_and_chrono_wall_exports_meet_their_documented_laws(e):
 
 def test_every_engine_is_a_final_class_declaring_its_facts():
     """The registry holds one instance of each engine's final class, under its NAME; each
-    declares its facts (the scene is two spheres exactly where TWO_SPHERES says), and its
-    law is the family it declares."""
-    from jaximpact._engines.base import FACTS, AbstractEngine, Key
+    declares its facts (the scene is two spheres exactly where TWO_SPHERES says) and its
+    tables of final normal and tangential models, each declaring its own facts; a law of
+    the normal table exports to its row."""
+    from jaximpact._engines.base import (
+        FACTS,
+        NORMAL_FACTS,
+        TANGENTIAL_FACTS,
+        AbstractEngine,
+        AbstractNormalModel,
+        AbstractTangentialModel,
+        Key,
+        scene_geometry,
+    )
 
     assert list(ENGINES) == ["mujoco", "lammps", "drake", "liggghts", "chrono", "yade"]
     for name, engine in ENGINES.items():
@@ -348,26 +358,37 @@ def test_every_engine_is_a_final_class_declaring_its_facts():
         assert engine.NAME == name and all(hasattr(engine, fact) for fact in FACTS)
         assert set(engine.SCENES) <= {"spheres", "wall"}
         assert engine.TWO_SPHERES == ("spheres" in engine.SCENES)
-        assert engine.geometry(None) == next(iter(engine.SCENES))
-        names = [key.name for key in engine.KEYS]
-        assert len(set(names)) == len(names) and all(isinstance(k, Key) for k in engine.KEYS)
-        assert names[: sum(k.needed for k in engine.KEYS)] == [k.name for k in engine.KEYS
-                                                                if k.needed]  # fmt: skip
+        assert scene_geometry(engine, None) == next(iter(engine.SCENES))
+        for law, model in engine.NORMAL.items():
+            assert isinstance(model, AbstractNormalModel) and model.LAW == law
+            assert type(model).__bases__ == (AbstractNormalModel,)
+            assert all(hasattr(model, fact) for fact in NORMAL_FACTS)
+            names = [key.name for key in model.KEYS]
+            assert len(set(names)) == len(names) and all(isinstance(k, Key) for k in model.KEYS)
+            assert names[: sum(k.needed for k in model.KEYS)] == [k.name for k in model.KEYS
+                                                                   if k.needed]  # fmt: skip
+        assert set(engine.TANGENTIAL) <= set(ji.TANGENTIAL_LAW_NAMES)
+        for model in engine.TANGENTIAL.values():
+            assert isinstance(model, AbstractTangentialModel)
+            assert type(model).__bases__ == (AbstractTangentialModel,)
+            assert all(hasattr(model, fact) for fact in TANGENTIAL_FACTS)
+            assert set(engine.SCENES) <= set(model.CONTACT_POINT)
+        assert engine.KEYS == next(iter(engine.NORMAL.values())).KEYS
     x = ji.export(None, "lammps", m=0.01, v0=1.0, e=0.5, T=1e-3, radius=0.01, curves=False)
-    assert x.law.name == ENGINES["lammps"].LAW
+    assert x.law.name == next(iter(ENGINES["lammps"].NORMAL))
 
 
 def test_engines_are_abstract_or_final():
-    from jaximpact._engines.base import AbstractEngine
-    from jaximpact._engines.mujoco import Mujoco
+    from jaximpact._engines.base import AbstractEngine, AbstractNormalModel
+    from jaximpact._engines.mujoco.engine import Mujoco
+    from jaximpact._engines.mujoco.normal import Solref
 
-    with pytest.raises(TypeError):
-        AbstractEngine()
-    with pytest.raises(TypeError, match="final"):
-
-        class Derived(Mujoco):
-            pass
-
+    for abstract in (AbstractEngine, AbstractNormalModel):
+        with pytest.raises(TypeError):
+            abstract()
+    for final in (Mujoco, Solref):
+        with pytest.raises(TypeError, match="final"):
+            type("Derived", (final,), {})
     with pytest.raises(TypeError, match="does not declare"):
 
         class Undeclared(AbstractEngine):
@@ -379,39 +400,39 @@ def test_design_and_stepping_are_named_records():
     apply): named fields, not a dict and a tuple."""
     from jaximpact._engines.base import Design, Stepping
 
-    out = MUJOCO.design(0.6, 5e-3, m=1.0, v0=1.0)
+    out = SOLREF.design(0.6, 5e-3, UNIT)
     assert isinstance(out, Design) and out.separation == "force" and out.stepping is not None
-    stepping = MUJOCO.stepper(out.stepping, m=1.0)
+    stepping = SOLREF.stepper(out.stepping, m=1.0)
     assert isinstance(stepping, Stepping) and stepping.timestep == out.timestep
     es, _ = stepping.run(1.0)
     assert es.mean() == pytest.approx(out.e, rel=1e-12)
-    assert ENGINES["chrono"].stepper({"E": 1e7, "coeff_restitution": 0.5}, m=1.0) is None
+    chrono = ENGINES["chrono"].NORMAL["tsuji"]
+    assert chrono.stepper({"E": 1e7, "coeff_restitution": 0.5}, m=1.0) is None
     drake_params = {"point_contact_stiffness": 1e5, "hunt_crossley_dissipation": 0.2}
-    assert ENGINES["drake"].stepper(drake_params, m=1.0) is None
+    assert ENGINES["drake"].NORMAL["point_contact"].stepper(drake_params, m=1.0) is None
 
 
 def _toy_engine():
     """An engine written as docs/layout.md's recipe says: a linear spring-dashpot on a plane
-    whose force never pulls (`kelvin_voigt`, separation by force), its continuous law only."""
-    from jaximpact._engines.base import AbstractEngine, Design, Key
+    whose force never pulls (`kelvin_voigt`, separation by force), its continuous law only:
+    one normal model in its `NORMAL` table, no tangential model."""
+    from jaximpact._engines.base import AbstractEngine, AbstractNormalModel, Design, Key
 
-    class Toy(AbstractEngine):
-        NAME = "toy"
-        LABEL = "Toy"
-        SCENES = {"wall": "a body of mass m on a plane at v0"}
-        TWO_SPHERES = False
-        MASS_DEPENDS = "its k and c scale with the mass"
-        KEYS = (Key("k", "N/m"), Key("c", "N s/m"))
+    class SpringDashpot(AbstractNormalModel):
+        NAME = "spring-dashpot"
         LAW = "kelvin_voigt"
+        KEYS = (Key("k", "N/m"), Key("c", "N s/m"))
         STEPPING = "not replicated: the continuous law's e and T"
-        CONTINUOUS_PLANT = True
+        MASS_DEPENDS = "its k and c scale with the mass"
+        ALLOWS_LIMIT_DAMPING = True
+        NEAREST = "its kelvin_voigt law"
+        SCENES = None
 
-        def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
-                   limit_damping=False, geometry=None):  # fmt: skip
+        def design(self, e, T, scene, *, timestep=None, poisson=0.3, limit_damping=False):
             zeta = mujoco_engine.dampratio_for(e)
             realised_e, tau = mujoco_engine.continuous(zeta)
             w0 = tau / T
-            parameters = {"k": m * w0**2, "c": 2 * zeta * w0 * m}
+            parameters = {"k": scene.m * w0**2, "c": 2 * zeta * w0 * scene.m}
             return Design(parameters, e=realised_e, T=T, timestep=0.0, separation="force")
 
         def law_parameters(self, parameters, m):
@@ -422,6 +443,15 @@ def _toy_engine():
 
         def stepper(self, parameters, *, m, radius=None):
             return None
+
+    class Toy(AbstractEngine):
+        NAME = "toy"
+        LABEL = "Toy"
+        SCENES = {"wall": "a body of mass m on a plane at v0"}
+        TWO_SPHERES = False
+        CONTINUOUS_PLANT = True
+        NORMAL = {"kelvin_voigt": SpringDashpot()}
+        TANGENTIAL = {}
 
         def snippet(self, parameters):
             return f"k = {parameters['k']!r}\nc = {parameters['c']!r}"

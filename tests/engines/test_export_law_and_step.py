@@ -19,7 +19,9 @@ from test_export_plastic_adhesive import R as RUBBER_R
 from test_export_plastic_adhesive import _damped_law, _dmt_law, pair_law, wall_law
 
 import jaximpact as ji
-from jaximpact._engines import _stepping, drake as drake_engine, mujoco as mujoco_engine
+from jaximpact._engines import _stepping
+from jaximpact._engines.drake import normal as drake_engine
+from jaximpact._engines.mujoco import solref as mujoco_engine
 from jaximpact._engines.export import UnrealisedExport, UnrealisedWarning
 from jaximpact._engines.materials import modulus_warnings
 

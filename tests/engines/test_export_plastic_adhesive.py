@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 import jaximpact as ji
-from jaximpact._engines import lammps_jkr, lammps_jkr_viscoelastic
+from jaximpact._engines.lammps import jkr as lammps_jkr
+from jaximpact._engines.lammps import jkr_viscoelastic as lammps_jkr_viscoelastic
 from jaximpact._engines.export import UnrealisedExport, engine_response, stepped_response
 from jaximpact._laws.jkr import adhesion_group
 

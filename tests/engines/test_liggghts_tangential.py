@@ -1,4 +1,4 @@
-"""LIGGGHTS's tangential history (jaximpact/_engines/liggghts_tangential.py): a `mindlin` law
+"""LIGGGHTS's tangential history (jaximpact/_engines/liggghts/tangential.py): a `mindlin` law
 exported with the normal one, its G* set through Poisson's ratio and its damper tied to the
 normal contact's restitution, against real LIGGGHTS on a primitive wall
 (`pytest.mark.engines`; Debian's `liggghts`), and the export's choices (fast tests)."""
@@ -10,7 +10,7 @@ import pytest
 from harness import require_executable, run_liggghts_oblique
 
 import jaximpact as ji
-from jaximpact._engines.liggghts_tangential import poisson_for, shear_ratio
+from jaximpact._engines.liggghts.tangential import poisson_for, shear_ratio
 
 # Kharaz's alumina sphere (R = 2.5 mm) at 3.9 m/s
 R = 2.5e-3

@@ -1,4 +1,4 @@
-"""MuJoCo's friction (jaximpact/_engines/mujoco_friction.py): the replica of its pyramidal
+"""MuJoCo's friction (jaximpact/_engines/mujoco/friction.py): the replica of its pyramidal
 cone on an oblique sphere against MuJoCo itself (`pytest.mark.engines`), and the export of a
 tangential law to MuJoCo as its Coulomb mu, with what MuJoCo then realises (fast tests)."""
 
@@ -9,8 +9,8 @@ import pytest
 from harness import require, run_mujoco_oblique
 
 import jaximpact as ji
-from jaximpact._engines import mujoco as mj
-from jaximpact._engines.mujoco_friction import frictional_solref, head_on_factor, oblique_replica
+from jaximpact._engines.mujoco import solref as mj
+from jaximpact._engines.mujoco.friction import frictional_solref, head_on_factor, oblique_replica
 
 # Kharaz's alumina sphere (R = 2.5 mm) at 3.9 m/s, e = 0.98 (Tsuji's damping), mu = 0.092
 R = 2.5e-3

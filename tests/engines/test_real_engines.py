@@ -18,12 +18,10 @@ from harness import (
 )
 
 import jaximpact as ji
-from jaximpact._engines import (
-    drake as drake_engine,
-    lammps as lammps_engine,
-    mujoco as mujoco_engine,
-    yade as yade_engine,
-)
+from jaximpact._engines import yade as yade_engine
+from jaximpact._engines.drake import normal as drake_engine
+from jaximpact._engines.lammps import hertz as lammps_engine
+from jaximpact._engines.mujoco import solref as mujoco_engine
 from jaximpact._engines.export import engine_response, stepped_response
 
 PHASES = (0.05, 0.3, 0.55, 0.8, 0.95)

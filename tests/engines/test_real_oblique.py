@@ -89,7 +89,7 @@ def test_other_engines_and_a_damped_spring_are_refused_in_one_line():
 def test_the_clause_is_lammps_own():
     """k = kt for linear_history, 8 G* for Mindlin (LAMMPS multiplies it by the contact
     radius), no tangential damping; in pair_coeff and fix wall/gran alike."""
-    from jaximpact._engines.lammps_tangential import tangential_clause
+    from jaximpact._engines.lammps.tangential import tangential_clause
 
     assert (
         tangential_clause(TANGENTIAL["linear_history"])

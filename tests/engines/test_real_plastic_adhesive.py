@@ -13,7 +13,10 @@ import pytest
 from harness import require, run_lammps, run_lammps_jkr
 
 import jaximpact as ji
-from jaximpact._engines import lammps_dmt, lammps_jkr, lammps_jkr_viscoelastic
+from jaximpact._engines.lammps import dmt as lammps_dmt
+from jaximpact._engines.lammps import jkr as lammps_jkr
+from jaximpact._engines.lammps import jkr_viscoelastic as lammps_jkr_viscoelastic
+from jaximpact._engines.lammps.script import FRICTIONLESS
 from jaximpact._engines.export import stepped_response
 
 R, M = 0.005, 0.004
@@ -65,7 +68,7 @@ def test_lammps_jkr_with_the_laws_own_surface_energy_takes_half_the_energy():
     law = _law("wall")
     V_s = float(law.sticking_speed(M))
     h = 2e-6
-    model = lammps_jkr.model(E, W / 2, NU)
+    model = f"{lammps_jkr.model(E, W / 2, NU)} {FRICTIONLESS}"  # the normal and tangential clauses
     literal = {
         "pair_style": "pair_style granular", "pair_coeff": f"pair_coeff * * {model}",
         "fix_wall": f"fix wall all wall/gran granular {model} zplane 0.0 NULL",

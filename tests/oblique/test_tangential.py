@@ -35,7 +35,7 @@ def test_table_names_and_histories():
 def test_a_rescaled_history_shrinks_with_the_contact_radius_on_unloading():
     """`stick_rate` adds `Q v / (2x)` where the overlap closes (`v < 0`), nothing while it
     opens, and each rescaled Mindlin law exports to LAMMPS's own model."""
-    from jaximpact._engines.lammps_tangential import tangential_clause
+    from jaximpact._engines.lammps.tangential import tangential_clause
 
     for name, history in (("mindlin_rescale", "displacement"), ("mindlin_rescale_force", "force")):
         tl = tangential_law(name, G_star=1e10, mu=0.2)

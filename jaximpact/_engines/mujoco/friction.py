@@ -32,11 +32,13 @@ per active set (x, z and the spin about y, per unit mass), and takes the consist
 """
 
 import itertools
+import math
 
 import numpy as np
 
-from . import _stepping
-from .mujoco import SOLIMP, effective
+from .. import _stepping
+from ..base import AbstractTangentialModel, Design
+from .solref import SOLIMP, continuous, effective, replica
 
 INERTIA = 0.4  # MuJoCo's solid sphere, I = 0.4 m R^2
 # the active sets: edge + (mu along the slip), edge -, the pair across the plane
@@ -122,3 +124,66 @@ def oblique_replica(solref, timestep, *, mu, radius, v_n, v_t, phases=_stepping.
         if done.all():
             return vel[..., 1] / v_n, vel[..., 0] / v_t, vel[..., 2]
     raise RuntimeError("the replica did not finish the contact; the time step is far too small")
+
+
+class PyramidalFriction(AbstractTangentialModel):
+    """MuJoCo's friction for any tangential law: its Coulomb `mu` on the pyramidal cone."""
+
+    MODEL = "MuJoCo's pyramidal friction cone"
+    FRICTION = (
+        "MuJoCo has no tangential spring: a tangential law goes as its Coulomb mu alone, in "
+        "MuJoCo's soft pyramidal friction cone (condim 3), solref corrected for the cone's "
+        "stiffening head-on; the cone acts on the slip at the rate of the contact's damping, "
+        "so a nearly elastic contact (low dampratio) barely slows it"
+    )
+    CONTACT_POINT = {"wall": 0.5}  # halfway through the penetration (replicated)
+
+    def check(self, tangential, *, timestep) -> None:
+        """MuJoCo takes any tangential law's `mu`."""
+
+    def poisson(self, design: Design, tangential) -> None:
+        return None
+
+    def parameters(self, design: Design, tangential) -> dict:
+        """The design's parameters with friction `mu` (the tangential law's) on the pyramidal
+        cone, and solref in its direct form divided by `head_on_factor(mu)`, so that head-on
+        MuJoCo realises the frictionless design. `mu = 0`: no friction (condim 1),
+        unchanged."""
+        parameters = design.parameters
+        mu = float(tangential.params["mu"])
+        out = dict(parameters, friction=[mu, 0.0, 0.0], condim=3 if mu > 0 else 1,
+                   cone="pyramidal", impratio=1.0)  # fmt: skip
+        if mu > 0:
+            out["solref"] = frictional_solref(parameters["solref"], parameters["timestep"], mu)
+            out["cone_factor"] = head_on_factor(mu)
+        return out
+
+    def realised(self, parameters, tangential):
+        return tangential
+
+    def notes(self, parameters, tangential) -> list[str]:
+        """How strongly MuJoCo's friction can act: its cone slows the slip at the rate of
+        the contact's damping `B` (1/s), over the contact's duration `T`; `B T` well below
+        1 leaves the slip almost as it came."""
+        if "cone_factor" not in parameters:
+            return []
+        stiffness, damping = effective(parameters["solref"], parameters["timestep"])
+        zeta = damping / (2.0 * math.sqrt(stiffness))
+        duration = continuous(zeta)[1] / math.sqrt(stiffness)
+        return [
+            f"MuJoCo's friction slows the slip at the rate of its contact damping, "
+            f"{damping:.3g} /s, over a contact of {duration:.3g} s: B T = "
+            f"{damping * duration:.2g} (it acts fully only where B T is several, a damping "
+            "ratio near 1)"
+        ]
+
+    def oblique(self, parameters, *, m, radius, v_n, v_t):
+        """MuJoCo's Euler step on the sphere with the exported friction (`oblique_replica`);
+        without friction the normal replica, the tangential speed and spin unchanged."""
+        mu = float(parameters.get("friction", [0.0])[0])
+        if mu > 0:
+            return oblique_replica(parameters["solref"], parameters["timestep"], mu=mu,
+                                   radius=radius, v_n=v_n, v_t=v_t)  # fmt: skip
+        v_n = np.atleast_1d(np.asarray(v_n, float))
+        e = np.stack([replica(parameters["solref"], parameters["timestep"], v)[0] for v in v_n])
+        return e, np.ones_like(e), np.zeros_like(e)

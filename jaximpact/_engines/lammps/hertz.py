@@ -14,20 +14,18 @@ coefficient given, and never below about 0.14 (e(coefficient -> 0)); the export 
 `fix nve/sphere` is velocity Verlet, the force taking the half-step velocity:
 `_stepping.velocity_verlet` replicates it.
 
-A `jkr` law goes to LAMMPS's `jkr` normal model instead (`native`; `lammps_jkr`), a `dmt`
-law to its `dmt` model with `damping viscoelastic` (`lammps_dmt`); parameters with a
-`cohesion` are the jkr model's in `response`, `stepper`, `snippet`, and with a `damp` too
-(or `normal` "dmt") the dmt model's.
+The first row of `Lammps.NORMAL` (engine.py): LAMMPS's default design, and its nearest
+law to one it lacks.
 """
 
 import math
 
 import numpy as np
 
-from . import _stepping, lammps_dmt, lammps_jkr, lammps_jkr_viscoelastic, lammps_script
-from .base import AbstractEngine, Design, Key, Stepping
-from .lammps_tangential import NO_TANGENTIAL, TANGENTIAL_MODELS, with_tangential
-from .materials import check_poisson, check_positive, check_restitution, hertz_stiffness
+from .. import _stepping
+from ..base import AbstractNormalModel, Design, Key, Scene, Stepping
+from ..materials import check_poisson, check_positive, check_restitution, hertz_stiffness
+from . import script
 
 
 def effective(m: float, radius: float, geometry: str = "spheres") -> tuple[float, float]:
@@ -45,8 +43,8 @@ def effective(m: float, radius: float, geometry: str = "spheres") -> tuple[float
 def impact_at_unit_scales(e_coefficient: float, separation: str):
     """`(e, tau)` of the Tsuji-form law at `c = m_eff = v0 = 1` (tau: T in units of
     `t* = (m_eff v0^2/c)^(2/5) / v0`), from jaximpact's solver."""
-    from .._laws import law
-    from .._solve.impact import impact
+    from ..._laws import law
+    from ..._solve.impact import impact
 
     result = impact(
         law("tsuji_restitution", c=1.0, e_nominal=e_coefficient, m_eff=1.0),
@@ -98,8 +96,8 @@ def replica(parameters, m: float, v0: float, phases=_stepping.PHASES):
     )
 
 
-def tsuji_response(engine: AbstractEngine, parameters, *, m: float, radius, clamped: bool):
-    """`(law, separation)` of a Tsuji-form `engine` (LAMMPS, LIGGGHTS, Chrono) from its
+def tsuji_response(engine: str, parameters, *, m: float, radius, clamped: bool):
+    """`(law, separation)` of a Tsuji-form `engine` (its name: LAMMPS, LIGGGHTS, Chrono) from its
     Young's modulus `E` (Pa), `coeff_restitution` and `poisson` (default 0.3), for two spheres
     of mass `m` (kg) and radius `radius` (m), or with `geometry` "wall" in `parameters` one
     such sphere on a flat wall of its material; `clamped`: the force is kept
@@ -107,7 +105,7 @@ def tsuji_response(engine: AbstractEngine, parameters, *, m: float, radius, clam
     wall = parameters.get("geometry", "spheres") == "wall"
     if radius is None:
         what = "sphere's" if wall else "spheres'"
-        raise ValueError(f"{engine.NAME} needs the {what} radius: pass radius= (m)")
+        raise ValueError(f"{engine} needs the {what} radius: pass radius= (m)")
     radius = check_positive("radius", radius, "m")
     E = check_positive("E", parameters["E"], "Pa")
     nu = check_poisson("poisson", parameters.get("poisson", 0.3))
@@ -115,36 +113,25 @@ def tsuji_response(engine: AbstractEngine, parameters, *, m: float, radius, clam
     c = hertz_stiffness(E, nu, radius, R2=None if wall else radius)
     m_eff = m if wall else m / 2.0
     b = damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
-    return engine.law({"k": c, "b": b}, m), "force" if clamped else "penetration"
+    from ..._laws import law
+
+    return law("tsuji", c=c, b=b), "force" if clamped else "penetration"
 
 
-def _model(E: float, coefficient: float, poisson: float, limit_damping: bool) -> str:
+def clause(E: float, coefficient: float, poisson: float) -> str:
     """The `hertz/material ... damping coeff_restitution` model of `pair_coeff` (and of
     `fix wall/gran granular`): Young's modulus `E` (Pa), the restitution coefficient given,
-    Poisson's ratio, no tangential force."""
-    extra = " limit_damping" if limit_damping else ""
-    return (
-        f"hertz/material {E:.10g} {coefficient:.10g} {poisson:.10g} "
-        f"damping coeff_restitution {NO_TANGENTIAL}{extra}"
-    )
+    Poisson's ratio."""
+    return f"hertz/material {E:.10g} {coefficient:.10g} {poisson:.10g} damping coeff_restitution"
 
 
-class Lammps(AbstractEngine):
-    """LAMMPS's `pair_style granular` (`hertz/material`, `damping coeff_restitution`) between
-    two spheres or a sphere and `fix wall/gran`, at `fix nve/sphere`'s velocity Verlet (the
-    module's docstring has the formulas and sources)."""
+class HertzMaterial(AbstractNormalModel):
+    """LAMMPS's `hertz/material` with `damping coeff_restitution` between two spheres or a
+    sphere and `fix wall/gran`, at `fix nve/sphere`'s velocity Verlet (the module's
+    docstring has the formulas and sources)."""
 
-    NAME = "lammps"
-    LABEL = "LAMMPS"
-    SCENES = {
-        "spheres": "two equal spheres, each of mass m and radius `radius`, colliding head-on at "
-        "relative speed v0 (no gravity, no friction effect on a head-on impact)",
-        "wall": "a sphere of mass m and radius `radius` hitting a fixed flat wall (fix "
-        "wall/gran, the sphere's own material) head-on at speed v0 (no gravity, no friction "
-        "effect)",
-    }
-    TWO_SPHERES = True
-    MASS_DEPENDS = "its Young's modulus scales with the mass"
+    NAME = "hertz/material"
+    LAW = "tsuji"
     KEYS = (
         Key("E", "Pa"),
         Key("coeff_restitution", "in (0, 1]"),
@@ -152,32 +139,28 @@ class Lammps(AbstractEngine):
         Key("limit_damping", "true or false", needed=False),
         Key("timestep", "s; without it, no stepping", needed=False),
     )
-    LAW = "tsuji"
     STEPPING = "with a timestep, fix nve/sphere's velocity Verlet: replicated"
+    MASS_DEPENDS = "its Young's modulus scales with the mass"
+    ALLOWS_LIMIT_DAMPING = True
+    SCENES = None  # the engine's
     # the law that an export of a law with a contact state LAMMPS lacks (thornton) goes to
-    # (export's `_nearest`)
     NEAREST = (
         "hertz/material with damping coeff_restitution (law tsuji, e the same at every "
         "speed; LAMMPS's mdr normal model is elastic-plastic, but another law, not exported)"
     )
-    CONTINUOUS_PLANT = False
-    TANGENTIAL = tuple(TANGENTIAL_MODELS)
 
-    def with_tangential(self, parameters, tangential):
-        return with_tangential(parameters, tangential)
-
-    def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
-               limit_damping=False, geometry=None) -> Design:  # fmt: skip
+    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
+               limit_damping=False) -> Design:  # fmt: skip
         """`pair_style granular` with `hertz/material ... damping coeff_restitution` for
         target `e` and `T` (s), two spheres of mass `m` (kg) and radius `radius` (m) at
-        relative speed `v0` (m/s), or with `geometry="wall"` one such sphere on a flat wall
-        at speed `v0` (`fix wall/gran granular` with the same model); `e` and `T` of the
-        design are the replica's mean over start phases."""
-        wall = geometry == "wall"
+        relative speed `v0` (m/s), or on a wall (`scene.geometry`) one such sphere at speed
+        `v0` (`fix wall/gran granular` with the same model); `e` and `T` of the design are
+        the replica's mean over start phases."""
+        m, v0, radius, wall = scene.m, scene.v0, scene.radius, scene.wall
         separation = "force" if limit_damping else "penetration"
         coefficient = coefficient_for(e, limit_damping)
         _, tau = impact_at_unit_scales(coefficient, separation)
-        m_eff, R_eff = effective(m, radius, geometry)
+        m_eff, R_eff = effective(m, radius, scene.geometry)
         c = m_eff * v0**2 * (tau / (T * v0)) ** 2.5
         E = c * 3.0 / (4.0 * math.sqrt(R_eff)) * 2.0 * (1.0 - poisson**2)
         assert abs(hertz_stiffness(E, poisson, radius, R2=None if wall else radius) / c - 1) < 1e-12
@@ -190,12 +173,12 @@ class Lammps(AbstractEngine):
             e,
             T,
             timestep,
-            engine=self.LABEL,
+            engine="LAMMPS",
             step="timestep",
         )
-        model = _model(E, coefficient, poisson, limit_damping)
-        parameters = lammps_script.granular_parameters(
-            model, h, E=E, poisson=poisson, wall=wall, coeff_restitution=coefficient, k=c,
+        text = clause(E, coefficient, poisson)
+        parameters = script.granular_parameters(
+            text, h, E=E, poisson=poisson, wall=wall, coeff_restitution=coefficient, k=c,
             b=b, limit_damping=limit_damping,
         )  # fmt: skip
         stepping = dict(E=E, coeff_restitution=coefficient, poisson=poisson,
@@ -208,50 +191,22 @@ class Lammps(AbstractEngine):
             warnings=tuple(warnings),
             separation=separation,
             stepping=stepping,
+            clause=text,
         )
-
-    def native(self, law) -> AbstractEngine | None:
-        """The engine for a law LAMMPS has as its own normal model rather than the Hertz
-        design: `lammps_jkr.LammpsJKR` for a `jkr` law, `lammps_dmt.LammpsDMT` (built with
-        the law) for a `dmt` law, else None."""
-        if law.name == lammps_dmt.LammpsDMT.LAW:
-            return lammps_dmt.LammpsDMT(law)
-        if law.name == _JKR_VISCOELASTIC.LAW:
-            return lammps_jkr_viscoelastic.LammpsJKRViscoelastic(law)
-        return _JKR if law.name == _JKR.LAW else None
-
-    def law(self, parameters, m):
-        """`tsuji`, or with a `cohesion` in `parameters` the `jkr` or `dmt` law of its
-        model."""
-        cohesive = _cohesive_model(parameters)
-        if cohesive is not None:
-            return cohesive.law(parameters, m)
-        return super().law(parameters, m)
 
     def law_parameters(self, parameters, m):
         """`tsuji`'s `c` = k (N/m^1.5) and `b` (N s/m^1.25) between the two spheres
         (effective mass `m/2`), or of the sphere on the wall."""
-        cohesive = _cohesive_model(parameters)
-        if cohesive is not None:
-            return cohesive.law_parameters(parameters, m)
         return {"c": parameters["k"], "b": parameters["b"]}
 
     def response(self, parameters, *, m, radius=None):
         """`(law, separation)` that `parameters` (`E`, `coeff_restitution`, `poisson`,
-        `limit_damping`) give two spheres of mass `m` (kg) and radius `radius` (m); with a
-        `cohesion` (J/m^2), the `jkr` model's (`lammps_jkr.LammpsJKR.response`)."""
-        cohesive = _cohesive_model(parameters)
-        if cohesive is not None:
-            return cohesive.response(parameters, m=m, radius=radius)
+        `limit_damping`) give two spheres of mass `m` (kg) and radius `radius` (m)."""
         clamped = bool(parameters.get("limit_damping", False))
-        return tsuji_response(self, parameters, m=m, radius=radius, clamped=clamped)
+        return tsuji_response("lammps", parameters, m=m, radius=radius, clamped=clamped)
 
     def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
-        """Velocity Verlet at `parameters["timestep"]` (s), or None without one (with a
-        `cohesion`: the `jkr` model's, `lammps_jkr.replica`)."""
-        cohesive = _cohesive_model(parameters)
-        if cohesive is not None:
-            return cohesive.stepper(parameters, m=m, radius=radius)
+        """Velocity Verlet at `parameters["timestep"]` (s), or None without one."""
         if parameters.get("timestep") is None:
             return None
         h = check_positive("timestep", parameters["timestep"], "s")
@@ -264,23 +219,3 @@ class Lammps(AbstractEngine):
             geometry=parameters.get("geometry", "spheres"),
         )
         return Stepping(h, lambda v: replica(stepping, m, v))
-
-    def snippet(self, parameters) -> str:
-        return lammps_script.snippet(parameters)  # every LAMMPS model's scene alike
-
-
-_JKR = lammps_jkr.LammpsJKR()
-_JKR_VISCOELASTIC = lammps_jkr_viscoelastic.LammpsJKRViscoelastic()
-_DMT = lammps_dmt.LammpsDMT()
-
-
-def _cohesive_model(parameters) -> AbstractEngine | None:
-    """LAMMPS's cohesive normal model that `parameters` are for: `jkr` with damping
-    viscoelastic (a `cohesion` and a `damp` with `normal` "jkr"), `dmt` (a `cohesion` with a
-    viscoelastic `damp`, or `normal` "dmt"), `jkr` (a `cohesion` alone), or None (the
-    Hertz design)."""
-    if "cohesion" not in parameters:
-        return None
-    if parameters.get("normal") == _JKR.LAW and "damp" in parameters:
-        return _JKR_VISCOELASTIC
-    return _DMT if parameters.get("normal") == _DMT.LAW or "damp" in parameters else _JKR

@@ -6,13 +6,13 @@ gran_sub_mod_damping.cpp (`GranSubModDampingViscoelastic`), release 22Jul2025 (t
 wheel), with `pair_coeff * * jkr E damp poisson cohesion damping viscoelastic`:
 
 - the elastic force, the neck's forming at `delta > 0` and its breaking at the least force
-  are `lammps_jkr`'s (`normal_force`, `pulloff_distance`);
+  are `jkr.py`'s (`normal_force`, `pulloff_distance`);
 - `Fdamp = -damp meff a v_n` with `a` the JKR contact radius (`contact_radius`): the
   `jkr_viscoelastic` law's `b a / R^0.5 v` with `b = damp meff Reff^0.5`.
 
 So LAMMPS's force is the law's; only the neck breaks earlier (at the least force, not the
 least overlap), and with damping in play no closed form says how much energy that keeps.
-In Hertz units (`lammps_jkr`'s `sigma`, `q`) the damping group is
+In Hertz units (`jkr.py`'s `sigma`, `q`) the damping group is
 `beta = b x*^1.5 / (meff v0)`, and LAMMPS's impact is a function of `(q, beta)`: the
 export keeps the law's `beta` at `v0`, sets `q` (the cohesion) so that LAMMPS's continuous
 impact has the law's `e` there, and `E` so that it lasts the law's `T` (`lammps_impact`,
@@ -23,17 +23,17 @@ import math
 
 import numpy as np
 
-from . import _stepping, lammps_script
-from .base import AbstractEngine, Design, Key, Stepping
-from .lammps_jkr import (
+from .. import _stepping
+from ..base import AbstractNormalModel, Design, Key, Scene, Stepping
+from . import script
+from .jkr import (
     ENERGY_RATIO,
     contact_radius,
     emix,
     normal_force,
     pulloff_distance,
 )
-from .lammps_tangential import NO_TANGENTIAL, TANGENTIAL_MODELS, with_tangential
-from .materials import check_poisson, check_positive
+from ..materials import check_poisson, check_positive
 
 
 def _radius(X: float, q: float) -> float:
@@ -104,7 +104,7 @@ def replica(parameters, m: float, v0: float, phases=_stepping.PHASES, max_steps=
     `parameters` (`E` Pa, `poisson`, `cohesion` J/m^2, `damp` 1/(m s), `R_eff` m,
     `timestep` s; `geometry` "wall": the sphere's own mass `m` on a wall, else two spheres of
     mass `m`, effective mass `m/2`) at impact speed `v0` (m/s): the neck as
-    `lammps_jkr.replica`, the damping `damp meff a v` at the half-step speed."""
+    `jkr.replica`, the damping `damp meff a v` at the half-step speed."""
     h = float(parameters["timestep"])
     wall = parameters.get("geometry", "spheres") == "wall"
     m_eff = m if wall else m / 2.0
@@ -141,25 +141,19 @@ def _check(parameters) -> tuple[float, float, float, float]:
 
 def model(E: float, damp: float, poisson: float, cohesion: float) -> str:
     """The damped `jkr` model of `pair_coeff` (and of `fix wall/gran granular`)."""
-    return (
-        f"jkr {E:.10g} {damp:.10g} {poisson:.10g} {cohesion:.10g} damping viscoelastic "
-        f"{NO_TANGENTIAL}"
-    )
+    return f"jkr {E:.10g} {damp:.10g} {poisson:.10g} {cohesion:.10g} damping viscoelastic"
 
 
-class LammpsJKRViscoelastic(AbstractEngine):
+class JKRViscoelastic(AbstractNormalModel):
     """LAMMPS's `pair_style granular` with the `jkr` normal model and `damping viscoelastic`,
     between two spheres or a sphere and `fix wall/gran`, at `fix nve/sphere`'s velocity
     Verlet: what `export(law("jkr_viscoelastic", ...), "lammps", ...)` targets (the module's
-    docstring has the formulas and sources). Built with the law it exports (`source`), whose
-    damping group it keeps; not in `ENGINES`: `lammps.Lammps` hands such a law to it."""
+    docstring has the formulas and sources). It keeps the damping group of the law it
+    exports (`scene.law`)."""
 
-    NAME = "lammps"
-    LABEL = "LAMMPS"
-    TWO_SPHERES = True
-    CONTINUOUS_PLANT = False
-    REFUSES_LIMIT_DAMPING = "jkr"
-    TANGENTIAL = tuple(TANGENTIAL_MODELS)
+    NAME = "jkr"
+    NEAREST = "its jkr_viscoelastic law"
+    ALLOWS_LIMIT_DAMPING = False
     SCENES = {
         "spheres": "two equal spheres, each of mass m and radius `radius`, colliding head-on at "
         "relative speed v0 (pair_style granular, jkr, damping viscoelastic; no gravity)",
@@ -181,30 +175,23 @@ class LammpsJKRViscoelastic(AbstractEngine):
         "overlap, break at the least force) and the damping at the half-step speed: replicated"
     )
 
-    def __init__(self, source=None):
-        self.source = source  # the jkr_viscoelastic law an export maps
-
-    def with_tangential(self, parameters, tangential):
-        return with_tangential(parameters, tangential)
-
-    def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
-               limit_damping=False, geometry=None) -> Design:  # fmt: skip
+    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
+               limit_damping=False) -> Design:  # fmt: skip
         """`pair_style granular` with `jkr E damp poisson cohesion damping viscoelastic`
-        whose impact at `v0` (m/s) keeps the law `source`'s damping group there and has its
+        whose impact at `v0` (m/s) keeps the law `scene.law`'s damping group there and has its
         restitution `e` and duration `T` (s) (the module's docstring): two spheres of mass
         `m` (kg) and radius `radius` (m), or with `geometry="wall"` one on `fix wall/gran`;
         `e` and `T` of the design are the replica's mean over start phases."""
-        self.check_limit_damping(limit_damping)
-        if self.source is None:
+        m, v0, radius, wall = scene.m, scene.v0, scene.radius, scene.wall
+        if scene.law is None:
             raise ValueError(
                 "LAMMPS's damped jkr model is exported from a jkr_viscoelastic law: pass the law"
             )
         if not 0.0 < e < 1.0:
             raise ValueError(f"a damped JKR impact to export has 0 < e < 1; got e = {e:g}")
-        p = {k: float(v) for k, v in self.source.parameters.items()}
+        p = {k: float(v) for k, v in scene.law.parameters.items()}
         x_law = (m * v0**2 / p["c"]) ** 0.4
         beta = p["b"] * x_law**1.5 / (m * v0)  # the law's damping group at v0
-        wall = geometry == "wall"
         m_eff, R_eff = (m, radius) if wall else (m / 2.0, radius / 2.0)
         q = group_for(e, beta)
         _, tau = lammps_impact(q, beta)
@@ -214,7 +201,7 @@ class LammpsJKRViscoelastic(AbstractEngine):
         E = E_mix * 2.0 * (1.0 - poisson) * (1.0 + poisson)
         cohesion = 0.5 * q**2 * x_star**1.5 * E_mix / (2.0 * math.pi * math.sqrt(R_eff))
         damp = beta * v0 / (x_star**1.5 * math.sqrt(R_eff))  # b = beta meff v0 / x*^1.5
-        stepping, h, es, Ts, warnings = lammps_script.cohesive_stepping(
+        stepping, h, es, Ts, warnings = script.cohesive_stepping(
             replica, dict(E=E, poisson=poisson, cohesion=cohesion, damp=damp, R_eff=R_eff),
             wall=wall, m=m, v0=v0, e=e, T=T, timestep=timestep,
         )  # fmt: skip
@@ -225,7 +212,7 @@ class LammpsJKRViscoelastic(AbstractEngine):
             "the export's e(v) is the replica's, beside the law's"
         )
         text = model(E, damp, poisson, cohesion)
-        parameters = lammps_script.granular_parameters(
+        parameters = script.granular_parameters(
             text, h, E=E, poisson=poisson, R_eff=R_eff, wall=wall, cohesion=cohesion,
             damp=damp, normal="jkr",
             pulloff_distance=float(pulloff_distance(R_eff, cohesion, E_mix)),
@@ -236,12 +223,13 @@ class LammpsJKRViscoelastic(AbstractEngine):
             warnings=tuple(warnings),
             separation="force",
             stepping=stepping,
+            clause=text,
         )
 
     def law_parameters(self, parameters, m):
         """The `jkr_viscoelastic` law (c N/m^1.5, b N s/m^1.5, R m, w J/m^2) nearest to
         LAMMPS's contact, for its effective mass: LAMMPS's `c = 4/3 Emix Reff^0.5`,
-        `b = damp meff Reff^0.5`, `R = Reff`, and, as `lammps_jkr`'s, `w` = 2 cohesion times
+        `b = damp meff Reff^0.5`, `R = Reff`, and, as `jkr.py`'s, `w` = 2 cohesion times
         `ENERGY_RATIO^(3/5)`, so that its neck (broken at the least overlap, LAMMPS's at the
         least force) takes about LAMMPS's energy: its e and T at the export's speed within
         0.3 % of the replica's (the rubber-like spheres of tests/engines; with `w = 2
@@ -257,16 +245,13 @@ class LammpsJKRViscoelastic(AbstractEngine):
     def response(self, parameters, *, m, radius=None):
         """`(law, "force")`: `law_parameters`' `jkr_viscoelastic` law for `parameters` of
         spheres of radius `radius` (m)."""
-        return self.law(lammps_script.with_effective_radius(parameters, radius), m), "force"
+        return self.law(script.with_effective_radius(parameters, radius), m), "force"
 
     def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
         """`replica` at `parameters["timestep"]` (s), or None without one."""
         if parameters.get("timestep") is None:
             return None
         h = check_positive("timestep", parameters["timestep"], "s")
-        full = {**lammps_script.with_effective_radius(parameters, radius), "timestep": h}
+        full = {**script.with_effective_radius(parameters, radius), "timestep": h}
         _check(full)
         return Stepping(h, lambda v: replica(full, m, v))
-
-    def snippet(self, parameters) -> str:
-        return lammps_script.snippet(parameters)

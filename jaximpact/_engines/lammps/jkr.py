@@ -48,10 +48,10 @@ import math
 
 import numpy as np
 
-from . import _stepping, lammps_script
-from .base import AbstractEngine, Design, Key, Stepping
-from .lammps_tangential import NO_TANGENTIAL, TANGENTIAL_MODELS, with_tangential
-from .materials import check_poisson, check_positive
+from .. import _stepping
+from ..base import AbstractNormalModel, Design, Key, Scene, Stepping
+from . import script
+from ..materials import check_poisson, check_positive
 
 # src/GRANULAR/gran_sub_mod_normal.cpp (22Jul2025): the constants of the contact radius
 _PI27SQ = 27.0 * math.pi**2
@@ -200,19 +200,19 @@ def _check(parameters) -> tuple[float, float, float]:
 def model(E: float, cohesion: float, poisson: float) -> str:
     """The `jkr` model of `pair_coeff` (and of `fix wall/gran granular`): Young's modulus `E`
     (Pa), no damping (`damping velocity` with `damp = 0`), Poisson's ratio, `cohesion`
-    (J/m^2, the surface energy: half the work of adhesion), no tangential force."""
-    return f"jkr {E:.10g} 0.0 {poisson:.10g} {cohesion:.10g} damping velocity {NO_TANGENTIAL}"
+    (J/m^2, the surface energy: half the work of adhesion)."""
+    return f"jkr {E:.10g} 0.0 {poisson:.10g} {cohesion:.10g} damping velocity"
 
 
-class LammpsJKR(AbstractEngine):
+class JKR(AbstractNormalModel):
     """LAMMPS's `pair_style granular` with the `jkr` normal model, between two spheres or a
     sphere and `fix wall/gran`, at `fix nve/sphere`'s velocity Verlet: what
     `export(law("jkr", ...), "lammps", ...)` targets (the module's docstring has the
-    formulas, their sources, and where LAMMPS's JKR differs from JKR's impact). Not in
-    `ENGINES`: `lammps.Lammps` hands a `jkr` law to it."""
+    formulas, their sources, and where LAMMPS's JKR differs from JKR's impact)."""
 
-    NAME = "lammps"
-    LABEL = "LAMMPS"
+    NAME = "jkr"
+    NEAREST = "its jkr law"
+    ALLOWS_LIMIT_DAMPING = False
     SCENES = {
         "spheres": "two equal spheres, each of mass m and radius `radius`, colliding head-on at "
         "relative speed v0 (pair_style granular, jkr; no gravity, no damping)",
@@ -220,7 +220,6 @@ class LammpsJKR(AbstractEngine):
         "wall/gran granular jkr, the sphere's own material) head-on at speed v0 (no gravity, "
         "no damping)",
     }
-    TWO_SPHERES = True
     MASS_DEPENDS = "its Young's modulus and cohesion scale with the mass"
     KEYS = (
         Key("E", "Pa"),
@@ -233,25 +232,18 @@ class LammpsJKR(AbstractEngine):
         "with a timestep, fix nve/sphere's velocity Verlet and the jkr touch rule (form at "
         "zero overlap, break at the least force): replicated"
     )
-    CONTINUOUS_PLANT = False
-    REFUSES_LIMIT_DAMPING = "jkr"
-    TANGENTIAL = tuple(TANGENTIAL_MODELS)
 
-    def with_tangential(self, parameters, tangential):
-        return with_tangential(parameters, tangential)
-
-    def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
-               limit_damping=False, geometry=None) -> Design:  # fmt: skip
+    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
+               limit_damping=False) -> Design:  # fmt: skip
         """`pair_style granular` with `jkr E 0 poisson cohesion damping velocity` whose
         impact at `v0` (m/s) has restitution `e` and duration `T` (s) (a JKR law's): two
         spheres of mass `m` (kg) and radius `radius` (m), or with `geometry="wall"` one
         such sphere on `fix wall/gran`. `cohesion` from `e` (LAMMPS's energy loss
         `C_LAMMPS q^(10/3) m_eff v0^2`), `E` from `T` (its continuous impact's duration);
         `e` and `T` of the design are the replica's mean over start phases."""
-        self.check_limit_damping(limit_damping)
         if not 0.0 < e < 1.0:
             raise ValueError(f"a JKR impact has 0 < e < 1; got e = {e:g}")
-        wall = geometry == "wall"
+        m, v0, radius, wall = scene.m, scene.v0, scene.radius, scene.wall
         m_eff, R_eff = (m, radius) if wall else (m / 2.0, radius / 2.0)
         q = group_for(e)
         _, tau = lammps_impact(q)
@@ -260,7 +252,7 @@ class LammpsJKR(AbstractEngine):
         E_mix = 0.75 * c / math.sqrt(R_eff)
         E = E_mix * 2.0 * (1.0 - poisson) * (1.0 + poisson)
         cohesion = 0.5 * q**2 * x_star**1.5 * E_mix / (2.0 * math.pi * math.sqrt(R_eff))
-        stepping, h, es, Ts, warnings = lammps_script.cohesive_stepping(
+        stepping, h, es, Ts, warnings = script.cohesive_stepping(
             replica, dict(E=E, poisson=poisson, cohesion=cohesion, R_eff=R_eff),
             wall=wall, m=m, v0=v0, e=e, T=T, timestep=timestep,
         )  # fmt: skip
@@ -273,7 +265,7 @@ class LammpsJKR(AbstractEngine):
             "every speed) and E the law's T at v0"
         )
         text = model(E, cohesion, poisson)
-        parameters = lammps_script.granular_parameters(
+        parameters = script.granular_parameters(
             text, h, E=E, poisson=poisson, R_eff=R_eff, wall=wall, cohesion=cohesion,
             damping=0.0, pulloff_distance=float(pulloff_distance(R_eff, cohesion, E_mix)),
         )  # fmt: skip
@@ -283,6 +275,7 @@ class LammpsJKR(AbstractEngine):
             warnings=tuple(warnings),
             separation="force",
             stepping=stepping,
+            clause=text,
         )
 
     def law_parameters(self, parameters, m):
@@ -300,7 +293,7 @@ class LammpsJKR(AbstractEngine):
     def response(self, parameters, *, m, radius=None):
         """`(law, "force")`: `law_parameters`' `jkr` law for `parameters` (`E`, `cohesion`,
         `poisson`; `geometry` "wall" or two spheres) of spheres of radius `radius` (m)."""
-        return self.law(lammps_script.with_effective_radius(parameters, radius), m), "force"
+        return self.law(script.with_effective_radius(parameters, radius), m), "force"
 
     def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
         """`replica` at `parameters["timestep"]` (s), or None without one."""
@@ -308,8 +301,5 @@ class LammpsJKR(AbstractEngine):
             return None
         h = check_positive("timestep", parameters["timestep"], "s")
         _check(parameters)
-        full = {**lammps_script.with_effective_radius(parameters, radius), "timestep": h}
+        full = {**script.with_effective_radius(parameters, radius), "timestep": h}
         return Stepping(h, lambda v: replica(full, m, v))
-
-    def snippet(self, parameters) -> str:
-        return lammps_script.snippet(parameters)

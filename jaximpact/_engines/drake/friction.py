@@ -26,6 +26,8 @@ import math
 
 import numpy as np
 
+from ..base import AbstractTangentialModel, Design
+
 STICTION_TOLERANCE = 1e-4  # m/s, Drake's default
 INERTIA = 0.4  # a solid sphere, I = 0.4 m R^2 (UnitInertia.SolidSphere)
 
@@ -82,3 +84,48 @@ def oblique_replica(*, k, d, m, radius, mu, v_n, v_t, stiction=STICTION_TOLERANC
     rows = [_one(k, d, m, radius, mu, a, b, stiction, inertia, rtol)
             for a, b in zip(v_n.ravel(), v_t.ravel(), strict=True)]  # fmt: skip
     return tuple(np.array(column).reshape(v_n.shape + (1,)) for column in zip(*rows, strict=True))
+
+
+class StribeckFriction(AbstractTangentialModel):
+    """Drake's friction for any tangential law: its Coulomb `mu`, static and dynamic, on the
+    continuous plant."""
+
+    MODEL = "Drake's Stribeck-regularised Coulomb friction"
+    FRICTION = (
+        "Drake has no tangential spring: a tangential law goes as its Coulomb mu alone "
+        "(static = dynamic), regularised by Drake's Stribeck curve below the stiction "
+        "tolerance, in the continuous plant"
+    )
+    CONTACT_POINT = {"wall": 0.5}  # halfway through the penetration (integrated)
+
+    def check(self, tangential, *, timestep) -> None:
+        """Drake takes any tangential law's `mu` on its continuous plant."""
+        if timestep:
+            raise ValueError(
+                "drake's friction is exported for its continuous plant only (a discrete "
+                "plant's friction is not replicated here): leave timestep unset"
+            )
+
+    def poisson(self, design: Design, tangential) -> None:
+        return None
+
+    def parameters(self, design: Design, tangential) -> dict:
+        """The design's parameters with Coulomb's `mu` of `tangential` as static and dynamic
+        friction
+        of both geometries, and Drake's default stiction tolerance ."""
+        mu = float(tangential.params["mu"])
+        return dict(design.parameters, friction=[mu, mu], stiction_tolerance=STICTION_TOLERANCE)
+
+    def realised(self, parameters, tangential):
+        return tangential
+
+    def notes(self, parameters, tangential) -> list[str]:
+        return []
+
+    def oblique(self, parameters, *, m, radius, v_n, v_t):
+        """The continuous plant's oblique impact with the exported friction, integrated
+        (`oblique_replica`)."""
+        return oblique_replica(k=parameters["point_contact_stiffness"],
+                               d=parameters["hunt_crossley_dissipation"], m=m, radius=radius,
+                               mu=parameters["friction"][0], v_n=v_n, v_t=v_t,
+                               stiction=parameters["stiction_tolerance"])  # fmt: skip

@@ -30,11 +30,11 @@ import math
 
 import numpy as np
 
-from . import _stepping, lammps_script
-from .base import AbstractEngine, Design, Key, Stepping
-from .lammps_jkr import emix
-from .lammps_tangential import NO_TANGENTIAL, TANGENTIAL_MODELS, with_tangential
-from .materials import check_poisson, check_positive
+from .. import _stepping
+from ..base import AbstractNormalModel, Design, Key, Scene, Stepping
+from . import script
+from .jkr import emix
+from ..materials import check_poisson, check_positive
 
 
 def normal_force(delta, v, *, c: float, b: float, pull: float):
@@ -83,34 +83,32 @@ def _contact(parameters, m_eff: float) -> tuple[float, float, float]:
 
 def model(E: float, damp: float, poisson: float, cohesion: float) -> str:
     """The `dmt` model of `pair_coeff` (and of `fix wall/gran granular`)."""
-    return (
-        f"dmt {E:.10g} {damp:.10g} {poisson:.10g} {cohesion:.10g} damping viscoelastic "
-        f"{NO_TANGENTIAL}"
-    )
+    return f"dmt {E:.10g} {damp:.10g} {poisson:.10g} {cohesion:.10g} damping viscoelastic"
 
 
-class LammpsDMT(AbstractEngine):
+class DMT(AbstractNormalModel):
     """LAMMPS's `pair_style granular` with the `dmt` normal model and `damping viscoelastic`,
     between two spheres or a sphere and `fix wall/gran`, at `fix nve/sphere`'s velocity
     Verlet: what `export(law("dmt", ...), "lammps", ...)` targets (the module's docstring
-    has the formulas and sources). Built with the law it exports (`source`), whose own
-    parameters it maps; not in `ENGINES`: `lammps.Lammps` hands a `dmt` law to it."""
+    has the formulas and sources). It maps the parameters of the law it exports
+    (`scene.law`)."""
 
-    NAME = "lammps"
-    LABEL = "LAMMPS"
+    NAME = "dmt"
+    NEAREST = "its dmt law"
+    ALLOWS_LIMIT_DAMPING = False
     SCENES = {
         "spheres": "two equal spheres, each of mass m and radius `radius`, colliding head-on at "
         "relative speed v0 (pair_style granular, dmt, damping viscoelastic; no gravity)",
         "wall": "a sphere of mass m and radius `radius` hitting a fixed flat wall (fix "
         "wall/gran granular dmt, the sphere's own material) head-on at speed v0 (no gravity)",
     }
-    TWO_SPHERES = True
     MASS_DEPENDS = "its Young's modulus and cohesion scale with the mass"
     KEYS = (
         Key("E", "Pa"),
         Key("damp", "1/(m s), viscoelastic damping: b = damp meff Reff^0.5"),
         Key("cohesion", "J/m^2, the surface energy (half the work of adhesion)"),
-        Key("R_eff", "m, the contact's effective radius"),
+        Key("R_eff", "m, the contact's effective radius (default: from the radius)",
+            needed=False),
         Key("poisson", "default 0.3", needed=False),
         Key("timestep", "s; without it, no stepping", needed=False),
     )
@@ -119,40 +117,30 @@ class LammpsDMT(AbstractEngine):
         "with a timestep, fix nve/sphere's velocity Verlet, the contact while the spheres "
         "overlap: replicated"
     )
-    CONTINUOUS_PLANT = False
-    REFUSES_LIMIT_DAMPING = "dmt"
-    TANGENTIAL = tuple(TANGENTIAL_MODELS)
 
-    def __init__(self, source=None):
-        self.source = source  # the dmt law an export maps
-
-    def with_tangential(self, parameters, tangential):
-        return with_tangential(parameters, tangential)
-
-    def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
-               limit_damping=False, geometry=None) -> Design:  # fmt: skip
+    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
+               limit_damping=False) -> Design:  # fmt: skip
         """`pair_style granular` with `dmt E damp poisson cohesion damping viscoelastic` that
-        is the law `source` for the pair (every force scaled by `meff/m`: the module's
+        is the law `scene.law` for the pair (every force scaled by `meff/m`: the module's
         docstring), two spheres of mass `m` (kg) and radius `radius` (m) or with
         `geometry="wall"` one on `fix wall/gran`; `e` and `T` (s), the law's at `v0` (m/s),
         are what the replica's mean over start phases is held to."""
-        self.check_limit_damping(limit_damping)
-        if self.source is None:
+        if scene.law is None:
             raise ValueError("LAMMPS's dmt model is exported from a dmt law: pass the law")
-        wall = geometry == "wall"
+        m, v0, radius, wall = scene.m, scene.v0, scene.radius, scene.wall
         m_eff, R_eff = (m, radius) if wall else (m / 2.0, radius / 2.0)
         scale = m_eff / m
-        q = {k: float(v) for k, v in self.source.parameters.items()}
+        q = {k: float(v) for k, v in scene.law.parameters.items()}
         c, b, pull = scale * q["c"], scale * q["b"], scale * 2.0 * math.pi * q["w"] * q["R"]
         E = 0.75 * c / math.sqrt(R_eff) * 2.0 * (1.0 - poisson) * (1.0 + poisson)
         damp = b / (m_eff * math.sqrt(R_eff))
         cohesion = pull / (4.0 * math.pi * R_eff)
-        stepping, h, es, Ts, warnings = lammps_script.cohesive_stepping(
+        stepping, h, es, Ts, warnings = script.cohesive_stepping(
             replica, dict(E=E, poisson=poisson, cohesion=cohesion, damp=damp, R_eff=R_eff),
             wall=wall, m=m, v0=v0, e=e, T=T, timestep=timestep,
         )  # fmt: skip
         text = model(E, damp, poisson, cohesion)
-        parameters = lammps_script.granular_parameters(
+        parameters = script.granular_parameters(
             text, h, E=E, poisson=poisson, R_eff=R_eff, wall=wall, damp=damp,
             cohesion=cohesion, normal="dmt",
         )  # fmt: skip
@@ -162,6 +150,7 @@ class LammpsDMT(AbstractEngine):
             warnings=tuple(warnings),
             separation="penetration",
             stepping=stepping,
+            clause=text,
         )
 
     def law_parameters(self, parameters, m):
@@ -176,16 +165,13 @@ class LammpsDMT(AbstractEngine):
 
     def response(self, parameters, *, m, radius=None):
         """`(law, "penetration")`: `law_parameters`' `dmt` law for `parameters`."""
-        return self.law(lammps_script.with_effective_radius(parameters, radius), m), "penetration"
+        return self.law(script.with_effective_radius(parameters, radius), m), "penetration"
 
     def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
         """`replica` at `parameters["timestep"]` (s), or None without one."""
         if parameters.get("timestep") is None:
             return None
         h = check_positive("timestep", parameters["timestep"], "s")
-        full = {**lammps_script.with_effective_radius(parameters, radius), "timestep": h}
+        full = {**script.with_effective_radius(parameters, radius), "timestep": h}
         _contact(full, m)
         return Stepping(h, lambda v: replica(full, m, v))
-
-    def snippet(self, parameters) -> str:
-        return lammps_script.snippet(parameters)

@@ -22,16 +22,16 @@ import math
 
 import numpy as np
 
-from . import _stepping
-from .base import AbstractEngine, Design, Key, Stepping
-from .materials import check_positive
+from .. import _stepping
+from ..base import AbstractNormalModel, Design, Key, Scene, Stepping
+from ..materials import check_positive
 
 
 def _tau(alpha: float) -> float:
     """The duration of `m x'' = -k x (1 + D v)` at `k = m = v0 = 1`, `D = alpha` (units of
     `sqrt(m/k)`), from jaximpact's solver."""
-    from .._laws import law
-    from .._solve.impact import impact
+    from ..._laws import law
+    from ..._solve.impact import impact
 
     return float(impact(law("point_contact", c=1.0, d=alpha), m=1.0, v0=1.0).T)
 
@@ -41,7 +41,7 @@ def alpha_for(e: float) -> float:
     force-criterion closed form) is `e` (0 for `e = 1`), or a one-line ValueError."""
     from scipy.optimize import brentq
 
-    from ..closed_forms import hunt_crossley_restitution
+    from ...closed_forms import hunt_crossley_restitution
 
     if e >= 1.0:
         return 0.0
@@ -121,65 +121,28 @@ def _discrete(e: float, T: float, k: float, alpha: float, m: float, v0: float, h
     return params, es, Ts, reachable
 
 
-class Drake(AbstractEngine):
+class PointContact(AbstractNormalModel):
     """Drake's point contact `f = k x (1 + d v)` for a body on a half space: its continuous
     plant, or a discrete plant's implicit step (the module's docstring has the sources)."""
 
-    NAME = "drake"
-    LABEL = "Drake"
-    SCENES = {
-        "wall": "a body of mass m on a fixed half space (both geometries with the exported "
-        "properties), no gravity, approaching along the normal at v0; continuous plant "
-        "(time_step = 0), or discrete with the Lagged, Similar or TAMSI approximation when a "
-        "timestep is given"
-    }
-    TWO_SPHERES = False
-    MASS_DEPENDS = "its point_contact_stiffness scales with the mass"
+    NAME = "point"
+    LAW = "point_contact"
     KEYS = (
         Key("point_contact_stiffness", "N/m"),
         Key("hunt_crossley_dissipation", "s/m"),
         Key("time_step", "s; 0 or none: its continuous plant", needed=False),
     )
-    LAW = "point_contact"
     STEPPING = (
         "with time_step > 0 its discrete plant's implicit step (Lagged, Similar, TAMSI): "
         "replicated; the continuous plant (time_step = 0) has no step error"
     )
-    CONTINUOUS_PLANT = True
-    FRICTION = (
-        "Drake has no tangential spring: a tangential law goes as its Coulomb mu alone "
-        "(static = dynamic), regularised by Drake's Stribeck curve below the stiction "
-        "tolerance, in the continuous plant"
-    )
+    MASS_DEPENDS = "its point_contact_stiffness scales with the mass"
+    ALLOWS_LIMIT_DAMPING = True
+    NEAREST = "its point_contact law"
+    SCENES = None
 
-    def check_tangential(self, tangential, *, radius, timestep):
-        """Drake takes any tangential law's `mu` on its continuous plant."""
-        if timestep:
-            raise ValueError(
-                "drake's friction is exported for its continuous plant only (a discrete "
-                "plant's friction is not replicated here): leave timestep unset"
-            )
-
-    def with_tangential(self, parameters, tangential):
-        """`parameters` with Coulomb's `mu` of `tangential` as static and dynamic friction
-        of both geometries, and Drake's default stiction tolerance (drake_friction.py)."""
-        from .drake_friction import STICTION_TOLERANCE
-
-        mu = float(tangential.params["mu"])
-        return dict(parameters, friction=[mu, mu], stiction_tolerance=STICTION_TOLERANCE)
-
-    def oblique(self, parameters, *, m, radius, v_n, v_t):
-        """The continuous plant's oblique impact with the exported friction, integrated
-        (drake_friction.py)."""
-        from .drake_friction import oblique_replica
-
-        return oblique_replica(k=parameters["point_contact_stiffness"],
-                               d=parameters["hunt_crossley_dissipation"], m=m, radius=radius,
-                               mu=parameters["friction"][0], v_n=v_n, v_t=v_t,
-                               stiction=parameters["stiction_tolerance"])  # fmt: skip
-
-    def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
-               limit_damping=False, geometry=None) -> Design:  # fmt: skip
+    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
+               limit_damping=False) -> Design:  # fmt: skip
         """`point_contact_stiffness` k (N/m) and `hunt_crossley_dissipation` d (s/m) that
         realise `e` and `T` (s) for mass `m` (kg) at `v0` (m/s): on the continuous plant
         (`timestep` None or 0: exact, from the closed-form e of `f = k x (1 + d v)`), or on a
@@ -187,8 +150,9 @@ class Drake(AbstractEngine):
         TAMSI approximation, whose implicit step damps further: k and d are then corrected
         through `replica` (mean over where first touch falls inside a step), and a warning
         says when no d >= 0 can give `e` at that step. The other options do not apply."""
-        from ..closed_forms import hunt_crossley_restitution
+        from ...closed_forms import hunt_crossley_restitution
 
+        m, v0 = scene.m, scene.v0
         if T is None:
             raise ValueError("Drake needs a contact duration: pass T= (s) or a law")
         alpha = alpha_for(e)
@@ -254,28 +218,3 @@ class Drake(AbstractEngine):
         h = check_positive("time_step", parameters["time_step"], "s")
         self.response(parameters, m=m)  # the values checked
         return Stepping(h, lambda v: replica(parameters, m, v, h))
-
-    def snippet(self, parameters) -> str:
-        per = parameters["per_geometry"]
-        friction, tolerance = "", ""
-        if "friction" in parameters:
-            mu_s, mu_d = parameters["friction"]
-            friction = f"friction=CoulombFriction({mu_s!r}, {mu_d!r}), "
-            tolerance = f"plant.set_stiction_tolerance({parameters['stiction_tolerance']!r})\n"
-        return (
-            "from pydrake.geometry import AddContactMaterial, ProximityProperties\n"
-            + ("from pydrake.multibody.plant import CoulombFriction\n" if friction else "")
-            + "props = ProximityProperties()\n"
-            f"AddContactMaterial(dissipation={per['hunt_crossley_dissipation']!r}, "
-            f"point_stiffness={per['point_contact_stiffness']!r}, {friction}properties=props)\n"
-            "# give these props to BOTH geometries in contact (they combine in series)\n"
-            f"plant = MultibodyPlant(time_step={parameters['time_step']!r})"
-            + (
-                "  # continuous: the promise holds\n"
-                if not parameters["time_step"]
-                else "\nplant.set_discrete_contact_approximation("
-                "DiscreteContactApproximation.kLagged)  # not kSap\n"
-            )
-            + "plant.set_contact_model(ContactModel.kPoint)"
-            + (f"\n{tolerance}" if tolerance else "")
-        )

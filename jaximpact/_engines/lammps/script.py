@@ -1,12 +1,16 @@
-"""What LAMMPS's exported models (`lammps`: hertz/material; `lammps_jkr`,
-`lammps_jkr_viscoelastic`, `lammps_dmt`) share: the script of an export's scene
-(`snippet`), the effective radius of its contact (`with_effective_radius`), the
-parameters of a `pair_style granular` design (`granular_parameters`), and for the cohesive
-models the stepped design (`cohesive_stepping`; their refusal of `limit_damping` is
-`AbstractEngine.REFUSES_LIMIT_DAMPING`)."""
+"""What LAMMPS's normal models (`hertz.py`: hertz/material; `jkr.py`, `jkr_viscoelastic.py`,
+`dmt.py`) share: the script of an export's scene (`snippet`), the commands that join a
+normal and a tangential clause (`commands`), the effective radius of its contact
+(`with_effective_radius`), the parameters of a `pair_style granular` design
+(`granular_parameters`), and for the cohesive models the stepped design
+(`cohesive_stepping`)."""
 
-from . import _stepping
-from .materials import check_positive
+from .. import _stepping
+from ..materials import check_positive
+
+# LAMMPS's granular pair requires a tangential model: without a tangential law, the
+# frictionless one
+FRICTIONLESS = "tangential linear_nohistory 0 0"
 
 
 def snippet(parameters) -> str:
@@ -26,6 +30,17 @@ def snippet(parameters) -> str:
     )
 
 
+def commands(normal: str, tangential: str, *, limit_damping: bool, wall: bool) -> dict:
+    """`pair_coeff` (and with `wall` the `fix wall/gran` on the plane z = 0) of the normal
+    model's clause `normal` (`hertz/material ...`) and the `tangential` clause, as LAMMPS's
+    own `pair_coeff` reads them, `limit_damping` last."""
+    text = f"{normal} {tangential}" + (" limit_damping" if limit_damping else "")
+    out = {"pair_coeff": f"pair_coeff * * {text}"}
+    if wall:
+        out["fix_wall"] = f"fix wall all wall/gran granular {text} zplane 0.0 NULL"
+    return out
+
+
 def with_effective_radius(parameters, radius) -> dict:
     """`parameters` with `R_eff` (m) from the spheres' `radius` (m) where not given: `R` on
     a wall (`geometry` "wall"), `R/2` between two spheres; a one-line ValueError without a
@@ -40,15 +55,17 @@ def with_effective_radius(parameters, radius) -> dict:
     return {**parameters, "R_eff": radius if wall else radius / 2.0}
 
 
-def granular_parameters(text: str, h: float, *, E: float, poisson: float, wall: bool,
+def granular_parameters(clause: str, h: float, *, E: float, poisson: float, wall: bool,
                         R_eff: float | None = None, **model) -> dict:  # fmt: skip
-    """An export's `parameters` for LAMMPS's `pair_style granular` with the model `text`
-    (what follows `pair_coeff * *`) at time step `h` (s): the commands, Young's modulus
+    """An export's `parameters` for LAMMPS's `pair_style granular` with the normal model's
+    `clause` and no tangential force, at time step `h` (s): the commands, Young's modulus
     `E` (Pa), `poisson`, `R_eff` (m, where the model has one), the model's own values
     (`model`, SI units), and with `wall` the `fix wall/gran` on the plane z = 0."""
+    lines = commands(clause, FRICTIONLESS, limit_damping=model.get("limit_damping", False),
+                     wall=wall)  # fmt: skip
     parameters = {
         "pair_style": "pair_style granular",
-        "pair_coeff": f"pair_coeff * * {text}",
+        "pair_coeff": lines["pair_coeff"],
         "timestep": f"timestep {h:.6g}",
         "timestep_s": h,
         "youngs_modulus": E,
@@ -58,7 +75,7 @@ def granular_parameters(text: str, h: float, *, E: float, poisson: float, wall: 
         "units": "units si",
     }
     if wall:
-        parameters["fix_wall"] = f"fix wall all wall/gran granular {text} zplane 0.0 NULL"
+        parameters["fix_wall"] = lines["fix_wall"]
         parameters["geometry"] = "wall"
     return parameters
 

@@ -21,14 +21,14 @@ Sanity checks (`global_properties.cpp`): `0.05 < coefficientRestitution <= 1`,
 
 import dataclasses
 
-from . import lammps
-from .base import AbstractEngine, Design, Stepping
+from ..base import AbstractNormalModel, Design, Scene, Stepping
+from ..lammps import hertz
 
 MIN_COEFFICIENT = 0.05  # createCoeffRest: "0.05 < coefficientRestitution <= 1 required"
-# the values of LAMMPS's design a LIGGGHTS export keeps (and of liggghts_tangential.design)
+# the values of LAMMPS's design a LIGGGHTS export keeps (and of tangential.py)
 _DESIGN_KEYS = ("timestep", "timestep_s", "youngs_modulus", "coeff_restitution", "poisson", "k",
                 "b", "friction", "G_star", "tangential_beta", "tangential_damping")  # fmt: skip
-_LAMMPS = lammps.Lammps()  # the same contact, design and stepping, in other words
+_LAMMPS = hertz.HertzMaterial()  # the same contact, design and stepping, in other words
 
 
 def particle_range_line(youngs_modulus: float) -> str | None:
@@ -41,11 +41,11 @@ def particle_range_line(youngs_modulus: float) -> str | None:
     return None
 
 
-def _parameters(p: dict, limit_damping: bool, extra: str | None, wall: bool) -> dict:
+def render(p: dict, limit_damping: bool, extra: str | None, wall: bool) -> dict:
     """LAMMPS's design parameters `p` in LIGGGHTS's words: `fix property/global` lines for
     the material, `pair_style gran model hertz`, `limitForce` for `limit_damping`, the
     sanity-range line `extra`, and with `wall` the primitive wall z = 0; with `p`'s
-    `friction` (liggghts_tangential.design) its coefficientFriction and, for an undamped
+    `friction` (tangential.py) its coefficientFriction and, for an undamped
     tangential law, `tangential_damping off`."""
     settings = " limitForce on" if limit_damping else ""  # after the models
     if p.get("friction") is not None and not p["tangential_damping"]:
@@ -82,77 +82,22 @@ def _parameters(p: dict, limit_damping: bool, extra: str | None, wall: bool) -> 
     return parameters
 
 
-class Liggghts(AbstractEngine):
+class Hertz(AbstractNormalModel):
     """LIGGGHTS's `pair_style gran model hertz` with the material as `fix property/global`:
     LAMMPS's `hertz/material` contact term for term, in LIGGGHTS's words and within its
     sanity checks (the module's docstring has the sources)."""
 
-    NAME = "liggghts"
-    LABEL = "LIGGGHTS"
-    SCENES = {
-        "spheres": lammps.Lammps.SCENES["spheres"],
-        "wall": "a sphere of mass m and radius `radius` hitting a fixed flat primitive wall "
-        "(fix wall/gran, of the sphere's own material: atom type 1) head-on at speed v0 (no "
-        "gravity, no friction effect)",
-    }
-    TWO_SPHERES = True
+    NAME = "hertz"
+    LAW = hertz.HertzMaterial.LAW
+    KEYS = hertz.HertzMaterial.KEYS  # limit_damping: its limitForce
+    STEPPING = hertz.HertzMaterial.STEPPING  # fix nve/sphere: the same velocity Verlet
     MASS_DEPENDS = "its youngsModulus scales with the mass"
-    KEYS = lammps.Lammps.KEYS  # limit_damping: its limitForce
-    LAW = lammps.Lammps.LAW
-    STEPPING = lammps.Lammps.STEPPING  # fix nve/sphere: the same velocity Verlet
-    CONTINUOUS_PLANT = False
-    TANGENTIAL = ("mindlin",)
-    # surface_model_default.h: cri = radi - 0.5 deltan, on a wall and between spheres
-    CONTACT_POINT = {"wall": 0.5, "spheres": 0.5}
+    ALLOWS_LIMIT_DAMPING = True
+    NEAREST = "its tsuji law"
+    SCENES = None
 
-    def check_tangential(self, tangential, *, radius, timestep):
-        """LIGGGHTS's `tangential history` is Mindlin's displacement-history spring."""
-        if tangential.name not in self.TANGENTIAL:
-            raise ValueError(
-                "LIGGGHTS's tangential history is Mindlin's spring with displacement history "
-                f"(k_t = 8 G* (R x)^0.5), not {tangential.name!r}: export a mindlin law"
-            )
-
-    def tangential_options(self, design, tangential, options):
-        """The Poisson's ratio at which LIGGGHTS's G* is the law's (liggghts_tangential.py)."""
-        from .liggghts_tangential import tied_poisson
-
-        return dict(options, poisson=tied_poisson(design.parameters, tangential))
-
-    def with_tangential(self, parameters, tangential):
-        """`parameters` (designed at `tangential_options`' Poisson's ratio) with `tangential`
-        (a `mindlin` law) as LIGGGHTS's tangential history: its friction, the damper on or
-        off (liggghts_tangential.py)."""
-        from .liggghts_tangential import tangential_values
-
-        self.check_tangential(tangential, radius=None, timestep=None)
-        p = tangential_values({k: parameters[k] for k in _DESIGN_KEYS if k in parameters},
-                              tangential)  # fmt: skip
-        return _parameters(p, parameters["limitForce"], parameters["particle_range"],
-                           "fix_wall" in parameters)  # fmt: skip
-
-    def tangential_changes(self, parameters, tangential):
-        """Poisson's ratio set for G*, and where LIGGGHTS's `mindlin` law is the nearest."""
-        from .liggghts_tangential import differences
-
-        out = [
-            f"LIGGGHTS's G* comes from E and nu: poissonsRatio {parameters['poisson']:.6g} "
-            f"(youngsModulus {parameters['youngs_modulus']:.6g} Pa) gives the tangential "
-            "law's G* with the normal contact's Y*"
-        ]
-        changed = differences(parameters, tangential)
-        if changed:
-            out.append("LIGGGHTS realises the nearest mindlin law: " + "; ".join(changed))
-        return out
-
-    def realised_tangential(self, parameters, tangential):
-        """The `mindlin` law LIGGGHTS realises (its G* and damper tied to E, nu, e)."""
-        from .liggghts_tangential import realised
-
-        return realised(parameters, tangential)
-
-    def design(self, e, T, *, m, v0, timestep=None, radius=None, poisson=0.3,
-               limit_damping=False, geometry=None) -> Design:  # fmt: skip
+    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
+               limit_damping=False) -> Design:  # fmt: skip
         """LAMMPS's design in LIGGGHTS's names. `geometry="wall"`: a sphere on a primitive
         `fix wall/gran` of its own material (atom type 1). Its contact, `fix_wall_gran.cpp`
         and `normal_model_hertz.h`: the particle's own mass and radius (`reff = radi` on a
@@ -161,14 +106,12 @@ class Liggghts(AbstractEngine):
         engines give the same e and T to every digit printed)."""
         if poisson < 0:
             raise ValueError(f"LIGGGHTS requires 0 <= poissonsRatio <= 0.5, got {poisson:g}")
-        out = _LAMMPS.design(
-            e, T, m=m, v0=v0, radius=radius, poisson=poisson, timestep=timestep,
-            limit_damping=limit_damping, geometry=geometry,
-        )  # fmt: skip
+        out = _LAMMPS.design(e, T, scene, poisson=poisson, timestep=timestep,
+                             limit_damping=limit_damping)  # fmt: skip
         p = out.parameters
         if p["coeff_restitution"] <= MIN_COEFFICIENT:
             separation = "force" if limit_damping else "penetration"
-            floor = lammps.impact_at_unit_scales(MIN_COEFFICIENT, separation)[0]
+            floor = hertz.impact_at_unit_scales(MIN_COEFFICIENT, separation)[0]
             raise ValueError(
                 f"LIGGGHTS cannot realise e = {e:g}: it refuses coefficientRestitution <= 0.05 "
                 f"(src/global_properties.cpp), whose e is {floor:.4g}"
@@ -181,8 +124,8 @@ class Liggghts(AbstractEngine):
                 f"youngsModulus {p['youngs_modulus']:.4g} Pa is outside LIGGGHTS's SI sanity "
                 f"range [5e6, 1e9] Pa: the snippet adds '{extra}'",
             )
-        parameters = _parameters(p, limit_damping, extra, geometry == "wall")
-        return dataclasses.replace(out, parameters=parameters, warnings=warnings)
+        parameters = render(p, limit_damping, extra, scene.wall)
+        return dataclasses.replace(out, parameters=parameters, warnings=warnings, clause=None)
 
     def law_parameters(self, parameters, m):
         """As LAMMPS's: `tsuji`'s `c` = k and `b`."""
@@ -191,27 +134,8 @@ class Liggghts(AbstractEngine):
     def response(self, parameters, *, m, radius=None):
         """`(law, separation)`: as LAMMPS's (`limit_damping` is `limitForce on`)."""
         clamped = bool(parameters.get("limit_damping", False))
-        return lammps.tsuji_response(self, parameters, m=m, radius=radius, clamped=clamped)
+        return hertz.tsuji_response("liggghts", parameters, m=m, radius=radius, clamped=clamped)
 
     def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
         """`fix nve/sphere`: LAMMPS's velocity Verlet."""
         return _LAMMPS.stepper(parameters, m=m, radius=radius)
-
-    def snippet(self, parameters) -> str:
-        return "\n".join(
-            [
-                "units si",
-                "atom_style granular",
-                "communicate single vel yes",
-                *([parameters["particle_range"]] if parameters.get("particle_range") else []),
-                parameters["youngsModulus"],
-                parameters["poissonsRatio"],
-                parameters["coefficientRestitution"],
-                parameters["coefficientFriction"],
-                parameters["pair_style"],
-                parameters["pair_coeff"],
-                *([parameters["fix_wall"]] if parameters.get("fix_wall") else []),
-                "fix integr all nve/sphere",
-                parameters["timestep"],
-            ]
-        )

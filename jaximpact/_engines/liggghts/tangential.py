@@ -27,7 +27,9 @@ tangential force halfway through the overlap (`surface_model_default.h`: `cri = 
 
 import math
 
-from .lammps import damp_coefficient
+from ..base import AbstractTangentialModel, Design
+from ..lammps.hertz import damp_coefficient
+from .normal import _DESIGN_KEYS, render
 
 # global_properties.cpp: 0 <= poissonsRatio <= 0.5; jaximpact's moduli take nu < 0.5
 _NU_RANGE = (0.0, 0.4999)
@@ -72,7 +74,7 @@ def tangential_values(p: dict, tangential) -> dict:
 
 def realised(parameters: dict, tangential):
     """The `mindlin` law LIGGGHTS realises with the exported `parameters`."""
-    from .._oblique import tangential_law
+    from ..._oblique import tangential_law
 
     return tangential_law("mindlin", G_star=parameters["G_star"], mu=parameters["friction"],
                           beta=parameters["tangential_beta"])  # fmt: skip
@@ -95,3 +97,52 @@ def differences(parameters: dict, tangential) -> list[str]:
             f"law's {beta:.4g}"
         )
     return out
+
+
+class TangentialHistory(AbstractTangentialModel):
+    """LIGGGHTS's `tangential history`: Mindlin's spring with displacement history, its G*
+    and damper tied to the normal contact (the module's docstring)."""
+
+    MODEL = (
+        "LIGGGHTS's tangential history is Mindlin's spring with displacement history "
+        "(k_t = 8 G* (R x)^0.5)"
+    )
+    FRICTION = None
+    # surface_model_default.h: cri = radi - 0.5 deltan, on a wall and between spheres
+    CONTACT_POINT = {"wall": 0.5, "spheres": 0.5}
+
+    def check(self, tangential, *, timestep) -> None:
+        """LIGGGHTS takes any `mindlin` law (the nearest where its G* or damper cannot be)."""
+
+    def poisson(self, design: Design, tangential) -> float:
+        """The Poisson's ratio at which LIGGGHTS's G* is the law's (`tied_poisson`)."""
+        return tied_poisson(design.parameters, tangential)
+
+    def parameters(self, design: Design, tangential) -> dict:
+        """The design's parameters (designed at `poisson`'s ratio) with `tangential` (a
+        `mindlin` law) as LIGGGHTS's tangential history: its friction, the damper on or
+        off."""
+        parameters = design.parameters
+        p = tangential_values({k: parameters[k] for k in _DESIGN_KEYS if k in parameters},
+                              tangential)  # fmt: skip
+        return render(p, parameters["limitForce"], parameters["particle_range"],
+                      "fix_wall" in parameters)  # fmt: skip
+
+    def realised(self, parameters, tangential):
+        """The `mindlin` law LIGGGHTS realises (its G* and damper tied to E, nu, e)."""
+        return realised(parameters, tangential)
+
+    def notes(self, parameters, tangential) -> list[str]:
+        """Poisson's ratio set for G*, and where LIGGGHTS's `mindlin` law is the nearest."""
+        out = [
+            f"LIGGGHTS's G* comes from E and nu: poissonsRatio {parameters['poisson']:.6g} "
+            f"(youngsModulus {parameters['youngs_modulus']:.6g} Pa) gives the tangential "
+            "law's G* with the normal contact's Y*"
+        ]
+        changed = differences(parameters, tangential)
+        if changed:
+            out.append("LIGGGHTS realises the nearest mindlin law: " + "; ".join(changed))
+        return out
+
+    def oblique(self, parameters, *, m, radius, v_n, v_t):
+        return None

@@ -1,0 +1,1 @@
+"""Drake (`engine.py`): its normal model and its friction, one module each."""

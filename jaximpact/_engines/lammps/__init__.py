@@ -1,0 +1,1 @@
+"""LAMMPS (`engine.py`): its normal and tangential models, one module each."""

@@ -1,0 +1,1 @@
+"""MuJoCo (`engine.py`): its normal model and its friction, one module each."""

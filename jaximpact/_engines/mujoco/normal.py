@@ -1,0 +1,177 @@
+"""MuJoCo's normal model: solref, solimp and a time step designed so that its Euler step
+realises a target e and T (its bias corrected), through `solref.replica`."""
+
+import math
+
+from .. import _stepping
+from ..base import AbstractNormalModel, Design, Key, Scene, Stepping
+from ..materials import check_positive
+from .solref import (
+    DEFAULT_TIMECONST,
+    DEFAULT_TIMESTEP,
+    SOLIMP,
+    check_solref,
+    continuous,
+    dampratio_for,
+    effective,
+    replica,
+)
+
+
+def _corrected(e: float, T: float, v0: float, timestep) -> tuple[float, float, float]:
+    """`(w0, zeta, h)`: the natural frequency (1/s) and damping ratio that MuJoCo's Euler
+    step at `h` (s: `timestep`, or the recommended step) turns into `e` and `T` (s) at `v0`
+    (m/s), the continuous contact's corrected for the step's own bias (phase means). The
+    recommended step is the coarsest at which e's spread over start phases stays within the
+    export's tolerance (`_stepping.recommended_step`; the correction then moves the mean onto
+    the target, within `_CORRECTION_TOL`), halved where the corrected contact still misses
+    it."""
+    if timestep is not None:
+        return (*_at_step(e, T, v0, float(timestep))[:2], float(timestep))
+    zeta = dampratio_for(e)
+    w0 = continuous(zeta)[1] / T
+    tol = _stepping.STEP_TOL - _CORRECTION_TOL
+    h = _stepping.recommended_step(lambda h: replica(_solref_at(w0, zeta, h), h, v0), T, None,
+                                   tol)  # fmt: skip
+    while True:
+        w0, zeta, es, Ts = _at_step(e, T, v0, h)
+        if _stepping.realises(es, Ts, e, T) or T / h > _stepping.MAX_STEPS:
+            return w0, zeta, h
+        h = _stepping.nice_down(h / 2.0)
+
+
+# how far (relative) the corrected contact's phase-mean e and T may stay from the target
+_CORRECTION_TOL = 2e-5
+
+
+def _at_step(e: float, T: float, v0: float, h: float):
+    """`(w0, zeta, es, Ts)`: the continuous contact's natural frequency (1/s) and damping
+    ratio corrected (phase means, up to 8 rounds) so that MuJoCo's Euler step at `h` (s)
+    realises `e` and `T` (s) at `v0` (m/s), and what it realises per start phase."""
+    zeta = target = dampratio_for(e)
+    w0 = continuous(zeta)[1] / T
+    for _ in range(8):
+        es, Ts = replica(_solref_at(w0, zeta, h), h, v0)
+        e_mean, T_mean = float(es.mean()), float(Ts.mean())
+        if abs(e_mean / e - 1) < _CORRECTION_TOL and abs(T_mean / T - 1) < _CORRECTION_TOL:
+            break
+        try:
+            zeta_apparent = dampratio_for(min(e_mean, 1.0))
+        except ValueError:
+            break
+        zeta = max(0.0, zeta + target - zeta_apparent)
+        w0 *= T_mean / T
+    else:
+        es, Ts = replica(_solref_at(w0, zeta, h), h, v0)
+    return w0, zeta, es, Ts
+
+
+def _solref(w0: float, zeta: float):
+    if zeta <= 0.0:
+        return (-(w0**2), 0.0)  # e = 1: only the direct form has no damping
+    return (1.0 / (w0 * zeta), zeta)
+
+
+def _solref_at(w0: float, zeta: float, h: float):
+    """`_solref`, in the direct form where refsafe would raise the standard form's
+    timeconst (below two steps `h`, s): the solref the design gives MuJoCo."""
+    solref = _solref(w0, zeta)
+    if solref[0] > 0 and solref[0] < 2.0 * h:
+        return (-(w0**2), -2.0 * zeta * w0)
+    return solref
+
+
+class Solref(AbstractNormalModel):
+    """MuJoCo's soft contact (solref, solimp) for a body on a plane, at its Euler step
+    (`solref.py` has the formulas and sources)."""
+
+    NAME = "solref"
+    LAW = "kelvin_voigt"
+    KEYS = (
+        Key("solref", "[timeconst s, dampratio], or the direct [-stiffness 1/s^2, -damping 1/s]"),
+        Key("timestep", f"s, default {DEFAULT_TIMESTEP:g}, for its refsafe rule", needed=False),
+    )
+    STEPPING = (
+        f"its Euler step at timestep (default {DEFAULT_TIMESTEP:g} s), semi-implicit in the "
+        "contact force: replicated"
+    )
+    # solref scales the contact per unit mass: from targets e and T no mass is needed (from
+    # a law, its e and T at v0 depend on the mass)
+    MASS_DEPENDS = None
+    ALLOWS_LIMIT_DAMPING = True
+    NEAREST = "its kelvin_voigt law"
+    SCENES = None
+
+    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
+               limit_damping=False) -> Design:  # fmt: skip
+        """solref, solimp and time step that realise `e` and `T` (s; None: MuJoCo's default
+        timeconst) at `v0` (m/s) in MuJoCo, and what MuJoCo realises with them. The contact
+        per unit mass does not depend on the mass `m`; the other options do not apply."""
+        v0 = scene.v0
+        warnings = []
+        if T is None:
+            zeta = dampratio_for(e)
+            T = DEFAULT_TIMECONST * (continuous(zeta)[1] * zeta if zeta > 0 else math.pi)
+            warnings.append(f"no T given: MuJoCo's default timeconst 0.02 s, T = {T:.4g} s")
+        w0, zeta, h = _corrected(e, T, v0, timestep)
+        solref = _solref(w0, zeta)
+        es, Ts = replica(solref, h, v0)
+        steps_per_contact = float(Ts.mean() / h)
+        if solref[0] > 0 and solref[0] < 2.0 * h:
+            warnings.append(
+                f"timeconst {solref[0]:.4g} s is below two time steps ({2 * h:.4g} s): "
+                "MuJoCo's refsafe raises it, so solref is given in its direct form, which is "
+                "not raised"
+            )
+            solref = (-(w0**2), -2.0 * zeta * w0)
+            es, Ts = replica(solref, h, v0)
+        half_spread = float((es.max() - es.min()) / 2 / es.mean()) if es.mean() > 0 else 0.0
+        if half_spread > _stepping.STEP_TOL:
+            warnings.append(
+                f"time step {h:.3g} s gives {steps_per_contact:.0f} steps per contact: e "
+                f"ranges {es.min():.4g} to {es.max():.4g} with where contact starts inside a "
+                f"step; use a step of {_stepping.describe_step(_corrected(e, T, v0, None)[2], T)}"
+                " or less"
+            )
+        tol = _stepping.STEP_TOL
+        if abs(es.mean() / e - 1) > tol or abs(Ts.mean() / T - 1) > tol:
+            warnings.append(
+                f"with time step {h:.3g} s MuJoCo realises e = {es.mean():.4g}, T = "
+                f"{Ts.mean():.4g} s instead of e = {e:.4g}, T = {T:.4g} s"
+            )
+        parameters = {
+            "solref": [float(solref[0]), float(solref[1])],
+            "solref_direct": [-(w0**2), -2.0 * zeta * w0],
+            "solimp": list(SOLIMP),
+            "timestep": h,
+            "integrator": "Euler",
+            "natural_frequency": w0,
+            "dampratio": zeta,
+        }
+        return Design(
+            parameters=parameters,
+            **_stepping.realised(es, Ts, h),
+            warnings=tuple(warnings),
+            separation="force",
+            target_T=T,
+            stepping=parameters,
+        )
+
+    def law_parameters(self, parameters, m):
+        """`kelvin_voigt`'s `c` (N/m) and `b` (N s/m) for a body of mass `m` (kg), to be
+        read with `separation="force"`."""
+        stiffness, damping = effective(parameters["solref"], parameters["timestep"])
+        return {"c": m * stiffness, "b": m * damping}
+
+    def response(self, parameters, *, m, radius=None):
+        """`(law, separation)`: the continuous law of `parameters` (`solref`, `timestep`,
+        default 0.002 s, for refsafe) for a body of mass `m` (kg), each value checked."""
+        solref = check_solref(parameters["solref"])
+        timestep = check_positive("timestep", parameters.get("timestep", DEFAULT_TIMESTEP), "s")
+        return self.law({"solref": solref, "timestep": timestep}, m), "force"
+
+    def stepper(self, parameters, *, m, radius=None) -> Stepping:
+        """MuJoCo's Euler step at `parameters["timestep"]` (default 0.002 s)."""
+        h = check_positive("timestep", parameters.get("timestep", DEFAULT_TIMESTEP), "s")
+        solref = check_solref(parameters["solref"])
+        return Stepping(h, lambda v: replica(solref, h, v))
