@@ -101,6 +101,10 @@ _PUBLIC.update(
         "_oblique",
     )
 )
+# uncertainty: posteriors of fits, their bands, the next measurement (issue 37)
+_PUBLIC.update(
+    dict.fromkeys(("posterior", "Posterior", "next_measurement", "NextMeasurement"), "_posterior")
+)
 _SUBMODULES = ("closed_forms",)
 
 __all__ = sorted([*_PUBLIC, *_SUBMODULES])

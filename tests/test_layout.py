@@ -20,7 +20,7 @@ RANK = {
     **dict.fromkeys(("_curves", "closed_forms"), 3),
     "_solve": 4,
     **dict.fromkeys(("_fit", "_batch", "_oblique"), 5),
-    **dict.fromkeys(("_studies", "_jobs"), 6),
+    **dict.fromkeys(("_studies", "_jobs", "_posterior"), 6),
     **dict.fromkeys(("_paper", "_bench", "_engines"), 7),
     "_cli": 8,
     "__init__": 9,

@@ -97,6 +97,13 @@ class Fit(eqx.Module):
     n_data: Array | None = None
     weighted: bool = eqx.field(static=True, default=False)
     notes: tuple[str, ...] = eqx.field(static=True, default=())
+    # what the fit was made of, so that `posterior` rebuilds the same forward model: the
+    # sigmas as given (None: not given), gravity g (m/s^2), and the compiled fit's options
+    # (free parameters, separation, tolerance, curves or closed form)
+    sigma_e: Array | None = None
+    sigma_T: Array | None = None
+    g: Array | float = 0.0
+    setup: eqx.Module | None = None
 
     # --------------------------------------------------------------- goodness of fit
 
@@ -720,6 +727,7 @@ def calibrate(
     fit = _fit(law, data, m, 0.0 if g_is_zero else jnp.asarray(g, dtype=float),
                np.float64(target_tol), options)  # fmt: skip
     fit = checks.refuse(fit, keep=("target_tol", "n_data"), converged=False, reproduces=False)
+    fit = dataclasses.replace(fit, sigma_e=sigma_e, sigma_T=sigma_T)  # for `posterior`
     e_only = T is None and g_is_zero and shape_of(law) is not None
     return _reported(fit, undetermined, undetermined_why, e_only)
 
@@ -952,4 +960,6 @@ def _fit(law, data, m, g, target_tol, options):
         n_data=jnp.asarray(n_data),
         weighted=options.has_sigma,
         optimizer=optimizer if isinstance(optimizer, str) else type(optimizer).__name__,
+        g=g,
+        setup=options,
     )

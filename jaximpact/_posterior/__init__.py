@@ -1,0 +1,9 @@
+"""Uncertainty of a fit: priors, the likelihood built from a fit's forward model, the
+Laplace approximation, NUTS (blackjax), the `Posterior` record, prediction bands and the
+next measurement. Imports `_fit`, `_curves` and `_laws`."""
+
+from .next_measurement import NextMeasurement as NextMeasurement
+from .next_measurement import next_measurement as next_measurement
+from .posterior import PosteriorWarning as PosteriorWarning
+from .posterior import posterior as posterior
+from .result import Posterior as Posterior

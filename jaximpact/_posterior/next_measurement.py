@@ -1,0 +1,103 @@
+"""`next_measurement`: which candidate speed teaches most about a law's parameters.
+
+For a near-Gaussian posterior of the free parameters (covariance `Sigma` of their
+unbounded coordinates over the draws) and a new measurement `y = f(z) + noise` at a
+candidate speed, linearised at the posterior median (`J = df/dz`), the expected
+information gain (mutual information between `y` and the parameters, nats) is
+
+    EIG = 1/2 ln det(I + S^-1/2 J Sigma J^T S^-1/2),
+
+with `S` the new measurement's noise covariance (diagonal: `sigma_e^2`, `sigma_T^2`).
+"""
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .._format import format_fields, format_value, jsonable
+from .bands import noise_scale
+
+
+class NextMeasurement(eqx.Module):
+    """Candidates ranked by expected information gain: `v0` (m/s), best first, and their
+    `gain` (nats, larger teaches more); `measure`: what a new measurement gives
+    (`("e", "T")`, `("e",)`, ...)."""
+
+    v0: np.ndarray
+    gain: np.ndarray
+    measure: tuple = eqx.field(static=True)
+
+    def summary(self) -> str:
+        rows = [(f"#{i + 1}: v0", f"{format_value(v, 'm/s')}, gain {g:.4g} nats")
+                for i, (v, g) in enumerate(zip(self.v0, self.gain))]  # fmt: skip
+        what = " and ".join(self.measure)
+        return format_fields(f"Next measurement of {what}, best first", rows)
+
+    def to_dict(self) -> dict:
+        return {"v0": jsonable(self.v0), "gain": jsonable(self.gain), "measure": list(self.measure)}
+
+    def __repr__(self) -> str:
+        return self.summary()
+
+
+@eqx.filter_jit
+def _jacobians(model, z, v0):
+    """`(e, T)` at `v0` and their derivatives with respect to `z`, each `(speeds, d)`."""
+
+    def f(zz):
+        e, T, _ = model.predict(model.values(zz), v0)
+        return jnp.stack([e, T])
+
+    return f(z), jax.jacfwd(f)(z)
+
+
+def next_measurement(post, v0, *, measure=None) -> NextMeasurement:
+    """Rank the candidate speeds `v0` (m/s) by the expected information gain of one new
+    measurement there about `post`'s free law parameters (nats; the module's formula,
+    linearised at the posterior median, with the posterior covariance of the draws and
+    the noise of the data: the sampled scales' medians, or the given sigmas' median,
+    `sigma_T` as a fraction of T). `measure`: what the new measurement gives, default what
+    the fit's data gave (`("e", "T")` when both were measured).
+
+    **Example**: `next_measurement(post, v0=np.linspace(0.5, 5, 10)).v0[0]`.
+    """
+    model = post.model
+    if model is None:
+        raise ValueError(
+            "next_measurement needs a Posterior with its forward model (from posterior())"
+        )
+    v0 = np.atleast_1d(np.asarray(v0, dtype=float))
+    if v0.ndim != 1 or v0.size == 0 or not np.all(np.isfinite(v0) & (v0 > 0)):
+        raise ValueError("v0 must be candidate speeds > 0 m/s (a number or a 1-D array)")
+    measured = tuple(k for k, data in (("e", model.e), ("T", model.T)) if data is not None)
+    measure = measured if measure is None else tuple(measure)
+    unknown = [k for k in measure if k not in ("e", "T")]
+    if unknown or not measure:
+        raise ValueError(f"measure takes 'e' and/or 'T', got {measure!r}")
+    for k in measure:
+        given = model.sigma_e if k == "e" else model.sigma_T
+        if f"sigma_{k}" not in model.names and given is None:
+            raise ValueError(
+                f"no noise scale for a new {k}: the fit had no {k} data; measure only "
+                f"{' and '.join(measured)}"
+            )
+    z = np.asarray(post.z)
+    free = [model.names.index(k) for k in model.free]
+    sigma = np.atleast_2d(np.cov(z[:, free], rowvar=False))
+    center = jnp.asarray(np.median(z, axis=0))
+    (e_T, jac) = _jacobians(model, center, jnp.asarray(v0))
+    e_T, jac = np.asarray(e_T), np.asarray(jac)[..., free]  # (2, k), (2, k, f)
+    rows = sorted({("e", "T").index(k) for k in measure})
+    scales = []
+    for r in rows:
+        what = ("e", "T")[r]
+        s = noise_scale(post, what, e_T[1][None, :], z)  # (draws or 1, speeds)
+        scales.append(np.broadcast_to(np.median(s, axis=0), v0.shape))
+    gains = np.empty(v0.shape)
+    for k in range(v0.size):
+        J = np.stack([jac[r, k] / scales[i][k] for i, r in enumerate(rows)])  # (o, f)
+        M = np.eye(len(rows)) + J @ sigma @ J.T
+        gains[k] = 0.5 * np.linalg.slogdet(M)[1]
+    order = np.argsort(-gains, kind="stable")
+    return NextMeasurement(v0[order], gains[order], measure)

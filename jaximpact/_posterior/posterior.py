@@ -1,0 +1,217 @@
+"""`posterior`: from a fit to the distribution of its parameters."""
+
+import warnings
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .._checks import is_traced
+from .._fit.calibrate import Fit, law_units
+from .laplace import gaussian_draws, laplace
+from .likelihood import NOISES, build_model
+from .nuts import diagnostics, poor, run_chains
+from .priors import default_noise_prior, default_prior, parse_prior
+from .result import Posterior
+
+METHODS = ("nuts", "laplace")
+
+
+class PosteriorWarning(UserWarning):
+    """A posterior whose sampler or mode search did poorly (see `Posterior.diagnostics`)."""
+
+
+def posterior(
+    fit,
+    *,
+    prior: dict | None = None,
+    method: str = "nuts",
+    num_samples: int = 2000,
+    num_warmup: int = 500,
+    chains: int = 4,
+    key=None,
+    noise: str = "normal",
+    nu: float = 4.0,
+    target_accept: float = 0.8,
+) -> Posterior:
+    """The posterior of `fit`'s free parameters given its data, `p(theta | y)`.
+
+    `fit`: the result of `calibrate` (supported); `fit_bounces` and `fit_oblique` results
+    are not supported yet (TypeError). The likelihood solves every impact with the fit's
+    own forward model (on the universal curves where they served the fit, else the closed
+    form or the integrated solve), compiled once.
+
+    - `prior`: `{name: (kind, a, b)}` with kind `"loguniform"` (lo, hi), `"uniform"`
+      (lo, hi), `"normal"` (mean, sd) or `"lognormal"` (mu, sigma of ln x), SI units. A
+      free parameter without one gets the weakly informative default: loguniform over
+      three decades either side of its fitted value (uniform on (0, 1) for `e_nominal`).
+    - Noise: with `sigma_e` (`sigma_T`) given to `calibrate`, each residual
+      `(prediction - measured) / sigma` is standard normal. Without, the noise scale is
+      a parameter of its own, sampled with the law's: `sigma_e` (absolute) with the
+      default prior loguniform(1e-4, 0.5), `sigma_T` (s) loguniform over 1e-4 to 0.5
+      times the median measured T; `prior=` may set them too. `noise="student_t"`: a
+      Student-t of `nu` (4) degrees of freedom instead of the normal, for data with
+      outliers (`sigma` is then its scale).
+    - `method="nuts"`: blackjax's NUTS with Stan's window adaptation (`num_warmup` steps,
+      a dense mass matrix seeded by the Laplace covariance, `target_accept`), `chains`
+      chains of `num_samples` draws each, started from draws of the Laplace
+      approximation. Diagnostics: rank-normalised split `r_hat`, bulk `ess` and the
+      divergent transitions; a `PosteriorWarning` when `r_hat > 1.05`, `ess < 100` or
+      any transition diverged.
+    - `method="laplace"`: the Gaussian at the mode in the unbounded coordinates
+      (`H = -` the Hessian of the log posterior, `jax.hessian`), `num_samples * chains`
+      independent draws of it: fast, and exact for a Gaussian posterior only.
+    - `log_evidence` (both methods): the Laplace approximation at the mode,
+      `ln Z = ln p(y, z*) + d/2 ln 2 pi - 1/2 ln det H`.
+
+    Sampling is in unbounded coordinates `z` (`_posterior.priors`): the logit of the
+    position in a uniform or loguniform prior's range, the standardised value or
+    logarithm for a normal or lognormal one, with the Jacobian in the density.
+
+    **Example**: `posterior(calibrate(law, m=1.0, v0=v0s, e=es, T=Ts, sigma_e=0.01,
+    sigma_T=0.02 * Ts), prior={"c": ("loguniform", 1e5, 1e8)}, key=jax.random.key(0))`.
+    """
+    if not isinstance(fit, Fit) or fit.setup is None:
+        raise TypeError(
+            f"posterior takes the result of calibrate (a Fit), got {type(fit).__name__}; "
+            "fit_bounces and fit_oblique results are not supported yet"
+        )
+    if is_traced(fit.loss) or np.ndim(fit.loss) != 0:
+        raise ValueError("posterior takes one concrete fit, not a traced or vmapped batch")
+    if method not in METHODS:
+        raise ValueError(f"method must be 'nuts' or 'laplace', got {method!r}")
+    if noise not in NOISES:
+        raise ValueError(f"noise must be 'normal' or 'student_t', got {noise!r}")
+    if not (isinstance(nu, (int, float)) and nu > 0):
+        raise ValueError(f"nu (Student-t degrees of freedom) must be > 0, got {nu!r}")
+    for name, value, least in (("num_samples", num_samples, 1), ("chains", chains, 1),
+                               ("num_warmup", num_warmup, 0)):  # fmt: skip
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
+            raise ValueError(f"{name} must be an integer >= {least}, got {value!r}")
+    if not 0 < target_accept < 1:
+        raise ValueError(f"target_accept must lie in (0, 1), got {target_accept!r}")
+    key = jax.random.key(0) if key is None else key
+
+    priors, starts = _priors(fit, prior)
+    model = build_model(fit, priors, noise=noise, nu=nu)
+    z0 = jnp.asarray(model.coordinates(starts))
+    mode = laplace(model, z0)
+    if not bool(mode.converged):
+        warnings.warn(
+            "the posterior's mode was not found to tolerance (its Hessian is not negative "
+            "definite, or the search stopped): the Laplace approximation and log_evidence "
+            "are unreliable; check the priors and the data",
+            PosteriorWarning,
+            stacklevel=2,
+        )
+    draw_key, chain_key = jax.random.split(key)
+    covariance = np.asarray(mode.covariance)
+    usable = bool(np.all(np.isfinite(covariance)))
+    usable = usable and bool(np.all(np.linalg.eigvalsh(covariance) > 0))
+    d = len(model.names)
+    if method == "laplace":
+        if not usable:
+            raise ValueError(
+                "the Laplace approximation does not exist here (the posterior's Hessian is "
+                "not negative definite at the mode): use method='nuts' or narrower priors"
+            )
+        z = gaussian_draws(mode, draw_key, num_samples * chains)
+        diag = {"r_hat": float("nan"), "ess": float(z.shape[0]), "divergences": 0,
+                "chains": 1, "draws_per_chain": int(z.shape[0])}  # fmt: skip
+    else:
+        inverse_mass = jnp.asarray(covariance if usable else np.eye(d))
+        if usable:
+            starts_z = gaussian_draws(mode, draw_key, chains)
+        else:
+            jitter = np.asarray(jax.random.normal(draw_key, (chains, d)))
+            starts_z = np.asarray(mode.z)[None, :] + 0.1 * jitter
+        result = run_chains(model, jnp.asarray(starts_z), inverse_mass, chain_key,
+                            int(num_warmup), int(num_samples), float(target_accept))  # fmt: skip
+        diag = diagnostics(result, model.names)
+        z = np.asarray(result.z).reshape(-1, d)
+        why = poor(diag)
+        if why is not None:
+            warnings.warn(
+                f"the NUTS draws may not represent the posterior: {why}; run longer "
+                "(num_warmup, num_samples), raise target_accept, or narrow the priors",
+                PosteriorWarning,
+                stacklevel=2,
+            )
+    values = model.values(jnp.asarray(z))
+    samples = {k: np.asarray(values[k]) for k in model.names}
+    at_mode = model.values(mode.z)
+    units = law_units(fit.law)
+    units = {k: units.get(k, "") for k in model.free}
+    units.update({k: u for k, u in (("sigma_e", ""), ("sigma_T", "s")) if k in model.names})
+    return Posterior(
+        samples=samples,
+        z=z,
+        names=model.names,
+        free=model.free,
+        method=method,
+        law_name=fit.law.name,
+        noise=noise,
+        nu=float(nu),
+        units=units,
+        priors={k: p.as_tuple() for k, p in zip(model.names, model.priors)},
+        map={k: float(v) for k, v in at_mode.items()},
+        log_evidence=float(mode.log_evidence),
+        diagnostics=diag,
+        model=model,
+    )
+
+
+def _priors(fit, prior):
+    """The checked priors of every sampled name and the start values (the fit's, and the
+    residuals' RMS for a sampled noise scale)."""
+    prior = {} if prior is None else prior
+    if not isinstance(prior, dict):
+        raise TypeError(f"prior takes a dict {{name: (kind, a, b)}}, got {type(prior).__name__}")
+    free = tuple(fit.free)
+    law_parameters = tuple(fit.law.parameters)
+    noise_names = []
+    if fit.setup.has_e and fit.sigma_e is None:
+        noise_names.append("sigma_e")
+    if fit.setup.has_T and fit.sigma_T is None:
+        noise_names.append("sigma_T")
+    for name in prior:
+        if name in free or name in noise_names:
+            continue
+        if name in ("sigma_e", "sigma_T"):
+            raise ValueError(
+                f"prior on {name!r}: {name} was given to calibrate (or its quantity was not "
+                "measured), so it is not sampled"
+            )
+        if name in law_parameters:
+            raise ValueError(
+                f"prior on {name!r}: {name} is held fixed by this fit (free = "
+                f"{', '.join(free)}); calibrate with free=(..., {name!r}) to sample it"
+            )
+        raise ValueError(
+            f"prior on {name!r}: the law {fit.law.name} has no parameter {name!r} (its "
+            f"parameters: {', '.join(law_parameters)}; noise scales: "
+            f"{', '.join(noise_names) or 'none sampled'})"
+        )
+    priors, starts = {}, {}
+    for name in free:
+        value = float(fit.params[name])
+        given = name in prior
+        priors[name] = parse_prior(name, prior[name]) if given else default_prior(name, value)
+        starts[name] = value
+    e_target = np.asarray(fit.e_target, float)
+    T_target = np.asarray(fit.T_target, float)
+    for name in noise_names:
+        if name == "sigma_e":
+            scale = 1.0
+            rms = float(np.sqrt(np.mean((np.asarray(fit.e) - e_target) ** 2)))
+        else:
+            known = np.isfinite(T_target)
+            scale = float(np.median(T_target[known]))
+            rms = float(np.sqrt(np.mean((np.asarray(fit.T)[known] - T_target[known]) ** 2)))
+        p = parse_prior(name, prior[name]) if name in prior else default_noise_prior(name, scale)
+        starts[name] = rms
+        if p.bounded:  # inside the range, away from a bound the RMS of an exact fit meets
+            floor = 10.0 * p.a if p.a > 0 else 0.01 * p.b
+            starts[name] = min(max(rms, floor), 0.5 * p.b)
+        priors[name] = p
+    return priors, starts

@@ -1,0 +1,184 @@
+"""`Posterior`: the draws of a calibration's parameters and what they imply."""
+
+import math
+
+import equinox as eqx
+import numpy as np
+
+from .._format import format_fields, format_value, jsonable
+from .bands import Bands, prediction_bands
+from .likelihood import Model
+
+
+class Posterior(eqx.Module):
+    """The posterior of a fit's free parameters (and of its sampled noise scales).
+
+    - `samples`: `{name: draws}` in SI units, shape `(chains * num_samples,)`; the law's
+      free parameters (`free`) and, where no sigma was given, `sigma_e` and `sigma_T` (s).
+    - `median`, `interval(0.9)` (the 5 and 95 % quantiles), `mean`, `std`.
+    - `map`: the mode (maximum a posteriori) the Laplace approximation is centred on.
+    - `diagnostics`: `r_hat` (worst over the parameters; NaN with one chain or for
+      Laplace), `ess` (worst bulk effective sample size), `divergences` (count), with the
+      per-parameter values; see `posterior`.
+    - `log_evidence`: log marginal likelihood of the data (nats), from the Laplace
+      approximation at the mode for both methods (NaN where the mode's Hessian is not
+      negative definite).
+    - `method`: "nuts" or "laplace"; `priors`: `{name: (kind, a, b)}`; `noise`, `nu`;
+      `law_name`, `units`; `z`: the draws in the sampler's unbounded coordinates.
+    - `predict(v0=...)`: bands of e and T at new speeds; `plot(path)`; `summary()`;
+      `to_dict()` and `Posterior.from_dict` (without the forward model).
+    """
+
+    samples: dict
+    z: np.ndarray
+    names: tuple = eqx.field(static=True)
+    free: tuple = eqx.field(static=True)
+    method: str = eqx.field(static=True)
+    law_name: str = eqx.field(static=True)
+    noise: str = eqx.field(static=True)
+    nu: float = eqx.field(static=True)
+    units: dict
+    priors: dict
+    map: dict
+    log_evidence: float
+    diagnostics: dict
+    model: Model | None = None
+
+    # ------------------------------------------------------------------ statistics
+
+    @property
+    def median(self) -> dict:
+        """`{name: median}` (SI)."""
+        return {k: float(np.median(v)) for k, v in self.samples.items()}
+
+    @property
+    def mean(self) -> dict:
+        return {k: float(np.mean(v)) for k, v in self.samples.items()}
+
+    @property
+    def std(self) -> dict:
+        return {k: float(np.std(v)) for k, v in self.samples.items()}
+
+    def interval(self, level: float = 0.9) -> dict:
+        """`{name: (lo, hi)}`: the `(1 - level)/2` and `(1 + level)/2` quantiles of the
+        draws (for 0.9, the 5 and 95 % quantiles)."""
+        if not 0 < level < 1:
+            raise ValueError(f"level must lie in (0, 1), e.g. 0.9, got {level!r}")
+        lo, hi = (1 - level) / 2, (1 + level) / 2
+        return {
+            k: (float(np.quantile(v, lo)), float(np.quantile(v, hi)))
+            for k, v in self.samples.items()
+        }
+
+    @property
+    def num_draws(self) -> int:
+        return int(self.z.shape[0])
+
+    # ------------------------------------------------------------------ predictions
+
+    def predict(self, v0, *, level: float = 0.9, observed: bool = False,
+                max_draws: int = 1000, key=None) -> Bands:  # fmt: skip
+        """Bands of `e` and `T` (s) at the speeds `v0` (m/s): median and the `level`
+        quantile band over the draws (at most `max_draws` of them, evenly thinned), each
+        draw's law solved by the fit's forward model. `observed=True` adds the
+        measurement noise (a band for a new measurement) to the law's band.
+
+        **Example**: `post.predict(v0=[1.0, 2.0, 4.0]).e_hi`."""
+        return prediction_bands(self, v0, level=level, observed=observed,
+                                max_draws=max_draws, key=key)  # fmt: skip
+
+    def plot(self, path=None, *, v0=None, level: float = 0.9):
+        """A pairs plot of the draws (histograms on the diagonal) and, with a forward
+        model, the `level` bands of e and T over the measured data; written to `path`
+        (PNG, PDF, ... by extension) when given. Returns the matplotlib Figure."""
+        from .plots import plot_posterior
+
+        return plot_posterior(self, path, v0=v0, level=level)
+
+    # ------------------------------------------------------------------ text, dicts
+
+    def summary(self) -> str:
+        """Each parameter's median and 90 % interval with its unit and prior, the
+        diagnostics and the evidence."""
+        rows = []
+        intervals = self.interval(0.9)
+        for k in self.names:
+            unit = self.units.get(k, "")
+            lo, hi = intervals[k]
+            kind, a, b = self.priors[k]
+            rows.append((
+                k,
+                f"{format_value(self.median[k], unit)} (90 %: {format_value(lo, unit)} to "
+                f"{format_value(hi, unit)}; prior {kind}({a:.4g}, {b:.4g}))",
+            ))  # fmt: skip
+        d = self.diagnostics
+        if self.method == "nuts":
+            rows.append((
+                "diagnostics",
+                f"r_hat = {d['r_hat']:.4g}, ess = {d['ess']:.0f}, divergences = "
+                f"{d['divergences']} ({d['chains']} chains x {d['draws_per_chain']} draws)",
+            ))  # fmt: skip
+        else:
+            laplace = f"Laplace approximation, {self.num_draws} independent draws"
+            rows.append(("diagnostics", laplace))
+        evidence = f"{format_value(self.log_evidence)} nats (Laplace at the mode)"
+        rows.append(("log_evidence", evidence))
+        noise = "normal" if self.noise == "normal" else f"Student-t (nu = {self.nu:g})"
+        rows.append(("noise", noise))
+        title = f"Posterior of {self.law_name} ({self.method}, {self.num_draws} draws; SI units)"
+        return format_fields(title, rows)
+
+    def to_dict(self, samples: bool = True) -> dict:
+        """JSON-able: `method`, `law`, `names`, `units`, `priors`, `median`, `mean`,
+        `std`, `interval90`, `map`, `diagnostics`, `log_evidence`, `noise`, `nu`, and with
+        `samples` the draws (SI) and `z`."""
+        out = {
+            "method": self.method,
+            "law": self.law_name,
+            "names": list(self.names),
+            "free": list(self.free),
+            "units": dict(self.units),
+            "priors": {k: list(v) for k, v in self.priors.items()},
+            "median": self.median,
+            "mean": self.mean,
+            "std": self.std,
+            "interval90": {k: list(v) for k, v in self.interval(0.9).items()},
+            "map": jsonable(self.map),
+            "diagnostics": jsonable(self.diagnostics),
+            "log_evidence": jsonable(self.log_evidence),
+            "noise": self.noise,
+            "nu": self.nu,
+        }
+        if samples:
+            out["samples"] = jsonable(self.samples)
+            out["z"] = jsonable(self.z)
+        return out
+
+    @classmethod
+    def from_dict(cls, data: dict) -> "Posterior":
+        """A `Posterior` from `to_dict()` (with its samples): statistics, intervals and the
+        pairs plot work; `predict` and `next_measurement` need the forward model, which
+        a dict does not carry (run `posterior` on the fit again)."""
+        if "samples" not in data or "z" not in data:
+            raise ValueError("from_dict needs a dict written by to_dict(samples=True)")
+        samples = {k: np.asarray(v, dtype=float) for k, v in data["samples"].items()}
+        log_evidence = data["log_evidence"]
+        return cls(
+            samples=samples,
+            z=np.asarray(data["z"], dtype=float),
+            names=tuple(data["names"]),
+            free=tuple(data["free"]),
+            method=data["method"],
+            law_name=data["law"],
+            noise=data["noise"],
+            nu=float(data["nu"]),
+            units=dict(data["units"]),
+            priors={k: tuple(v) for k, v in data["priors"].items()},
+            map={k: float(v) for k, v in data["map"].items()},
+            log_evidence=math.nan if log_evidence is None else float(log_evidence),
+            diagnostics=dict(data["diagnostics"]),
+            model=None,
+        )
+
+    def __repr__(self) -> str:
+        return self.summary()
