@@ -24,16 +24,19 @@ from .._checks import check_nonnegative, check_positive, invalid_entries
 from .._choices import unknown_name
 from .._laws import LAW_NAMES, LAWS, AbstractLaw, CustomLaw, custom_law
 from .._laws.named_law import batch_law, invalid_parameter_rows, table_law
-from .._progress import AbstractMeter
 from .._solve.grid import GRID_FIELDS, grid_contact, grid_serves
 from .._solve.impact import check_custom_law, solve_impact
 from .._solve.options import (
+    BATCH_DECIDES,
+    SolveOptions,
     check_choices,
     check_options,
     choose_path,
     make_options,
+    solve_options,
+    with_defaults,
+    with_tolerances,
 )
-from .._solve.precision import resolvable_tolerances
 from .._status import Status
 from .runner import GLOBAL, run_batch
 
@@ -162,6 +165,8 @@ def _fix_shape(skeleton, params):
 _LABELS = {"gravity_table": "integrated", "dry_table": "integrated"}
 # the keywords of `impact` that a batch passes on (beyond separation, method, rtol, peaks)
 IMPACT_OPTIONS = ("solver", "atol", "max_steps", "tau_max", "rest_tol", "adjoint")
+# `run_batch`'s keywords, passed on by `run_impacts`
+_RUN = ("chunk_size", "progress", "devices", "exact")
 
 
 def batch_path(law, separation, *, method="auto", rtol=1e-11, g=0.0, **impact_options) -> str:
@@ -293,67 +298,57 @@ def run_impacts(
     *,
     separation: str = "force",
     method: str = "auto",
-    rtol: float | None = 1e-11,
-    peaks: bool = True,
     fields: tuple = IMPACT_FIELDS,
     order: str = "cost",
-    chunk_size: int | None = None,
-    progress: bool | AbstractMeter = True,
-    devices=None,
-    exact: bool = True,
-    **impact_options,
+    options: SolveOptions | None = None,
+    **keywords,
 ) -> Impacts:
     """The impacts of rows already checked (`prepare_rows`, or a table's row checks): the
     law's structure `skeleton`, its `params` and `kinematics` (`m`, `v0`, `g`) as 1-D
     arrays of one length. No value is checked here; the options are (`impact`'s errors),
-    and the path is chosen once for the batch (`choose_path`). Arguments as in
+    and the path is chosen once for the batch (`choose_path`). `options`: the impacts'
+    `SolveOptions` (`rtol` None: `impact`'s default, 1e-11 or a user's law 1e-12);
+    `keywords`: `run_batch`'s `chunk_size`, `progress`, `devices`, `exact`, and the fields
+    of `options` one by one (`rtol` by default 1e-11, `peaks`, `impact_options`), as in
     `impact_batch`."""
-    unknown = sorted(set(impact_options) - set(IMPACT_OPTIONS))
+    run = {k: keywords.pop(k) for k in _RUN if k in keywords}
+    unknown = sorted(set(keywords) - {"rtol", "peaks", *IMPACT_OPTIONS})
     if unknown:
         raise TypeError(
             f"impact_batch got an unexpected keyword argument {unknown[0]!r}; its options "
             f"for each impact are {', '.join(IMPACT_OPTIONS)} (see jaximpact.impact)"
         )
-    rtol = check_choices(separation, method, rtol, table_law=skeleton[0] == "law")
-    limits = dict(max_steps=4096, tau_max=1e4, rest_tol=1e-7, atol=None)
-    limits.update({k: v for k, v in impact_options.items() if k in limits})
-    check_options(rtol=rtol, **limits)
+    if "rtol" not in keywords and (options is None or options.rtol is None):
+        keywords["rtol"] = 1e-11
+    solve = solve_options("impact_batch", options, refused=BATCH_DECIDES, **keywords)
+    solve = with_defaults(solve, max_steps=4096, tau_max=1e4, rest_tol=1e-7, peaks=True)
+    rtol = check_choices(separation, method, solve.rtol, table_law=skeleton[0] == "law")
+    check_options(rtol=rtol, atol=solve.atol, rest_tol=solve.rest_tol,
+                  max_steps=solve.max_steps, tau_max=solve.tau_max)  # fmt: skip
     skeleton, params = _fix_shape(skeleton, params)
     gravity = not bool(np.all(kinematics["g"] == 0.0))
     rows = {"params": params, "m": kinematics["m"], "v0": kinematics["v0"]}
     if gravity:
         rows["g"] = kinematics["g"]
-    solver = impact_options.get("solver")
+    solver, peaks = solve.solver, solve.peaks
     path, plain = _member_path(skeleton, params, gravity, separation=separation, method=method,
                                solver=solver, rtol=rtol)  # fmt: skip
-    atol = rtol if limits["atol"] is None else limits["atol"]
     # one program over every process's devices pairs the processes' calls: each gives the
     # same rows, which a second pass over each one's own left rows would not
-    spans = isinstance(devices, str) and devices == GLOBAL
+    spans = isinstance(run.get("devices"), str) and run["devices"] == GLOBAL
     grid = not spans and grid_serves(path, plain, method=method, solver=solver, rtol=rtol,
                                      gravity=gravity)  # fmt: skip
-    rtol, atol, rest_tol = resolvable_tolerances(rtol, atol, limits["rest_tol"])
-    options = make_options(
-        path,
-        separation=separation,
-        rtol=rtol,
-        atol=atol,
-        rest_tol=rest_tol,
-        solver=solver,
-        adjoint=impact_options.get("adjoint"),
-        max_steps=limits["max_steps"],
-        tau_max=limits["tau_max"],
-        peaks=peaks,
-        gravity=gravity,
-    )
+    options = make_options(path, with_tolerances(solve, rtol), separation=separation,
+                           gravity=gravity)  # fmt: skip
     computed = tuple(name for name in fields if name != "path")
     try:
         member = _impact_member(skeleton, computed, options, gravity)
     except TypeError:  # an option that cannot be hashed (an array): compiled for this call
         member = _impact_member.__wrapped__(skeleton, computed, options, gravity)
     label = skeleton[1] if skeleton[0] == "law" else "custom law"
+    chunk_size = run.pop("chunk_size", None)
     chunk = (1024 if path.integrates else 65536) if chunk_size is None else chunk_size
-    batch = dict(progress=progress, devices=devices, exact=exact)
+    batch = dict(progress=True, devices=None, exact=True) | run
     name = _LABELS.get(path.name, path.name)
     paths = np.full(rows["m"].shape, name)
     if grid:  # every row on the grid, then the rows it did not serve integrated
@@ -429,28 +424,13 @@ def mark_invalid(out: dict, rows: np.ndarray) -> dict:
 
 
 def impact_batch(
-    law,
-    params: Mapping | None = None,
-    *,
-    m=None,
-    v0=None,
-    g=0.0,
-    separation: str = "force",
-    method: str = "auto",
-    rtol: float = 1e-11,
-    peaks: bool = True,
-    fields: tuple = IMPACT_FIELDS,
-    order: str = "cost",
-    chunk_size: int | None = None,
-    progress: bool | AbstractMeter = True,
-    devices=None,
-    exact: bool = True,
-    invalid: str = "mark",
-    **impact_options,
+    law, params: Mapping | None = None, *, m=None, v0=None, g=0.0, invalid="mark", **keywords
 ) -> dict[str, np.ndarray]:
     """Impacts of many bodies at once, arrays in and arrays out: the computation behind
     `jaximpact.impact_batch` (whose docstring has every argument), without its chunks and
-    files (`_jobs`). Returns a dict of numpy arrays, one value per row."""
+    files (`_jobs`); `keywords`: `run_impacts`' (`separation`, `method`, `fields`, `order`,
+    `options`, `rtol`, `peaks`, `chunk_size`, `progress`, `devices`, `exact`, and the
+    `impact_options`). Returns a dict of numpy arrays, one value per row."""
     if params is not None and not isinstance(params, Mapping):
         raise TypeError(
             "params must be a mapping name -> number or 1-D array; chunks with out= are "
@@ -458,30 +438,16 @@ def impact_batch(
         )
     if m is None or v0 is None:
         raise ValueError("impact_batch needs m= (kg) and v0= (m/s): numbers or 1-D arrays")
+    order = keywords.get("order", "cost")
     if order not in ("cost", "given"):
         raise ValueError(f"order must be 'cost' or 'given', got {order!r}")
-    unknown = sorted(set(fields) - set(_ALL_FIELDS))
+    unknown = sorted(set(keywords.get("fields", IMPACT_FIELDS)) - set(_ALL_FIELDS))
     if unknown:
         raise ValueError(f"unknown fields {unknown}; choose from {_ALL_FIELDS}")
     skeleton, law_params, kinematics, bad = prepare_rows(
         law, params, m=m, v0=v0, g=g, invalid=invalid
     )
-    done = run_impacts(
-        skeleton,
-        law_params,
-        kinematics,
-        separation=separation,
-        method=method,
-        rtol=rtol,
-        peaks=peaks,
-        fields=fields,
-        order=order,
-        chunk_size=chunk_size,
-        progress=progress,
-        devices=devices,
-        exact=exact,
-        **impact_options,
-    )
+    done = run_impacts(skeleton, law_params, kinematics, **keywords)
     lost = done.lost & ~bad
     if lost.any():
         first = int(np.argmax(lost))

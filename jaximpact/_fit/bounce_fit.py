@@ -11,7 +11,7 @@ import numpy as np
 from .._format import format_number, jsonable
 from .._laws import AbstractLaw
 from .._solve.bounce import BounceResult, bounce_options, solve_bounce
-from .._solve.options import default_rtol
+from .._solve.options import SolveOptions
 from .bounce_model import BounceProblem, Stage, round_up
 from .calibrate import law_units
 from .parameters import law_with
@@ -148,9 +148,10 @@ class BounceFit(eqx.Module):
         `height(ts)` gives the fitted motion at any times, in metres)."""
         drag = self.nuisance.get("drag")
         options = bounce_options(
+            self.law,
+            SolveOptions(),
             separation=self.separation,
             max_impacts=max_impacts or round_up(self.num_impacts + 1, 16),
-            rtol=default_rtol(None, table_law=self.law.spec is not None),
         )
         t1, v1 = self.nuisance["t_impact"], self.nuisance["v_impact"]
         if t_end is None:  # just past the last modelled impact

@@ -13,7 +13,6 @@ import optimistix as optx
 from jaxtyping import Array
 
 from .._checks import MemberChecks, check_scale, is_traced
-from .._curves.shapes import curve_key
 from .._curves.similarity import beta_for_restitution, curve_values
 from .._curves.store import curves_for
 from .._format import (
@@ -24,8 +23,17 @@ from .._format import (
     jsonable,
 )
 from .._laws import AbstractLaw, damping_parameter, shape_of
-from .._solve.impact import CURVES_RTOL, ImpactOptions, similarity_reason, solve_impact
-from .._solve.options import is_no_gravity, table_key
+from .._solve.impact import ImpactOptions, solve_impact
+from .._solve.options import (
+    FIT_DECIDES,
+    Path,
+    SolveOptions,
+    choose_path,
+    is_no_gravity,
+    make_options,
+    solve_options,
+    with_defaults,
+)
 from .._status import Status
 from .._xla_log import quietly_compiled
 from .forward_jacobian import value_and_jacobian, with_forward_jacobian
@@ -460,7 +468,8 @@ def _initial_law(law, free, *, m, v0, e, T, separation):
 
 
 def _start_on_curves(law, free, *, m, v0, e, T, has_T, key):
-    """The start read off the curves (inside the compiled fit): `beta` from `e` at the
+    """The start read off the curves (inside the compiled fit; the curves were loaded, or
+    built, by `choose_path` before it was compiled): `beta` from `e` at the
     median speed by inverting `e(beta)`, then `T/t* = tau(beta)` gives `t*` and so the
     stiffness, and `beta` the damping (linear in the damping parameter at fixed `c`). At
     one speed with `e` and `T` this is the fit itself, to the curves' accuracy."""
@@ -487,28 +496,35 @@ def _start_on_curves(law, free, *, m, v0, e, T, has_T, key):
 
 
 def _residual_function(
-    law, free, *, m, separation, g, rtol, has_e, has_T, curves=None, closed_form=False,
-    peaks=False,
+    law, free, *, m, separation, g, rtol, has_e, has_T, curves=None, closed_form=False
 ):  # fmt: skip
-    """Weighted residuals and predictions `(e, T, status)` (with `peaks`, also `x_max`
-    and `F_max`); differentiated in forward mode only (through `with_forward_jacobian`),
-    hence the explicit `ForwardMode` adjoint. With `curves` (a `CurveKey`) every impact
-    is read off the universal curves, with `closed_form` taken from the law's exact
-    solution (Kelvin-Voigt, Bingham, Maxwell): no ODE solve."""
-    options = ImpactOptions(
-        separation=separation,
-        closed_form=closed_form,
-        solver=dfx.Tsit5(),
-        rtol=rtol,
-        atol=rtol,
-        max_steps=4096,
-        tau_max=1e4,
-        rest_tol=1e-9,
-        adjoint=dfx.ForwardMode(),
-        peaks=peaks,
-        similarity=curves,
-        gravity=not is_no_gravity(g),
-    )
+    """`_residuals` with the options of a fit at tolerance `rtol` on the path that `curves`
+    (a `CurveKey`, or a two-group table's key) and `closed_form` name, every other option at
+    `calibrate`'s default (for a caller that rebuilds a fit's forward model by keywords)."""
+    path = Path("closed_form" if closed_form else "integrated", curves)
+    options = _impact_options(path, SolveOptions(rtol=rtol), separation=separation, g=g)
+    return _residuals(law, free, options, m=m, g=g, has_e=has_e, has_T=has_T)
+
+
+def _impact_options(path, solve: SolveOptions, *, separation, g) -> ImpactOptions:
+    """The `ImpactOptions` of a fit's solves on `path`: `solve`'s fields, at `calibrate`'s
+    defaults where None (`atol` = `rtol`, `rest_tol` 1e-9, `diffrax.Tsit5()`), the peaks
+    left out (the final evaluation asks for them) and diffrax's `ForwardMode` (the fit's
+    Jacobian is a forward-mode one, `with_forward_jacobian`)."""
+    solve = with_defaults(
+        solve, atol=solve.rtol, max_steps=4096, tau_max=1e4, rest_tol=1e-9, solver=dfx.Tsit5(),
+        adjoint=dfx.ForwardMode(), peaks=False,
+    )  # fmt: skip
+    return make_options(path, solve, separation=separation, gravity=not is_no_gravity(g))
+
+
+def _residuals(law, free, options: ImpactOptions, *, m, g, has_e, has_T):
+    """Weighted residuals and predictions `(e, T, status)` (with `options.peaks`, also
+    `x_max` and `F_max`) of the impacts of `law` with its `free` parameters at `theta`,
+    solved as `options` say: read off the universal curves (`options.similarity`), taken
+    from the law's exact solution (`options.closed_form`: Kelvin-Voigt, Bingham, Maxwell),
+    or integrated; differentiated in forward mode only (through `with_forward_jacobian`),
+    hence the explicit `ForwardMode` adjoint."""
 
     def residuals(theta, data):
         v0, e, T, s_e, s_T = data
@@ -516,7 +532,7 @@ def _residual_function(
         result = jax.vmap(lambda v: solve_impact(fitted, m, v, g, None, options))(v0)
         parts = []
         predictions = (result.e, result.T, result.status)
-        if peaks:
+        if options.peaks:
             predictions += (result.x_max, result.F_max)
         if has_e:
             parts.append((result.e - e) / s_e)
@@ -601,6 +617,7 @@ def calibrate(
     target_tol: float | None = None,
     rtol: float = 1e-10,
     method: str = "auto",
+    options: SolveOptions | None = None,
 ) -> Fit:
     """Fit `law`'s parameters to a measured restitution `e` and/or contact duration `T` (s).
 
@@ -627,6 +644,12 @@ def calibrate(
       speed with `e` and `T`, that start is the answer), else takes the law's exact
       solution where it has one (Kelvin-Voigt, Bingham 7 and 9 with any `g`, Maxwell at
       `g = 0`); `"similarity"` insists, `"integrate"` solves the ODE for every impact.
+      `choose_path(..., fit=True)` decides it, once, before the fit is compiled.
+    - `options`: a `SolveOptions` for every impact solve, whole: `rtol` (a keyword `rtol`
+      that sets it otherwise is refused), `atol` (default `rtol`), `max_steps`, `tau_max`,
+      `rest_tol` (default 1e-9), `solver` (choosing one integrates); the fit differentiates
+      in forward mode and asks for the peaks itself, so `adjoint`, `peaks` and `throw`
+      stay None.
     A batch of fits (one body per element: its own mass, speeds and targets) is `jax.vmap`
     over a lambda, `jax.jit(jax.vmap(lambda m, e, T: calibrate(start, m=m, v0=v0, e=e, T=T)))`,
     which returns one `Fit` whose fields carry a leading batch axis; a batch runs until its
@@ -678,22 +701,13 @@ def calibrate(
         raise ValueError("free names no parameter to fit")
     g_is_zero = is_no_gravity(g)
     undetermined, undetermined_why = _undetermined(law, free, e=e, T=T, g_is_zero=g_is_zero)
-    curves = None
-    if method in ("auto", "similarity"):
-        reason = similarity_reason(law, separation, g_is_zero=g_is_zero)
-        if reason is None and (method == "similarity" or rtol >= CURVES_RTOL):
-            curves = curve_key(*shape_of(law), separation)
-        elif method == "similarity":
-            raise ValueError(f"method='similarity' cannot serve this fit: {reason}")
-    elif method != "integrate":
-        raise ValueError(f"method must be 'auto', 'similarity' or 'integrate', got {method!r}")
-    if init == "auto" and curves is None:
+    solve = solve_options(calibrate, options, rtol=rtol, refused=FIT_DECIDES)
+    # the path, once: its curves are loaded (or built) now, before the fit is compiled
+    path = choose_path(law, separation=separation, method=method, g=g, solver=solve.solver,
+                       rtol=solve.rtol, fit=True)  # fmt: skip
+    start_on_curves = init == "auto" and path.name == "similarity"
+    if init == "auto" and not start_on_curves:
         law = _initial_law(law, free, m=m, v0=v0, e=e, T=T, separation=separation)
-    # a dry force in both phases (Bingham-modified), an adhesion in contact (DMT): a
-    # two-group table, integrated where a speed falls outside it
-    table = None
-    if curves is None and method == "auto" and rtol >= CURVES_RTOL:
-        table = table_key(law, separation, g_is_zero=g_is_zero)
 
     ones = np.ones(rows)
     s_e = ones if sigma_e is None else sigma_e
@@ -706,21 +720,14 @@ def calibrate(
     target_tol = (3.0 if has_sigma else 1e-6) if target_tol is None else target_tol
     options = _Options(
         free=free,
-        separation=separation,
         optimizer=optimizer,
         max_iter=max_iter,
         tol=tol,
-        rtol=rtol,
         has_e=e is not None,
         has_T=T is not None,
         has_sigma=has_sigma,
-        curves=curves if table is None else table,
-        start_on_curves=init == "auto" and curves is not None,
-        # an exact solution where the law has one (Kelvin-Voigt, Bingham 7 and 9 with any
-        # g, Maxwell without gravity), unless the caller asked for the integration
-        closed_form=curves is None
-        and method == "auto"
-        and law.closed_form(separation, g_is_zero=g_is_zero) is not None,
+        impact=_impact_options(path, solve, separation=separation, g=g),
+        start_on_curves=start_on_curves,
     )
     # g = 0 as a Python number is static to filter_jit (a numpy scalar would be traced):
     # the formulas without gravity are compiled alone
@@ -831,18 +838,36 @@ def _undetermined(law, free, *, e, T, g_is_zero) -> tuple[tuple[str, ...], str]:
 
 
 class _Options(eqx.Module):
+    """What is static about a fit (its `Fit.setup`): the free parameters, the optimiser
+    and its budget, which targets were given, and `impact`, the `ImpactOptions` of its
+    solves (separation, tolerance, the path: `curves`, `closed_form`)."""
+
     free: tuple = eqx.field(static=True)
-    separation: str = eqx.field(static=True)
     optimizer: object = eqx.field(static=True)
     max_iter: int = eqx.field(static=True)
     tol: float = eqx.field(static=True)
-    rtol: float = eqx.field(static=True)
     has_e: bool = eqx.field(static=True)
     has_T: bool = eqx.field(static=True)
     has_sigma: bool = eqx.field(static=True)
-    curves: object = eqx.field(static=True, default=None)
+    impact: ImpactOptions
     start_on_curves: bool = eqx.field(static=True, default=False)
-    closed_form: bool = eqx.field(static=True, default=False)
+
+    @property
+    def separation(self) -> str:
+        return self.impact.separation
+
+    @property
+    def rtol(self) -> float:
+        return self.impact.rtol
+
+    @property
+    def curves(self):
+        """The universal curves' `CurveKey`, or a two-group table's key, or None."""
+        return self.impact.similarity
+
+    @property
+    def closed_form(self) -> bool:
+        return self.impact.closed_form
 
 
 @eqx.filter_jit
@@ -855,18 +880,8 @@ def _fit(law, data, m, g, target_tol, options):
         law = _start_on_curves(
             law, free, m=m, v0=v0, e=e, T=T, has_T=options.has_T, key=options.curves
         )
-    raw = _residual_function(
-        law,
-        free,
-        m=m,
-        separation=options.separation,
-        g=g,
-        rtol=options.rtol,
-        has_e=options.has_e,
-        has_T=options.has_T,
-        curves=options.curves,
-        closed_form=options.closed_form,
-    )
+    targets = dict(m=m, g=g, has_e=options.has_e, has_T=options.has_T)
+    raw = _residuals(law, free, options.impact, **targets)
     # one traced copy of the residuals and of their Jacobian, shared by every call site
     raw = jax.jit(raw)
     jacobian_fn = jax.jit(lambda theta, data: value_and_jacobian(raw, theta, data))
@@ -903,10 +918,7 @@ def _fit(law, data, m, g, target_tol, options):
         )
     # the final point once more, with the peaks (x_max, F_max: the sanity echo); on the
     # curves they cost nothing, an integrated law adds their events to this one solve
-    final = _residual_function(law, free, m=m, separation=options.separation, g=g,
-                               rtol=options.rtol, has_e=options.has_e, has_T=options.has_T,
-                               curves=options.curves, closed_form=options.closed_form,
-                               peaks=True)  # fmt: skip
+    final = _residuals(law, free, dataclasses.replace(options.impact, peaks=True), **targets)
     r, (e_fit, T_fit, status, x_max, F_max) = final(theta, data)
     (_, _), jacobian = jacobian_fn(theta, data)
     final_loss = 0.5 * jnp.sum(r**2)

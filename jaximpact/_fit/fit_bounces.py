@@ -33,7 +33,7 @@ import numpy as np
 
 from .._laws import AbstractLaw
 from .._solve.bounce import bounce_options
-from .._solve.options import default_rtol
+from .._solve.options import FIT_DECIDES, SolveOptions, solve_options
 from .._xla_log import quietly_compiled
 from .bounce_fit import BounceFit, Measurements, find_outliers, finish
 from .bounce_model import (
@@ -163,6 +163,7 @@ def fit_bounces(
     tol: float = 1e-10,
     rtol: float | None = None,
     max_steps: int = 4096,
+    options: SolveOptions | None = None,
 ) -> BounceFit:
     """Fit `law` to a bouncing ball of mass `m` (kg): a sampled trajectory `(t, y)` or the
     instants of its impacts `impact_times` (s, e.g. from a microphone).
@@ -191,6 +192,10 @@ def fit_bounces(
       estimated from the residuals.
     - `rtol`, `max_steps`: each contact's solve (`rtol` as `bounce`'s: by default 1e-11
       for a law of the table, 1e-12 for a user's law); `max_iter`, `tol`: the optimiser.
+    - `options`: a `SolveOptions` for each contact's solve, whole: `rtol`, `max_steps` (a
+      keyword that sets one of them otherwise is refused), `atol`, `tau_max`, `rest_tol`,
+      `solver` (as `bounce`'s); the fit differentiates in forward mode and leaves out the
+      peaks, so `adjoint`, `peaks` and `throw` stay None.
     Eager (it sorts data and chooses the model's size), with a compiled core: the chain
     and its forward-mode Jacobian, compiled once per law, data kind and size bucket.
 
@@ -210,7 +215,7 @@ def fit_bounces(
         options = dict(
             m=m, free=free, g=g, separation=separation, drag=drag, fit_drag=fit_drag,
             sigma=sigma, clean_tol=clean_tol, outlier_sigma=outlier_sigma, max_iter=max_iter,
-            tol=tol, rtol=rtol, max_steps=max_steps,
+            tol=tol, rtol=rtol, max_steps=max_steps, options=options,
         )  # fmt: skip
         for i, times in enumerate(impact_times):  # every drop checked before any is fitted
             try:
@@ -244,14 +249,10 @@ def fit_bounces(
             f"cannot fit {', '.join(unknown)}: the law's parameters are {', '.join(law.parameters)}"
         )
     kind = "impacts" if impact_times is not None else "trajectory"
-    options = bounce_options(
-        separation=separation,
-        max_impacts=8,
-        rtol=default_rtol(rtol, table_law=law.spec is not None),
-        max_steps=max_steps,
-        adjoint=dfx.ForwardMode(),
-        peaks=False,
-    )
+    solve = solve_options(fit_bounces, options, rtol=rtol, max_steps=max_steps,
+                          refused=FIT_DECIDES)  # fmt: skip
+    solve = dataclasses.replace(solve, adjoint=dfx.ForwardMode(), peaks=False)
+    options = bounce_options(law, solve, separation=separation, max_impacts=8)
     problem = BounceProblem(
         law=law,
         free=free,

@@ -5,9 +5,10 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from .._batch import IMPACT_FIELDS, impacts
+from .._batch import IMPACT_FIELDS, IMPACT_OPTIONS, impacts
 from .._laws import AbstractLaw
 from .._progress import AbstractMeter
+from .._solve.options import BATCH_DECIDES, SolveOptions, solve_options
 from .job import BatchFile, batch_file
 
 
@@ -30,6 +31,7 @@ def impact_batch(
     exact: bool = True,
     invalid: str = "mark",
     out=None,
+    options: SolveOptions | None = None,
     **impact_options,
 ) -> dict[str, np.ndarray] | BatchFile:
     """Impacts of many bodies at once: `impact` over a batch, in chunks, on all local devices.
@@ -58,6 +60,10 @@ def impact_batch(
       `progress`, `devices`, `exact`: as
       in `run_batch`.
 
+    - `options`: a `SolveOptions` holding `rtol`, `peaks` and any of `impact_options` as
+      one record (`throw` stays None: a batch reports each row's status); a keyword that
+      sets one of them to another value than the record does is refused (`ValueError`).
+
     - `invalid`: what a row with invalid inputs (NaN, infinite, a mass, speed or stiffness
       <= 0, a negative damping) does: `"mark"` (default) gives it status `Status.invalid`
       and NaN results, with a warning, while the other rows run; `"raise"` refuses the
@@ -81,26 +87,23 @@ def impact_batch(
     out["e"], out["T"]
     ```
     """
+    if options is not None:  # the record whole, each of its fields given once
+        given = {k: impact_options.pop(k) for k in IMPACT_OPTIONS if k in impact_options}
+        options = solve_options(impact_batch, options, refused=BATCH_DECIDES, rtol=rtol,
+                                peaks=peaks, **given)  # fmt: skip
     if out is None and (params is None or isinstance(params, Mapping)):
-        return impacts.impact_batch(
-            law,
-            params,
-            m=m,
-            v0=v0,
-            g=g,
-            separation=separation,
-            method=method,
-            rtol=1e-11 if rtol is None else rtol,
-            peaks=peaks,
-            fields=fields,
-            order=order,
-            chunk_size=chunk_size,
-            progress=progress,
-            devices=devices,
-            exact=exact,
-            invalid=invalid,
-            **impact_options,
-        )
+        settings = dict(m=m, v0=v0, g=g, separation=separation, method=method, fields=fields,
+                        order=order, chunk_size=chunk_size, progress=progress,
+                        devices=devices, exact=exact, invalid=invalid)  # fmt: skip
+        if options is not None:
+            return impacts.impact_batch(law, params, **settings, options=options,
+                                        **impact_options)  # fmt: skip
+        return impacts.impact_batch(law, params, **settings, rtol=1e-11 if rtol is None else rtol,
+                                    peaks=peaks, **impact_options)  # fmt: skip
+    if options is not None:  # a file's options are keywords (its resume key)
+        rtol = options.rtol
+        given = {k: getattr(options, k) for k in IMPACT_OPTIONS}
+        impact_options.update({k: v for k, v in given.items() if v is not None})
     if not isinstance(law, (str, AbstractLaw)):
         raise ValueError(
             "impact_batch with chunks and out= takes a law name (see LAW_NAMES), a law from "

@@ -24,17 +24,21 @@ import numpy as np
 from jaxtyping import Array
 
 from .._checks import MemberChecks, is_traced
-from .._curves.gravity import WithGravity
-from .._curves.shapes import curve_key
 from .._format import format_fields, format_value, jsonable
-from .._laws import AbstractLaw, shape_of
+from .._laws import AbstractLaw
 from .._status import Status
 from .adjoint import auto_adjoint, reverse_only, through_forward_jacobian
 from .flight import Flight
-from .impact import CURVES_RTOL, SEPARATIONS, ImpactOptions, gravity_impact, similarity_reason
-from .options import adhesion_table_key, default_rtol
+from .impact import SEPARATIONS, ImpactOptions, gravity_impact
+from .options import (
+    SolveOptions,
+    choose_path,
+    default_rtol,
+    solve_options,
+    with_defaults,
+    with_tolerances,
+)
 from .phases import integrated_contact
-from .precision import resolvable_tolerances
 from .results import ImpactResult, status_names, status_text
 
 
@@ -76,33 +80,16 @@ class BounceOptions(eqx.Module):
     max_impacts: int = eqx.field(static=True)
 
 
-def _gravity_key(law, options: ImpactOptions):
-    """The two-group table's key where `impact(..., g=g)` would read it (a one-group law of
-    the table with a shipped gravity table, `rtol >= CURVES_RTOL`, the default solver
-    Tsit5, and not `method="integrate"`), else `None` (static)."""
-    if not options.closed_form:
-        return None
-    if options.rtol < CURVES_RTOL or type(options.solver) is not dfx.Tsit5:
-        return None
-    adhesion = adhesion_table_key(law)  # DMT: its adhesion pulls in as gravity does
-    if adhesion is not None:
-        return adhesion
-    reason = similarity_reason(law, options.separation, g_is_zero=False, gravity_table=True)
-    if reason is not None:
-        return None
-    return WithGravity(curve_key(*shape_of(law), options.separation))
-
-
 def _contact(law, m, v_in, g, ts_local, options: ImpactOptions, active=True):
     """One contact at impact speed `v_in` with gravity `g`: the `ImpactResult`, the
     penetration at separation (m; > 0 when the force criterion ends contact inside the
     surface), and, with `ts_local` (s from first touch), the histories on that grid.
-    Without histories a law whose exact solution holds under gravity (its row's
-    `closed_form_gravity`: Kelvin-Voigt, Bingham 7 and 9, Maxwell) takes it, as `impact`
-    does, unless `options.closed_form` is off (`bounce(..., method="integrate")`), and
-    only where the contact is `active` (zeros elsewhere: a contact after the end of the
-    drop costs nothing, but under `vmap`); else a contact whose `(beta, gamma)` the
-    gravity table holds is read off it (`gravity_impact`); the others are integrated."""
+    Without histories, on the path `choose_path` decided (`bounce_options`): the law's
+    exact solution under gravity where `options.closed_form` (Kelvin-Voigt, Bingham 7 and
+    9, Maxwell), only where the contact is `active` (zeros elsewhere: a contact after the
+    end of the drop costs nothing, but under `vmap`); the gravity table where
+    `options.similarity` names one, for a contact whose `(beta, gamma)` it holds
+    (`gravity_impact`); the others, and every contact with histories, integrated."""
     closed = None
     if ts_local is None and options.closed_form:
         closed = law.closed_form(options.separation, g_is_zero=False)
@@ -125,9 +112,8 @@ def _contact(law, m, v_in, g, ts_local, options: ImpactOptions, active=True):
         x_end = fields.pop("x_end")
         return ImpactResult(**fields, path="closed_form"), x_end
     dynamics = law.dynamics(m=m, v0=v_in, g=g)
-    key = None if ts_local is not None else _gravity_key(law, options)
-    if key is not None:
-        return gravity_impact(dynamics, m, v_in, g, dataclasses.replace(options, similarity=key))
+    if ts_local is None and options.similarity is not None:
+        return gravity_impact(dynamics, m, v_in, g, options)
     tau_grid = None if ts_local is None else ts_local / dynamics.t_star
     return integrated_contact(dynamics, options, m=m, v0=v_in, g=g, tau_grid=tau_grid)
 
@@ -527,56 +513,57 @@ def _check_tolerance(name, value, below_one=False):
         raise ValueError(f"{name} must be {limit.format(name=name)}, got {value!r}")
 
 
+# a drop's contacts always have gravity (`bounce` refuses g <= 0): what `choose_path` is told
+_GRAVITY = 1.0
+
+
 def bounce_options(
-    *,
-    separation="force",
-    max_impacts=64,
-    solver=None,
-    rtol=1e-10,
-    atol=None,
-    max_steps=4096,
-    tau_max=1e4,
-    rest_tol=1e-9,
-    adjoint=None,
-    peaks=True,
-    method="auto",
+    law, solve: SolveOptions, *, separation="force", max_impacts=64, method="auto"
 ) -> BounceOptions:
-    """The static options of a bounce (see `bounce`); `adjoint` defaults to diffrax's
-    `RecursiveCheckpointAdjoint`."""
+    """The static options of a bounce of `law` (see `bounce`) from its `solve` options,
+    whose `None` fields take `bounce`'s defaults (`rtol` by `default_rtol`, `rest_tol`
+    1e-9; `adjoint` diffrax's `RecursiveCheckpointAdjoint`), and the path of its contacts,
+    which `choose_path` decides (with gravity; `method="integrate"` integrates them)."""
+    solve = with_defaults(solve, max_steps=4096, tau_max=1e4, rest_tol=1e-9, peaks=True)
+    rtol = default_rtol(solve.rtol, table_law=law.spec is not None)
     if separation not in SEPARATIONS:
         raise ValueError(f"separation must be one of {SEPARATIONS}, got {separation!r}")
     if method not in BOUNCE_METHODS:
         raise ValueError(f"method must be one of {BOUNCE_METHODS}, got {method!r}")
     _check_count("max_impacts", max_impacts)
-    _check_count("max_steps", max_steps)
+    _check_count("max_steps", solve.max_steps)
     _check_tolerance("rtol", rtol, below_one=True)
-    if atol is not None:
-        _check_tolerance("atol", atol)
-    _check_tolerance("rest_tol", rest_tol, below_one=True)
-    _check_tolerance("tau_max", tau_max)
-    if not isinstance(peaks, (bool, np.bool_)):
-        raise TypeError(f"peaks must be True or False, got {peaks!r}")
+    if solve.atol is not None:
+        _check_tolerance("atol", solve.atol)
+    _check_tolerance("rest_tol", solve.rest_tol, below_one=True)
+    _check_tolerance("tau_max", solve.tau_max)
+    if not isinstance(solve.peaks, (bool, np.bool_)):
+        raise TypeError(f"peaks must be True or False, got {solve.peaks!r}")
+    solver, adjoint = solve.solver, solve.adjoint
     if solver is not None and not isinstance(solver, dfx.AbstractSolver):
         raise TypeError(f"solver must be a diffrax solver such as diffrax.Tsit5(), got {solver!r}")
     if adjoint is not None and not isinstance(adjoint, dfx.AbstractAdjoint):
         raise TypeError(
             f"adjoint must be a diffrax adjoint such as diffrax.ForwardMode(), got {adjoint!r}"
         )
-    rtol, atol, rest_tol = resolvable_tolerances(rtol, rtol if atol is None else atol, rest_tol)
+    solve = with_tolerances(solve, rtol)
+    # Tsit5 given is the default solver here: the gravity table still serves
+    default = solver is None or type(solver) is dfx.Tsit5
+    path = choose_path(law, separation=separation, method=method, g=_GRAVITY,
+                       solver=None if default else solver, rtol=solve.rtol)  # fmt: skip
     return BounceOptions(
         impact=ImpactOptions(
             separation=separation,
-            # a bounce takes each contact's exact solution (or the gravity table) where
-            # its law has one, unless told to integrate
-            closed_form=method == "auto",
+            closed_form=path.name == "closed_form",
             solver=dfx.Tsit5() if solver is None else solver,
-            rtol=rtol,
-            atol=atol,
-            max_steps=max_steps,
-            tau_max=tau_max,
-            rest_tol=rest_tol,
+            rtol=solve.rtol,
+            atol=solve.atol,
+            max_steps=solve.max_steps,
+            tau_max=solve.tau_max,
+            rest_tol=solve.rest_tol,
             adjoint=dfx.RecursiveCheckpointAdjoint() if adjoint is None else adjoint,
-            peaks=peaks,
+            peaks=solve.peaks,
+            similarity=path.key,  # the gravity table (`WithGravity`), or None
         ),
         max_impacts=int(max_impacts),
     )
@@ -604,6 +591,7 @@ def bounce(
     peaks: bool = True,
     method: str = "auto",
     throw: bool = False,
+    options: SolveOptions | None = None,
 ) -> BounceResult:
     """A ball of mass `m` (kg) released at height `h0` (m) above a floor at `t = 0`, with
     downward speed `v_drop` (m/s; 0: dropped from rest), bouncing until `t_end` (s).
@@ -625,8 +613,8 @@ def bounce(
       (with a speed-independent restitution the bounces accumulate in finite time).
     - `solver`, `rtol`, `atol`, `max_steps`, `tau_max`, `rest_tol`, `peaks`: each contact's
       solve, as in `impact` (`rtol` by default 1e-11 for a law of the table, 1e-12 for a
-      user's law: each contact's e, T and x_max within 1e-9; `peaks=False` leaves `F_max` and `x_max` out and integrates each
-      contact in one phase; the histories always use the three phases, so they then agree
+      user's law: each contact's e, T and x_max within 1e-9; `peaks=False` leaves `F_max`
+      and `x_max` out and integrates each contact in one phase; the histories always use the three phases, so they then agree
       with the per-contact arrays to the solver's tolerance rather than exactly); `adjoint`:
       default picks the cheapest diffrax adjoint for the transformation in use
       (`ForwardMode` under `jax.jacfwd`). Tolerances must lie in (0, 1), `tau_max` be > 0,
@@ -640,6 +628,10 @@ def bounce(
     - `throw`: raise if the sequence failed or ran out of `max_impacts`; by default an
       eager call whose sequence failed (a contact's solve ran out of steps or failed) warns,
       and keeps the contacts before the failed one (the failed one's fields are NaN).
+    - `options`: a `SolveOptions` holding any of `solver`, `rtol`, `atol`, `max_steps`,
+      `tau_max`, `rest_tol`, `adjoint`, `peaks`, `throw` as one record (its `None` fields
+      take the defaults above); a keyword that sets one of them to another value than the
+      record does is refused (`ValueError`).
     Differentiable (forward and reverse mode) in the law's parameters, `m`, `h0`, `v_drop`,
     `g` and `drag`; works under `jax.vmap`. Under `jax.grad` alone (no `adjoint` given) the
     sequence's forward-mode Jacobian is transposed (`impact`'s rule).
@@ -691,24 +683,18 @@ def bounce(
             raise ValueError(message)
     else:
         h0 = checks.mark(resting, h0, 1.0)
+    solve = solve_options(
+        bounce, options, solver=solver, rtol=rtol, atol=atol, max_steps=max_steps,
+        tau_max=tau_max, rest_tol=rest_tol, adjoint=adjoint, peaks=peaks, throw=throw,
+    )  # fmt: skip
     # jax.grad alone: the forward-mode Jacobian, transposed (`adjoint.by_forward_jacobian`)
-    by_forward = adjoint is None and reverse_only(law, m, h0, v_drop, g, drag, t_end)
+    by_forward = solve.adjoint is None and reverse_only(law, m, h0, v_drop, g, drag, t_end)
     if by_forward:
-        adjoint = dfx.ForwardMode()
-    elif adjoint is None:
-        adjoint = auto_adjoint(law, m, h0, v_drop, g, drag, t_end)
+        solve = dataclasses.replace(solve, adjoint=dfx.ForwardMode())
+    elif solve.adjoint is None:
+        solve = dataclasses.replace(solve, adjoint=auto_adjoint(law, m, h0, v_drop, g, drag, t_end))
     options = bounce_options(
-        separation=separation,
-        max_impacts=max_impacts,
-        solver=solver,
-        rtol=default_rtol(rtol, table_law=law.spec is not None),
-        atol=atol,
-        max_steps=max_steps,
-        tau_max=tau_max,
-        rest_tol=rest_tol,
-        adjoint=adjoint,
-        peaks=peaks,
-        method=method,
+        law, solve, separation=separation, max_impacts=max_impacts, method=method
     )
     start = (jnp.zeros(()), h0, -v_drop)
     if by_forward:
@@ -722,7 +708,7 @@ def bounce(
     result = checks.refuse(
         result, keep=_INPUTS, status=BounceStatus.invalid, num_impacts=0, contact_status=-1
     )
-    if throw:
+    if solve.throw:
         result = eqx.error_if(
             result,
             (result.status == BounceStatus.failed) | (result.status == BounceStatus.max_impacts),
@@ -734,7 +720,7 @@ def bounce(
             # failed contact and those after it NaN (the failure rule, `Status`)
             warnings.warn(
                 f"the bounce sequence failed at contact {int(result.num_impacts)}: its solve "
-                f"ran out of steps (max_steps={max_steps}) or failed; the contacts before it "
+                f"ran out of steps (max_steps={solve.max_steps}) or failed; the contacts before it "
                 "are right, the rest NaN (raise max_steps or loosen rtol; throw=True raises)",
                 stacklevel=2,
             )

@@ -17,17 +17,18 @@ from .._curves.similarity import similarity_fields
 from .._laws import AbstractLaw
 from .._status import Status
 from .options import (
-    CURVES_RTOL as CURVES_RTOL,
     SEPARATIONS as SEPARATIONS,
     ImpactOptions as ImpactOptions,
+    SolveOptions,
     check_choices,
     check_options,
     choose_path,
     is_no_gravity,
     make_options,
     similarity_reason as similarity_reason,
+    solve_options,
+    with_tolerances,
 )
-from .precision import resolvable_tolerances
 from .results import ImpactResult
 
 
@@ -225,6 +226,7 @@ def impact(
     adjoint=None,
     peaks: bool = True,
     throw: bool | None = None,
+    options: SolveOptions | None = None,
 ) -> ImpactResult:
     """One impact of a body of mass `m` (kg) hitting the surface at speed `v0` (m/s).
 
@@ -267,6 +269,10 @@ def impact(
       NaN in every result field and its status says why. `True`: raise for any ending
       but `separated` (stuck and captured too; `eqx.error_if`, so also under `jit`).
       `False`: never raise (a failed result is NaN with its status).
+    - `options`: a `SolveOptions` holding any of `solver`, `rtol`, `atol`, `max_steps`,
+      `tau_max`, `rest_tol`, `adjoint`, `peaks`, `throw` as one record (its `None` fields
+      take the defaults above); a keyword that sets one of them to another value than the
+      record does is refused (`ValueError`).
     - Bad values (`m` or `v0` not > 0, `g` < 0, not finite): an eager call raises a one-line
       `ValueError`; under `jit`, `vmap` or `grad` that member has NaN in every result field
       (and its derivatives) and status `invalid`, and the other members are computed.
@@ -279,8 +285,13 @@ def impact(
             f"impact needs a law from jaximpact.law(...) or jaximpact.custom_law(...), "
             f"got {type(law).__name__}"
         )
-    rtol = check_choices(separation, method, rtol, table_law=law.spec is not None)
-    check_options(rtol=rtol, atol=atol, rest_tol=rest_tol, max_steps=max_steps, tau_max=tau_max)
+    solve = solve_options(
+        impact, options, solver=solver, rtol=rtol, atol=atol, max_steps=max_steps,
+        tau_max=tau_max, rest_tol=rest_tol, adjoint=adjoint, peaks=peaks, throw=throw,
+    )  # fmt: skip
+    rtol = check_choices(separation, method, solve.rtol, table_law=law.spec is not None)
+    check_options(rtol=rtol, atol=solve.atol, rest_tol=solve.rest_tol,
+                  max_steps=solve.max_steps, tau_max=solve.tau_max)  # fmt: skip
     # eager: a one-line ValueError; traced: a bad member is NaN and invalid (`MemberChecks`)
     checks = MemberChecks()
     # 1e-300 kg is refused as 1e300 kg is: the contact's scales would under- or overflow
@@ -293,30 +304,22 @@ def impact(
     if jnp.ndim(m) or jnp.ndim(v0) or jnp.ndim(g):
         raise ValueError("impact takes scalar m, v0 and g; use jax.vmap for a batch")
     path = choose_path(
-        law, separation=separation, method=method, g=given_g, ts=ts, solver=solver, rtol=rtol
+        law, separation=separation, method=method, g=given_g, ts=ts, solver=solve.solver, rtol=rtol
     )
     check_custom_law(law, v0)
     if ts is not None:
         ts = jnp.asarray(ts, dtype=float)
         if ts.ndim != 1:
             raise ValueError("ts must be a 1-D array of times in seconds")
-    rtol, atol, rest_tol = resolvable_tolerances(rtol, rtol if atol is None else atol, rest_tol)
     options = make_options(
         path,
+        with_tolerances(solve, rtol),
         separation=separation,
-        rtol=rtol,
-        atol=atol,
-        rest_tol=rest_tol,
-        solver=solver,
-        adjoint=adjoint,
-        max_steps=max_steps,
-        tau_max=tau_max,
-        peaks=peaks,
         inputs=(law, m, v0, g, ts),
         gravity=not is_no_gravity(given_g),
     )
     result = None
-    if path.integrates and adjoint is None:  # diffrax is imported there (`make_options`)
+    if path.integrates and solve.adjoint is None:  # diffrax is imported there (`make_options`)
         import diffrax as dfx
 
         from .adjoint import reverse_only, through_forward_jacobian
@@ -336,11 +339,11 @@ def impact(
         if int(result.num_steps) > 0:  # outside the table: integrated, and said so
             fields = {f.name: getattr(result, f.name) for f in dataclasses.fields(result)}
             result = ImpactResult(**{**fields, "path": "integrated"})
-    if throw is not False:
-        raise_if_failed(result, max_steps=max_steps, rtol=rtol)
+    if solve.throw is not False:
+        raise_if_failed(result, max_steps=solve.max_steps, rtol=options.rtol)
     _check_representable(result, m, v0, g)
     _warn_if_energy_gained(law, result, m, v0)
-    if throw:
+    if solve.throw:
         result = eqx.error_if(
             result,
             result.status != Status.separated,

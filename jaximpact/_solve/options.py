@@ -1,8 +1,14 @@
-"""What is static about an impact solve (`ImpactOptions`), and the one decision of how an
-impact is computed (`choose_path`): the law's exact closed form, the universal curves, the
-two-group gravity table (integrated where it ends), or the integration. `impact` and
-`impact_batch` both ask `choose_path`, once per call (a batch: once for all its rows)."""
+"""The options a user gives a solve (`SolveOptions`, one record accepted whole by `impact`,
+`impact_batch`, `bounce`, `calibrate` and `fit_bounces`), what is static about a compiled
+impact solve (`ImpactOptions`), and the one decision of how an impact is computed
+(`choose_path`): the law's exact closed form, the universal curves, the two-group gravity
+table (integrated where it ends), or the integration. `impact`, `impact_batch`, `bounce`
+(and `fit_bounces`) and `calibrate` all ask `choose_path`, once per call (a batch: once for
+all its rows)."""
 
+import dataclasses
+import functools
+import inspect
 import math
 from typing import NamedTuple
 
@@ -12,7 +18,9 @@ from .._checks import is_traced
 from .._curves.gravity import WithDryForce, WithGravity, table_for
 from .._curves.shapes import CurveKey, curve_key
 from .._curves.similarity import serves
+from .._curves.store import curves_for
 from .._laws import shape_of
+from .precision import resolvable_tolerances
 
 SEPARATIONS = ("force", "penetration")
 METHODS = ("auto", "integrate", "closed_form", "similarity")
@@ -26,11 +34,143 @@ DEFAULT_RTOL = 1e-11
 CUSTOM_RTOL = 1e-12
 
 
+class SolveOptions(eqx.Module):
+    """How an impact is solved, as one record: what `impact`, `impact_batch`, `bounce`,
+    `calibrate` and `fit_bounces` take whole as `options=`, beside their keywords of the
+    same names (as diffrax takes a `stepsize_controller`). Every field left `None` is the
+    entry point's own default (the defaults stay those of its keywords); a keyword given
+    with `options=` that sets the same field to another value is refused (`ValueError`).
+    The fields are static: one compiled program per distinct record, and a record closed
+    over or passed through `jax.jit` and `jax.vmap` is configuration, not data.
+
+    - `rtol`, `atol` (dimensionless): tolerances of the integration in the contact's own
+      units (`x* = (m v0^2/c)^(1/(n+1))` m, `t* = x*/v0` s), so relative to the contact's
+      scales; default `rtol` 1e-11 for a law of the table and 1e-12 for a user's law
+      (`impact`, `bounce`, `fit_bounces`), 1e-10 (`calibrate`), 1e-11 (`impact_batch`
+      of arrays); `atol` defaults to `rtol`. Both in (0, 1).
+    - `max_steps` (integer >= 1, default 4096): the integrator's step budget per phase.
+    - `tau_max` (units of `t*`, default 1e4): the horizon; a contact still going on there is
+      `captured`.
+    - `rest_tol` (dimensionless, default 1e-7 for `impact`, 1e-9 for `bounce` and the
+      fits): a body whose speed (units of `v0`) plus net force (units of `m v0^2/x*`)
+      falls below it is at rest.
+    - `solver`: a diffrax solver (default `diffrax.Tsit5()`; choosing one integrates
+      instead of reading the universal curves).
+    - `adjoint`: a diffrax adjoint (default: the cheapest for the transformation in use;
+      the fits differentiate in forward mode and take none).
+    - `peaks` (bool, default True): find `x_max`, `t_max`, `F_max` (the fits choose this
+      themselves and take none).
+    - `throw` (bool or None): what a solve that did not separate does, as `impact`'s and
+      `bounce`'s `throw` (`impact_batch` and the fits report a status and take none).
+
+    **Example**:
+    ```python
+    options = jaximpact.SolveOptions(rtol=1e-12, max_steps=16384)
+    jaximpact.impact(law, m=1.0, v0=2.5, options=options)   # as rtol=1e-12, max_steps=16384
+    jax.vmap(lambda v: jaximpact.impact(law, m=1.0, v0=v, options=options).e)(speeds)
+    ```
+    """
+
+    rtol: float | None = eqx.field(static=True, default=None)
+    atol: float | None = eqx.field(static=True, default=None)
+    max_steps: int | None = eqx.field(static=True, default=None)
+    tau_max: float | None = eqx.field(static=True, default=None)
+    rest_tol: float | None = eqx.field(static=True, default=None)
+    solver: object = eqx.field(static=True, default=None)  # a diffrax solver
+    adjoint: object = eqx.field(static=True, default=None)  # a diffrax adjoint
+    peaks: bool | None = eqx.field(static=True, default=None)
+    throw: bool | None = eqx.field(static=True, default=None)
+
+
+SOLVE_FIELDS = tuple(f.name for f in dataclasses.fields(SolveOptions))
+# the options an entry point decides itself, and why (`solve_options(refused=...)`)
+FIT_DECIDES = {
+    "adjoint": "a fit differentiates its solves in forward mode",
+    "peaks": "a fit asks for them where it needs them",
+    "throw": "a fit reports its solves in converged",
+}
+BATCH_DECIDES = {"throw": "a batch reports each row's status"}
+
+
+@functools.cache
+def _keyword_defaults(entry) -> dict:
+    """The defaults of `entry`'s keywords (read once per function)."""
+    return {
+        name: p.default
+        for name, p in inspect.signature(entry).parameters.items()
+        if p.default is not inspect.Parameter.empty
+    }
+
+
+def _same(a, b) -> bool:
+    if a is b:
+        return True
+    try:
+        return bool(a == b)
+    except Exception:  # an array, a value that cannot be compared: not the same
+        return False
+
+
+def solve_options(entry, options, *, refused: dict | None = None, **given) -> SolveOptions:
+    """The `SolveOptions` of a call of `entry` (the public function, or its name where every
+    keyword in `given` was passed by the caller): its keywords `given` (by name, as the call
+    received them) with the record `options`. A keyword left at its default gives way to
+    the record's value; a keyword given another value where the record sets a third is
+    refused in one line (`ValueError`), as is a field of `refused` (field -> why) that the
+    record sets (an option `entry` decides itself). Fields neither given nor set stay
+    `None` (the entry point's default)."""
+    if options is None:
+        return SolveOptions(**given)
+    name = entry if isinstance(entry, str) else entry.__name__
+    if not isinstance(options, SolveOptions):
+        raise TypeError(
+            f"{name}'s options must be a jaximpact.SolveOptions, got {type(options).__name__}"
+        )
+    for field, why in (refused or {}).items():
+        if getattr(options, field) is not None:
+            raise ValueError(
+                f"{name} takes no {field} (options.{field}={getattr(options, field)!r}: "
+                f"{why}); leave it None"
+            )
+    defaults = {} if isinstance(entry, str) else _keyword_defaults(entry)
+    merged = {}
+    for field in SOLVE_FIELDS:
+        held = getattr(options, field)
+        if field not in given:
+            merged[field] = held
+            continue
+        value = given[field]
+        if held is None or _same(value, held) or _same(value, defaults.get(field)):
+            merged[field] = value if held is None else held
+            continue
+        raise ValueError(
+            f"{name} got {field}={value!r} and options.{field}={held!r}: give {field} once "
+            "(as a keyword or in options)"
+        )
+    return SolveOptions(**merged)
+
+
+def with_defaults(solve: SolveOptions, **defaults) -> SolveOptions:
+    """`solve` with each field named in `defaults` that is None set to its default (the
+    defaults of an entry point whose record fields are not all keywords of it)."""
+    unset = {k: v for k, v in defaults.items() if getattr(solve, k) is None}
+    return dataclasses.replace(solve, **unset) if unset else solve
+
+
+def with_tolerances(solve: SolveOptions, rtol: float) -> SolveOptions:
+    """`solve` with `rtol` (its default resolved), `atol` (default `rtol`) and `rest_tol`
+    as the working precision can meet them (`precision.resolvable_tolerances`)."""
+    atol = rtol if solve.atol is None else solve.atol
+    rtol, atol, rest_tol = resolvable_tolerances(rtol, atol, solve.rest_tol)
+    return dataclasses.replace(solve, rtol=rtol, atol=atol, rest_tol=rest_tol)
+
+
 class ImpactOptions(eqx.Module):
     """Everything static about an impact solve: one compiled program per distinct value.
 
-    `impact` builds it from its keywords (see `impact` for their meanings); a caller that
-    runs `solve_impact` itself (a fit, a batch) builds it with `make_options`.
+    The library builds it from a call's `SolveOptions` and the path `choose_path` decided
+    (`make_options`); a user gives `SolveOptions` (or the keywords), not this record, which
+    a caller that runs `solve_impact` itself (a fit, a batch, a test) may build.
 
     - `separation`: `"force"` or `"penetration"`, the end of contact.
     - `closed_form`: take the law's exact solution (`AbstractLaw.closed_form`).
@@ -165,8 +305,11 @@ def choose_path(
     ts=None,
     solver=None,
     rtol: float = DEFAULT_RTOL,
+    fit: bool = False,
 ) -> Path:
-    """How `impact` computes the impact of `law` (the only place that decides it).
+    """How an impact of `law` is computed (the only place that decides it): asked by
+    `impact`, `impact_batch` (once for its rows), `bounce` and `fit_bounces` (once for every
+    contact: `g` their gravity) and `calibrate` (`fit=True`).
 
     `method="auto"`: the law's closed form where one holds for these inputs (every `g`
     where its row says so, else `g = 0`; no time histories `ts`), else the universal
@@ -175,8 +318,18 @@ def choose_path(
     `"integrate"` always integrates; `"closed_form"` and `"similarity"` insist (a
     `ValueError` says why they cannot serve). Gravity is none only where `g` is a number
     0 (a static fact); an array or a traced value counts as gravity.
+
+    `fit=True` is a fit's route (`calibrate`, its `method` one of `"auto"`,
+    `"similarity"`, `"integrate"`): the curves first where they serve without gravity
+    (before a closed form: the fit also starts on them), then a two-group table of the
+    law's own (a dry force, an adhesion), then the closed form; no gravity table for a
+    one-group law. The curves of a path that reads them are loaded (or, for a shape not
+    shipped, built and cached) here, through `similarity_reason`, before anything is
+    compiled: a compiled solve or fit never builds curves.
     """
     g_is_zero = is_no_gravity(g)
+    if fit:
+        return _fit_path(law, separation, method, g_is_zero, solver, rtol)
     closed = None if ts is not None else law.closed_form(separation, g_is_zero=g_is_zero)
     if method == "closed_form" and closed is None:
         raise ValueError(
@@ -196,8 +349,35 @@ def choose_path(
     if method in ("auto", "similarity") and solver is None and rtol >= CURVES_RTOL:
         table = table_key(law, separation, g_is_zero=g_is_zero, ts=ts)
         if table is not None:
-            return Path(f"{table.group}_table", table)
+            return _table_path(table)
     return Path("integrated")
+
+
+def _fit_path(law, separation, method, g_is_zero, solver, rtol) -> Path:
+    """`choose_path(..., fit=True)`: a fit's route."""
+    fast = solver is None and rtol >= CURVES_RTOL  # "auto": the curves and tables
+    if method in ("auto", "similarity"):
+        reason = similarity_reason(law, separation, g_is_zero=g_is_zero)
+        if reason is None and (method == "similarity" or fast):
+            return Path("similarity", curve_key(*shape_of(law), separation))
+        if method == "similarity":
+            raise ValueError(f"method='similarity' cannot serve this fit: {reason}")
+    elif method != "integrate":
+        raise ValueError(f"method must be 'auto', 'similarity' or 'integrate', got {method!r}")
+    if method == "auto" and fast:
+        table = table_key(law, separation, g_is_zero=g_is_zero)
+        if table is not None:
+            return _table_path(table)
+    if method == "auto" and law.closed_form(separation, g_is_zero=g_is_zero) is not None:
+        return Path("closed_form")
+    return Path("integrated")
+
+
+def _table_path(table) -> Path:
+    """The path of a two-group table, with the universal curves it corrects loaded now
+    (shipped, cached or built: never inside a compiled solve or fit)."""
+    curves_for(curve_key(table.key.n, table.key.p, table.key.separation))
+    return Path(f"{table.group}_table", table)
 
 
 def adhesion_table_key(law, *, ts=None) -> WithGravity | None:
@@ -231,25 +411,14 @@ def dry_table_key(law, separation: str, *, g_is_zero: bool, ts=None) -> WithDryF
 
 
 def make_options(
-    path: Path,
-    *,
-    separation: str,
-    rtol: float,
-    atol: float,
-    rest_tol: float,
-    solver=None,
-    adjoint=None,
-    max_steps: int = 4096,
-    tau_max: float = 1e4,
-    peaks: bool = True,
-    inputs: tuple = (),
-    gravity: bool = True,
+    path: Path, solve: SolveOptions, *, separation: str, inputs: tuple = (), gravity: bool = True
 ) -> ImpactOptions:
-    """The `ImpactOptions` of a solve on `path` (tolerances as the working precision can
-    meet them: `precision.resolvable_tolerances`). Where the path integrates, `solver`
-    defaults to `diffrax.Tsit5()` and `adjoint` to the cheapest one for the tracers in
-    `inputs` (`adjoint.auto_adjoint`; no tracers: `RecursiveCheckpointAdjoint`);
-    `gravity=False` where `g` is a number 0 (`is_no_gravity`)."""
+    """The `ImpactOptions` of a solve on `path` with the call's options `solve` (its
+    tolerances resolved: `with_tolerances`; `max_steps`, `tau_max`, `peaks` set). Where the
+    path integrates, `solve.solver` defaults to `diffrax.Tsit5()` and `solve.adjoint` to the
+    cheapest one for the tracers in `inputs` (`adjoint.auto_adjoint`; no tracers:
+    `RecursiveCheckpointAdjoint`); `gravity=False` where `g` is a number 0 (`is_no_gravity`)."""
+    solver, adjoint = solve.solver, solve.adjoint
     if path.integrates:
         import diffrax as dfx
 
@@ -261,13 +430,13 @@ def make_options(
         separation=separation,
         closed_form=path.name == "closed_form",
         solver=solver,
-        rtol=rtol,
-        atol=atol,
-        max_steps=max_steps,
-        tau_max=tau_max,
-        rest_tol=rest_tol,
+        rtol=solve.rtol,
+        atol=solve.atol,
+        max_steps=solve.max_steps,
+        tau_max=solve.tau_max,
+        rest_tol=solve.rest_tol,
         adjoint=adjoint,
-        peaks=peaks,
+        peaks=solve.peaks,
         similarity=path.key,
         gravity=gravity,
     )

@@ -86,24 +86,15 @@ def solve_broke(result):
     )
 
 
-def integrate_phases(
-    dynamics,
-    *,
-    plan,
-    separation,
-    tau_grid,
-    solver,
-    rtol,
-    atol,
-    max_steps,
-    tau_max,
-    rest_tol,
-    adjoint,
-    hold=None,
-):
-    """Run the phases of `plan`; return the state and time at the end of each
+def integrate_phases(dynamics, options, *, plan, tau_grid, hold=None):
+    """Run the phases of `plan` as `options` (an `ImpactOptions`: separation, solver,
+    tolerances, horizon, adjoint) say; return the state and time at the end of each
     (nondimensional), stacked along a leading axis. `hold` (a boolean): skip every phase
     (a contact known in closed form never to return, see `AbstractDynamics.creeping`)."""
+    separation, solver, adjoint, max_steps = (
+        options.separation, options.solver, options.adjoint, options.max_steps
+    )  # fmt: skip
+    rtol, atol, tau_max, rest_tol = options.rtol, options.atol, options.tau_max, options.rest_tol
     term = dfx.ODETerm(lambda t, y, args: dynamics.rhs(y, args < _TO_SEPARATION))
     conditions = _event_conditions(dynamics, separation, plan, rest_tol)
     event = dfx.Event(
@@ -187,20 +178,7 @@ def integrated_contact(dynamics, options, *, m, v0, g, tau_grid=None, hold=None,
     (see `integrate_phases`); `creep`: a contact known in closed form never to return
     (`AbstractDynamics.creeping`), held and assembled from that form."""
     plan = phase_plan(dynamics, options.peaks or tau_grid is not None)
-    phases = integrate_phases(
-        dynamics,
-        plan=plan,
-        separation=options.separation,
-        tau_grid=tau_grid,
-        solver=options.solver,
-        rtol=options.rtol,
-        atol=options.atol,
-        max_steps=options.max_steps,
-        tau_max=options.tau_max,
-        rest_tol=options.rest_tol,
-        adjoint=options.adjoint,
-        hold=hold,
-    )
+    phases = integrate_phases(dynamics, options, plan=plan, tau_grid=tau_grid, hold=hold)
     result = assemble_integrated(
         dynamics, phases, plan, m=m, v0=v0, g=g, tau_grid=tau_grid, creep=creep
     )
