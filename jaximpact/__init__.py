@@ -31,6 +31,7 @@ _PUBLIC = {
     # one impact
     "ImpactResult": "_solve.results",
     "ImpactOptions": "_solve.options",
+    "SolveOptions": "_solve.options",
     "impact": "_solve.impact",
     "Status": "_status",
     # one drop
@@ -42,7 +43,7 @@ _PUBLIC = {
     "calibrate": "_fit.calibrate",
     "BounceFit": "_fit.bounce_fit",
     "fit_bounces": "_fit.fit_bounces",
-    "compare_laws": "_fit.model_choice",
+    "compare_laws": "_posterior.evidence",  # by="aic": _fit.model_choice's; "evidence"
     "clean_impact_times": "_fit.impact_times",
     "interval_restitution": "_fit.impact_times",
     "read_recording": "_fit.recordings",

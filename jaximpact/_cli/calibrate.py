@@ -122,8 +122,91 @@ def add_calibrate(subparsers):
     parser.add_argument(
         "--max-iter", type=int, default=100, metavar="N", help="iteration limit (default 100)"
     )
+    add_posterior_arguments(parser)
     add_output_arguments(parser)
     parser.set_defaults(handler=run_calibrate)
+
+
+def add_posterior_arguments(parser):
+    """`--posterior [nuts|laplace]`, `--draws`, `--seed`, `--prior` (`jaximpact.posterior`)."""
+    parser.add_argument(
+        "--posterior", nargs="?", const="nuts", choices=("nuts", "laplace"), metavar="METHOD",
+        help="also sample the posterior of the fitted parameters (jaximpact.posterior): "
+        "'nuts' (the default; 4 chains) or 'laplace' (the Gaussian at the mode, fast); "
+        "prints medians with 90 %% intervals and the diagnostics, --plot writes the pairs "
+        "plot and the bands over the data, --json adds the posterior's summary and 200 of "
+        "its draws (what 'jaximpact export --from' reads for the engine's band)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--draws", type=int, default=2000, metavar="N",
+        help="with --posterior: draws per chain (default 2000, 4 chains)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--seed", type=int, default=0, metavar="N",
+        help="with --posterior: the random seed (default 0)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--prior", action="extend", nargs="+", default=[], metavar="NAME=KIND:A:B",
+        help="with --posterior: a parameter's prior, SI units, KIND one of loguniform "
+        "(A, B: the range), uniform, normal (mean, sd), lognormal (mu, sigma of ln x), e.g. "
+        "--prior c=loguniform:1e5:1e8 (default: loguniform over three decades either side "
+        "of the fitted value)",
+    )  # fmt: skip
+
+
+def posterior_options(args) -> dict | None:
+    """The checked `--posterior` options (None without `--posterior`), before any fit:
+    `method`, `draws`, `seed`, `prior` ({name: (kind, a, b)})."""
+    from .._posterior.priors import parse_prior
+
+    if args.posterior is None:
+        given = [f for f, v in (("--prior", args.prior), ("--draws", args.draws != 2000),
+                                ("--seed", args.seed != 0)) if v]  # fmt: skip
+        if given:
+            raise CLIError(f"{' and '.join(given)} need --posterior")
+        return None
+    if args.draws < 1:
+        raise CLIError(f"--draws must be at least 1, got {args.draws}")
+    prior = {}
+    for item in args.prior:
+        name, sep, spec = item.partition("=")
+        parts = spec.split(":")
+        if not sep or not name.strip() or len(parts) != 3:
+            raise CLIError(f"--prior {item!r} must be NAME=KIND:A:B, e.g. c=loguniform:1e5:1e8")
+        name = name.strip()
+        if name in prior:
+            raise CLIError(f"--prior {name} is given twice")
+        try:
+            prior[name] = parse_prior(name, (parts[0], parts[1], parts[2])).as_tuple()
+        except ValueError as error:
+            raise CLIError(f"--prior {item!r}: {error}") from None
+    return dict(method=args.posterior, draws=args.draws, seed=args.seed, prior=prior)
+
+
+# the draws the JSON of a posterior holds: enough for the engine's band of `export --from`
+JSON_DRAWS = 200
+
+
+def sample_posterior(fit, options):
+    """`(posterior, record)`: the posterior of `fit` (`jaximpact.posterior`) and its JSON
+    record, `Posterior.to_dict(samples=False)` with `JSON_DRAWS` evenly thinned draws
+    (`samples`, `z`) and `thinned` (how many, of how many); the statistics are those of
+    all the draws."""
+    import jax
+
+    from .._posterior import posterior
+
+    with metered(heartbeat_meter(), 1, f"posterior ({options['method']})") as bar:
+        key = jax.random.key(options["seed"])
+        post = posterior(fit, prior=options["prior"] or None, method=options["method"],
+                         num_samples=options["draws"], key=key)  # fmt: skip
+        bar.update(1, "done")
+    record = post.to_dict(samples=False)
+    rows = post.draw_indices(JSON_DRAWS)
+    record["samples"] = {k: [float(x) for x in v[rows]] for k, v in post.samples.items()}
+    record["z"] = [[float(x) for x in row] for row in post.z[rows]]
+    record["thinned"] = {"draws": int(len(rows)), "of": post.num_draws}
+    return post, record
 
 
 # --------------------------------------------------------------------------- the data
@@ -236,6 +319,7 @@ def run_calibrate(args):
         raise CLIError(f"--mass must be a finite number > 0 kg, got {args.mass:g}")
     if args.max_iter < 1:
         raise CLIError("--max-iter must be at least 1")
+    sampling = posterior_options(args)
     data = measurements(args)
     if args.law == ALL:
         if args.free or args.param:
@@ -243,8 +327,11 @@ def run_calibrate(args):
                 "--law all chooses each law's free parameters and start itself: "
                 "drop --free and --param"
             )
+        if args.posterior is not None:
+            raise CLIError("--posterior takes one law: give --law NAME (the ranking of --law "
+                           "all has no posterior)")  # fmt: skip
         return _run_all(args, data)
-    return _run_one(args, data)
+    return _run_one(args, data, sampling)
 
 
 def _fit_kwargs(args, data):
@@ -262,7 +349,7 @@ def _fit_kwargs(args, data):
     )
 
 
-def _run_one(args, data):
+def _run_one(args, data, sampling=None):
     import jax
 
     from .._fit.calibrate import calibrate
@@ -305,10 +392,19 @@ def _run_one(args, data):
         start={k: float(v) for k, v in start.parameters.items()},
         given=sorted(given),
     )
+    post = None
+    if sampling is not None:
+        post, result["posterior"] = sample_posterior(fit, sampling)
     if args.plot is not None:
-        _plot(args, data, [(args.law, fit)])
+        if post is None:
+            _plot(args, data, [(args.law, fit)])
+        else:  # the pairs plot and the bands over the data
+            post.plot(args.plot)
         result["plot"] = str(args.plot)
-    emit(args, result, lambda: _one_text(result, data))
+    text = lambda: _one_text(result, data)  # noqa: E731
+    if post is not None:
+        text = lambda: _one_text(result, data) + "\n\n" + post.summary()  # noqa: E731
+    emit(args, result, text)
     return 0
 
 

@@ -12,6 +12,7 @@ from .common import (
     add_tangential_arguments,
     command_parser,
     emit,
+    heartbeat_meter,
     is_file_law,
     make_law,
     parse_params,
@@ -93,7 +94,14 @@ def add_export(subparsers):
     parser.add_argument(
         "--from", dest="source", metavar="FILE",
         help="a fit to export: the JSON that 'jaximpact calibrate --json' (or 'simulate "
-        "--json') writes, '-' for stdin; its law, parameters, mass and speed are used",
+        "--json') writes, '-' for stdin; its law, parameters, mass and speed are used. From "
+        "'calibrate --posterior --json': the law at the posterior medians, and the band "
+        "(5-95 %%) of what the engine realises over the draws the file holds",
+    )  # fmt: skip
+    parser.add_argument(
+        "--band-draws", type=int, default=200, metavar="N",
+        help="with --from a posterior: the engine's band over N of its draws (default 200; "
+        "one export each: about 10 ms for LAMMPS, 0.5 s for MuJoCo)",
     )  # fmt: skip
     parser.add_argument(
         "--law", metavar="NAME",
@@ -184,7 +192,9 @@ def _run_export(args):
             raise CLIError("give either --from or --e/--T, not both")
         if args.param:
             raise CLIError("--param conflicts with --from: the fit gives the parameters")
-        name, params, args.mass, args.v0, notes = read_fit(args.source, args)
+        name, params, args.mass, args.v0, notes, posterior = read_fit(args.source, args)
+        if args.band_draws < 1:
+            raise CLIError(f"--band-draws must be at least 1, got {args.band_draws}")
     else:
         if args.law is None and args.e is None:
             raise CLIError("give --law (with --param), --from FILE or the target --e (and --T)")
@@ -195,6 +205,7 @@ def _run_export(args):
         if args.v0 is None:
             raise CLIError("--v0 is required: the impact speed, m/s")
         name, params = args.law, parse_params(args.param)
+        posterior = None
     chosen = _engines()[engine]
     missing = []
     if args.mass is None and (name is not None or chosen.MASS_DEPENDS is not None):
@@ -229,6 +240,10 @@ def _run_export(args):
                 strict=args.strict,
                 tangential=tangential,
             )
+        origin = ""
+        if posterior is not None:  # the engine's band over the posterior's draws
+            x, origin, why = _band(x, posterior, name, args, tangential)
+            notes += why
     except UnrealisedExport as refusal:
         raise CLIError(refusal.message("--no-strict")) from None
     data = x.to_dict()
@@ -255,7 +270,7 @@ def _run_export(args):
         mass = "per unit mass" if x.m is None else f"m = {format_number(x.m)} kg"
         lines = [
             f"{x.engine}: {x.scene}",
-            *([f"from     {args.source}: law {name}"] if args.source is not None else []),
+            *([f"from     {args.source}: law {name}{origin}"] if args.source is not None else []),
             f"asked    e = {x.target_e:.6g}, T = {x.target_T:.6g} s at v0 = {x.v0:g} m/s, {mass}",
             step,
             f"realised e = {x.e:.6g}, T = {x.T:.6g} s at that step"
@@ -264,6 +279,12 @@ def _run_export(args):
                 if x.e_range
                 else ""
             ),
+            *(
+                [f"band     e {x.e_band[0]:.5g} to {x.e_band[1]:.5g}, T {x.T_band[0]:.5g} to "
+                 f"{x.T_band[1]:.5g} s (5-95 % over {x.band_draws} posterior draws, that step)"]
+                if x.e_band is not None
+                else []
+            ),  # fmt: skip
             "parameters:",
             *(f"  {k} = {v}" for k, v in x.parameters.items()),
             "snippet:",
@@ -294,13 +315,44 @@ def _run_export(args):
     emit(args, data, text)
 
 
+def _band(x, posterior: dict, name: str, args, tangential):
+    """`(x, origin, notes)`: the export `x` with the engine's band over the draws of
+    `posterior` (a `Posterior.to_dict` record, as `calibrate --posterior --json` writes
+    it) and the words for its origin, or `x` alone with a note saying why there is no band
+    (no draws in the file, a user's law)."""
+    from .._engines.export import with_band
+    from .._posterior import Posterior
+
+    origin = " at the posterior medians"
+    if "samples" not in posterior or "z" not in posterior:
+        return x, origin, ["no engine band: the posterior in the file holds no draws (write "
+                           "it with 'jaximpact calibrate --posterior --json')"]  # fmt: skip
+    if is_file_law(name):
+        return x, origin, ["no engine band for a user's law (FILE.py:NAME) read from JSON"]
+    try:
+        post = Posterior.from_dict(posterior)
+    except (KeyError, TypeError, ValueError) as error:
+        raise CLIError(f"--from {args.source}: its posterior is not one that 'jaximpact "
+                       f"calibrate --posterior --json' writes ({error})") from None  # fmt: skip
+    x = with_band(x, post, band_draws=args.band_draws, progress=heartbeat_meter(),
+                  m=args.mass, v0=args.v0,
+                  radius=args.radius, poisson=args.poisson, limit_damping=args.limit_damping,
+                  geometry="wall" if args.wall else None, tangential=tangential)  # fmt: skip
+    thinned = posterior.get("thinned", {})
+    of = f", of {thinned['of']}" if isinstance(thinned, dict) and "of" in thinned else ""
+    return x, f"{origin} (band over {x.band_draws} of its draws{of})", []
+
+
 def read_fit(path: str, args):
-    """`(law name, parameters, m, v0, notes)` of the fit in the JSON file `path` ('-': stdin)
-    that `jaximpact calibrate --json` writes (one law, or `--law all`'s ranking: its best,
-    or the one `--law` names), or `simulate --json`: its `law`, `params`, `m` (kg) and
-    speed (`rows[].v0`, or `v0`), m/s. `--mass` and `--law`, where given, must agree with
-    the file; `--v0` picks the speed (required where the fit has several). Each missing or
-    mismatched field is a one-line `CLIError`; `notes` are warnings for the output."""
+    """`(law name, parameters, m, v0, notes, posterior)` of the fit in the JSON file `path`
+    ('-': stdin) that `jaximpact calibrate --json` writes (one law, or `--law all`'s
+    ranking: its best, or the one `--law` names), or `simulate --json`: its `law`,
+    `params`, `m` (kg) and speed (`rows[].v0`, or `v0`), m/s. With `calibrate --posterior
+    --json`'s `posterior`, the law is at the posterior medians of its free parameters and
+    `posterior` is that record (else None). `--mass` and `--law`, where given, must agree
+    with the file; `--v0` picks the speed (required where the fit has several). Each
+    missing or mismatched field is a one-line `CLIError`; `notes` are warnings for the
+    output."""
     import math
 
     from .._laws import LAWS
@@ -361,7 +413,14 @@ def read_fit(path: str, args):
         )
     if record.get("converged") is False:
         notes.append(f"the fit in {path} did not converge")
-    return name, {k: float(v) for k, v in params.items()}, float(m), float(v0), notes
+    params = {k: float(v) for k, v in params.items()}
+    posterior = record.get("posterior")
+    if posterior is not None:
+        median = posterior.get("median") if isinstance(posterior, dict) else None
+        if not isinstance(median, dict) or not all(_number(v) for v in median.values()):
+            raise CLIError(f"{where}: its 'posterior' has no 'median' (NAME -> number)")
+        params.update({k: float(v) for k, v in median.items() if k in params})
+    return name, params, float(m), float(v0), notes, posterior
 
 
 def _speeds(record) -> list[float] | None:

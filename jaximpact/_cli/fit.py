@@ -120,6 +120,11 @@ def add_fit(subparsers):
         help="measurement noise (s for impact times, height units for a trajectory); "
         "default: estimated from the residuals",
     )
+    parser.add_argument(
+        "--posterior", nargs="?", const="nuts", choices=("nuts", "laplace"), metavar="METHOD",
+        help="the posterior of the fitted parameters: not yet for a bounce fit (jaximpact."
+        "posterior takes calibrate's fits; 'jaximpact calibrate --posterior' on e and T)",
+    )  # fmt: skip
     add_output_arguments(parser)
     parser.set_defaults(handler=run_fit)
 
@@ -225,6 +230,11 @@ def _plot(fits, recording, path):
 
 
 def run_fit(args):
+    if args.posterior is not None:  # before reading or fitting anything
+        raise CLIError(
+            "--posterior: the posterior of a bounce fit (fit_bounces) is not supported yet; "
+            "'jaximpact calibrate --posterior' samples one from e (and T) per impact speed"
+        )
     check_plot_path(args.plot, inputs=[args.file])
     if not (math.isfinite(args.mass) and args.mass > 0):
         raise CLIError(f"--mass must be a number > 0 kg, got {args.mass}")

@@ -158,6 +158,7 @@ def posterior(
         log_evidence=float(mode.log_evidence),
         diagnostics=diag,
         model=model,
+        law_parameters={k: float(v) for k, v in fit.law.parameters.items()},
     )
 
 

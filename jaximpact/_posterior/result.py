@@ -25,8 +25,13 @@ class Posterior(eqx.Module):
       negative definite).
     - `method`: "nuts" or "laplace"; `priors`: `{name: (kind, a, b)}`; `noise`, `nu`;
       `law_name`, `units`; `z`: the draws in the sampler's unbounded coordinates.
+    - `law_parameters`: every parameter of the fitted law (SI; the fixed ones as fitted
+      with), so that `law_at` builds the law at any draw.
     - `predict(v0=...)`: bands of e and T at new speeds; `plot(path)`; `summary()`;
       `to_dict()` and `Posterior.from_dict` (without the forward model).
+    - `law_at(values)`, `median_law`, `draw_laws(n)`: the law at given values of the free
+      parameters, at the medians, at `n` evenly thinned draws (what `export(post, ...)`
+      exports, and over which it gives the engine's band).
     """
 
     samples: dict
@@ -43,6 +48,7 @@ class Posterior(eqx.Module):
     log_evidence: float
     diagnostics: dict
     model: Model | None = None
+    law_parameters: dict | None = None
 
     # ------------------------------------------------------------------ statistics
 
@@ -73,6 +79,45 @@ class Posterior(eqx.Module):
     @property
     def num_draws(self) -> int:
         return int(self.z.shape[0])
+
+    # ------------------------------------------------------------------ laws
+
+    def law_at(self, values: dict | None = None):
+        """The fitted law with its free parameters set to `values` (`{name: SI value}`;
+        default the medians), the others as fitted with. A posterior read from a dict
+        rebuilds it by name (a law of the table; a user's law needs the fit)."""
+        values = self.median if values is None else values
+        free = {k: float(values[k]) for k in self.free}
+        if self.model is not None:
+            return self.model.law.replace(**free)
+        from .._laws import LAWS, law
+
+        if self.law_parameters is None or self.law_name not in LAWS:
+            raise ValueError(
+                f"this Posterior (read from a dict) cannot rebuild its law {self.law_name!r}: "
+                + ("a user's law needs the fit it came from" if self.law_parameters is not None
+                   else "the dict holds no 'law_parameters'")
+            )  # fmt: skip
+        return law(self.law_name, **{**self.law_parameters, **free})
+
+    @property
+    def median_law(self):
+        """The law at the posterior medians of its free parameters (`law_at()`)."""
+        return self.law_at()
+
+    def draw_indices(self, n: int) -> np.ndarray:
+        """The rows of at most `n` draws, evenly spaced over all of them (chains alike)."""
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+            raise ValueError(f"the number of draws must be an integer >= 1, got {n!r}")
+        total = self.num_draws
+        if total <= n:
+            return np.arange(total)
+        return np.linspace(0, total - 1, int(n)).astype(int)
+
+    def draw_laws(self, n: int = 200) -> list:
+        """The law at each of at most `n` draws, evenly thinned (`draw_indices(n)`)."""
+        return [self.law_at({k: self.samples[k][i] for k in self.free})
+                for i in self.draw_indices(n)]  # fmt: skip
 
     # ------------------------------------------------------------------ predictions
 
@@ -130,8 +175,8 @@ class Posterior(eqx.Module):
 
     def to_dict(self, samples: bool = True) -> dict:
         """JSON-able: `method`, `law`, `names`, `units`, `priors`, `median`, `mean`,
-        `std`, `interval90`, `map`, `diagnostics`, `log_evidence`, `noise`, `nu`, and with
-        `samples` the draws (SI) and `z`."""
+        `std`, `interval90`, `map`, `diagnostics`, `log_evidence`, `noise`, `nu`,
+        `law_parameters` (the fitted law's, SI), and with `samples` the draws (SI) and `z`."""
         out = {
             "method": self.method,
             "law": self.law_name,
@@ -148,6 +193,7 @@ class Posterior(eqx.Module):
             "log_evidence": jsonable(self.log_evidence),
             "noise": self.noise,
             "nu": self.nu,
+            "law_parameters": jsonable(self.law_parameters),
         }
         if samples:
             out["samples"] = jsonable(self.samples)
@@ -178,7 +224,12 @@ class Posterior(eqx.Module):
             log_evidence=math.nan if log_evidence is None else float(log_evidence),
             diagnostics=dict(data["diagnostics"]),
             model=None,
+            law_parameters=_parameters(data.get("law_parameters")),
         )
 
     def __repr__(self) -> str:
         return self.summary()
+
+
+def _parameters(value):
+    return None if value is None else {k: float(v) for k, v in value.items()}
