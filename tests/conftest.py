@@ -14,6 +14,10 @@
   an `@example` of its test.
 - JAX's persistent compilation cache on, as a user turns it on (`jaximpact.enable_cache()`;
   the library itself changes no JAX setting): compiled programs are reused between runs.
+- The fast suite's budget (3 minutes on 2 cores with an empty cache): the tests in
+  `SLOW_BY_COST` each compile programs that no other fast test shares (measured: 4 to 13
+  CPU seconds each, 2026-11-27); they are marked `slow` here, in one place, and run in the
+  slow group (`.ci/run`). Each feature they check keeps a cheaper fast test.
 - The command line's progress reports (on stderr, also when it is not a terminal) are turned
   off for the tests, which check stderr line by line; tests of the progress turn it on.
 """
@@ -25,6 +29,7 @@ os.environ.setdefault("XLA_FLAGS", "--xla_backend_optimization_level=0")
 os.environ.setdefault("JAXIMPACT_PROGRESS", "off")
 
 import jax  # noqa: E402
+import pytest  # noqa: E402
 from hypothesis import settings  # noqa: E402
 
 import jaximpact  # noqa: E402
@@ -39,3 +44,44 @@ jaximpact.enable_cache()
 _TESTS = os.path.dirname(os.path.abspath(__file__))
 if _TESTS not in sys.path:
     sys.path.insert(0, _TESTS)
+
+
+# node ids (a parametrised test: its id, or its name for every case); see the docstring
+SLOW_BY_COST = (
+    "tests/posterior/test_grid_reference.py::test_laplace_is_honestly_different_where_skewed",
+    "tests/posterior/test_record.py::test_noise_scale_is_a_parameter_without_sigmas",
+    "tests/curves/test_gravity_curves.py::test_single_impact_takes_the_table_and_matches",
+    "tests/laws/test_closed_forms_linear.py::test_gradients_match_finite_differences",
+    "tests/fit/test_fit_bounces.py::test_a_list_of_drops_is_fitted_drop_by_drop",
+    "tests/laws/test_custom_laws.py::test_a_failed_solve_is_never_a_number",
+    "tests/solve/test_gradients.py::test_forward_gradients_match_finite_differences",
+    "tests/oblique/test_maw_similarity.py::test_the_impact_depends_on_the_groups_alone",
+    "tests/laws/test_dmt.py::test_without_adhesion_it_is_law_14_and_with_it_law_14_under_gravity",
+    "tests/laws/test_thornton.py::test_the_integrated_path_matches_the_closed_form",
+    "tests/laws/test_thornton.py::test_with_gravity_it_matches_scipy",
+    "tests/laws/test_closed_forms.py::test_maxwell_under_damped",
+    "tests/solve/test_impact.py::test_gravity_matches_scipy[maxwell]",
+    "tests/solve/test_impact.py::test_paper_sets_match_scipy[hertz_rate[fig10]-force]",
+    "tests/solve/test_impact.py::test_histories[hertz_rate]",
+    "tests/curves/test_similarity.py::test_capture_threshold_of_hertz_viscous_under_penetration",
+    "tests/laws/test_jkr.py::test_gradients_of_the_closed_form_match_central_differences",
+    "tests/laws/test_jkr.py::test_the_integrated_path_matches_the_closed_form",
+    "tests/engines/test_export.py::test_engine_e_stepped_response_converges_to_the_continuous_law",
+    "tests/solve/test_solve_options.py::test_bounce_takes_the_record_whole_and_asks_choose_path",
+    "tests/solve/test_solve_options.py::test_the_record_under_jit_and_vmap",
+    "tests/solve/test_solve_options.py::test_impact_batch_takes_the_record_whole",
+    "tests/solve/test_solve_options.py::test_impact_takes_the_record_whole[integrate]",
+    "tests/posterior/test_engine_band.py::test_the_band_is_the_draws_exported_one_by_one[lammps-kwargs0-12]",
+    "tests/fit/test_fit_bounces.py::test_cli_fits_impact_times",
+    *(
+        f"tests/engines/test_recorded_exports.py::test_the_export_is_as_recorded[{case}]"
+        for case in ("mujoco targets", "lammps spheres", "lammps dmt spheres",
+                     "lammps jkr_viscoelastic spheres")
+    ),  # fmt: skip
+)
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        name = item.nodeid.split("[")[0]
+        if item.nodeid in SLOW_BY_COST or name in SLOW_BY_COST:
+            item.add_marker(pytest.mark.slow)
