@@ -16,6 +16,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._format import format_fields, format_value, jsonable
+from .._xla_log import quietly_compiled
 from .bands import noise_scale
 
 
@@ -52,6 +53,7 @@ def _jacobians(model, z, v0):
     return f(z), jax.jacfwd(f)(z)
 
 
+@quietly_compiled
 def next_measurement(post, v0, *, measure=None) -> NextMeasurement:
     """Rank the candidate speeds `v0` (m/s) by the expected information gain of one new
     measurement there about `post`'s free law parameters (nats; the module's formula,

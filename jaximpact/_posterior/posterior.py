@@ -8,6 +8,7 @@ import numpy as np
 
 from .._checks import is_traced
 from .._fit.calibrate import Fit, law_units
+from .._xla_log import quietly_compiled
 from .laplace import gaussian_draws, laplace
 from .likelihood import NOISES, build_model
 from .nuts import diagnostics, poor, run_chains
@@ -21,6 +22,7 @@ class PosteriorWarning(UserWarning):
     """A posterior whose sampler or mode search did poorly (see `Posterior.diagnostics`)."""
 
 
+@quietly_compiled
 def posterior(
     fit,
     *,

@@ -6,6 +6,7 @@ import equinox as eqx
 import numpy as np
 
 from .._format import format_fields, format_value, jsonable
+from .._xla_log import quietly_compiled
 from .bands import Bands, prediction_bands
 from .likelihood import Model
 
@@ -121,6 +122,7 @@ class Posterior(eqx.Module):
 
     # ------------------------------------------------------------------ predictions
 
+    @quietly_compiled
     def predict(self, v0, *, level: float = 0.9, observed: bool = False,
                 max_draws: int = 1000, key=None) -> Bands:  # fmt: skip
         """Bands of `e` and `T` (s) at the speeds `v0` (m/s): median and the `level`
