@@ -63,10 +63,12 @@ def diagnostics(chains: Chains, names) -> dict:
     # blackjax broadcasts by rank promotion, which a strict caller's config would refuse
     with jax.numpy_rank_promotion("allow"):
         if n_chains > 1:
-            r_hat = np.asarray(blackjax.diagnostics.rhat(z, chain_axis=0, sample_axis=1))
+            r_hat = blackjax.diagnostics.rhat(z, chain_axis=0, sample_axis=1)
         else:
             r_hat = np.full(z.shape[-1], np.nan)
-        ess = np.asarray(blackjax.diagnostics.ess_bulk(z, chain_axis=0, sample_axis=1))
+        ess = blackjax.diagnostics.ess_bulk(z, chain_axis=0, sample_axis=1)
+    # blackjax gives a 0-d array for one parameter: one value per parameter, always
+    r_hat, ess = (np.asarray(a).reshape(z.shape[-1]) for a in (r_hat, ess))
     return {
         "r_hat": float(np.max(r_hat)),
         "ess": float(np.min(ess)),

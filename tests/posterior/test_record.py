@@ -118,3 +118,17 @@ def test_student_t_is_robust_to_an_outlier():
             np.log(ref.samples["b1"])
         )
     assert shift["normal"] > 3.0 and shift["student_t"] < 0.5 * shift["normal"]
+
+
+@pytest.mark.parametrize("d", [1, 2])
+def test_diagnostics_per_parameter_with_one_parameter_too(d):
+    """NUTS's diagnostics, one r_hat and ESS per parameter, also for a single free
+    parameter (blackjax returns a 0-d array there: a fit of b1 alone raised IndexError)."""
+    from jaximpact._posterior.nuts import Chains, diagnostics
+
+    z = jax.random.normal(jax.random.key(0), (4, 400, d))
+    names = ["b1", "c"][:d]
+    diag = diagnostics(Chains(z, np.zeros((4, 400), bool), np.ones((4, 400))), names)
+    assert set(diag["r_hat_by_parameter"]) == set(names)
+    assert all(0.98 < r < 1.02 for r in diag["r_hat_by_parameter"].values())
+    assert all(e > 800 for e in diag["ess_by_parameter"].values())  # 1,600 independent draws
