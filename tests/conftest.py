@@ -79,6 +79,13 @@ SLOW_BY_COST = (
     "tests/posterior/test_engine_band.py::test_the_band_is_the_draws_exported_one_by_one",
     "tests/posterior/test_engine_band.py::test_the_band_holds_the_posterior_of_the_law",
     "tests/batch/test_custom_law_files.py::test_batch_file_takes_a_users_law",
+    # a bounce fit and its Laplace posterior, one module fixture: about 50 CPU s
+    *(
+        f"tests/posterior/test_bounce_posterior.py::{name}"
+        for name in ("test_laplace_agrees_with_the_fit", "test_record_text_and_dict",
+                     "test_bands_of_single_impacts", "test_bad_priors_and_unsupported_fits",
+                     "test_cli_fit_posterior")
+    ),  # fmt: skip
     "tests/solve/test_gradients.py::test_contact_time_derivative_at_zero_damping",
     "tests/fit/test_fit_bounces.py::test_cli_refuses_impact_times_going_backwards",
     "tests/laws/test_closed_forms_linear.py::test_matches_scipy",

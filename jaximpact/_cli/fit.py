@@ -16,6 +16,7 @@ from pathlib import Path
 
 from .._fit.recordings import parse_number, read_recording
 from .._plotting import new_figure, save_figure
+from .calibrate import add_posterior_arguments, posterior_options, sample_posterior
 from .common import (
     CLIError,
     add_law_arguments,
@@ -120,11 +121,7 @@ def add_fit(subparsers):
         help="measurement noise (s for impact times, height units for a trajectory); "
         "default: estimated from the residuals",
     )
-    parser.add_argument(
-        "--posterior", nargs="?", const="nuts", choices=("nuts", "laplace"), metavar="METHOD",
-        help="the posterior of the fitted parameters: not yet for a bounce fit (jaximpact."
-        "posterior takes calibrate's fits; 'jaximpact calibrate --posterior' on e and T)",
-    )  # fmt: skip
+    add_posterior_arguments(parser)
     add_output_arguments(parser)
     parser.set_defaults(handler=run_fit)
 
@@ -230,11 +227,7 @@ def _plot(fits, recording, path):
 
 
 def run_fit(args):
-    if args.posterior is not None:  # before reading or fitting anything
-        raise CLIError(
-            "--posterior: the posterior of a bounce fit (fit_bounces) is not supported yet; "
-            "'jaximpact calibrate --posterior' samples one from e (and T) per impact speed"
-        )
+    sampling = posterior_options(args)  # before reading or fitting anything
     check_plot_path(args.plot, inputs=[args.file])
     if not (math.isfinite(args.mass) and args.mass > 0):
         raise CLIError(f"--mass must be a number > 0 kg, got {args.mass}")
@@ -260,14 +253,39 @@ def run_fit(args):
         "kind": recording.kind,
         "fits": {name: fit.to_dict() for name, fit in fits.items()},
     }
+    posts = {}
+    if sampling is not None:  # one posterior per drop
+        for name, fit in fits.items():
+            posts[name], payload["fits"][name]["posterior"] = sample_posterior(fit, sampling)
+            if args.plot is not None:
+                path = _posterior_plot_path(args.plot, name, len(fits))
+                posts[name].plot(path)
+                payload["fits"][name]["posterior"]["plot"] = str(path)
     if args.plot is not None:
         payload["plot"] = str(args.plot)
 
     def text():
-        blocks = [fit.summary(units, title=name) for name, fit in fits.items()]
+        blocks = []
+        for name, fit in fits.items():
+            blocks.append(fit.summary(units, title=name))
+            if name in posts:
+                block = posts[name].summary()
+                record = payload["fits"][name]["posterior"]
+                if "plot" in record:
+                    block += f"\n  pairs plot written to {record['plot']}"
+                blocks.append(block)
         if args.plot is not None:
             blocks.append(f"plot written to {args.plot}")
         return "\n\n".join(blocks)
 
     emit(args, payload, text)
     return 0
+
+
+def _posterior_plot_path(plot: Path, name: str, count: int) -> Path:
+    """Where `--plot PATH` puts a drop's posterior pairs plot: `STEM-posterior.SUFFIX`
+    beside it, with the drop's name when the file holds several."""
+    import re
+
+    tag = "" if count == 1 else "-" + re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("_")
+    return plot.with_name(f"{plot.stem}-posterior{tag}{plot.suffix}")

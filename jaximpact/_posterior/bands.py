@@ -76,6 +76,11 @@ def prediction_bands(post, v0, *, level=0.9, observed=False, max_draws=1000, key
         )
     if not 0 < level < 1:
         raise ValueError(f"level must lie in (0, 1), e.g. 0.9, got {level!r}")
+    if observed and model.e is None and model.T is None:
+        raise ValueError(
+            "observed=True adds the noise of measured e and T: this posterior's fit (a "
+            "bounce) measured neither; its bands (observed=False) are the law's"
+        )
     v0 = np.atleast_1d(np.asarray(v0, dtype=float))
     if v0.ndim != 1 or not np.all(np.isfinite(v0) & (v0 > 0)):
         raise ValueError("v0 must be finite speeds > 0 m/s (a number or a 1-D array)")

@@ -97,11 +97,16 @@ class Model(eqx.Module):
         return jnp.where(jnp.isnan(value), -jnp.inf, value)
 
     def _log_noise(self, r, s):
-        if self.noise == "normal":
-            return -0.5 * r**2 - jnp.log(s) - 0.5 * math.log(2.0 * math.pi)
-        nu = self.nu
-        const = gammaln((nu + 1.0) / 2.0) - gammaln(nu / 2.0) - 0.5 * math.log(nu * math.pi)
-        return const - 0.5 * (nu + 1.0) * jnp.log1p(r**2 / nu) - jnp.log(s)
+        return log_noise(r, s, self.noise, self.nu)
+
+
+def log_noise(r, s, noise: str, nu: float):
+    """Log density of one datum whose standardised residual is `r` under noise of scale
+    `s`: normal, or Student-t of `nu` degrees of freedom (`noise="student_t"`)."""
+    if noise == "normal":
+        return -0.5 * r**2 - jnp.log(s) - 0.5 * math.log(2.0 * math.pi)
+    const = gammaln((nu + 1.0) / 2.0) - gammaln(nu / 2.0) - 0.5 * math.log(nu * math.pi)
+    return const - 0.5 * (nu + 1.0) * jnp.log1p(r**2 / nu) - jnp.log(s)
 
 
 def _forward(model: Model, theta, v0):

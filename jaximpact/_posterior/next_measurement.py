@@ -69,6 +69,11 @@ def next_measurement(post, v0, *, measure=None) -> NextMeasurement:
         raise ValueError(
             "next_measurement needs a Posterior with its forward model (from posterior())"
         )
+    if model.e is None and model.T is None:
+        raise ValueError(
+            "next_measurement ranks speeds for a new e or T measurement: it takes the "
+            "posterior of a calibrate fit, not of a bounce fit (fit_bounces)"
+        )
     v0 = np.atleast_1d(np.asarray(v0, dtype=float))
     if v0.ndim != 1 or v0.size == 0 or not np.all(np.isfinite(v0) & (v0 > 0)):
         raise ValueError("v0 must be candidate speeds > 0 m/s (a number or a 1-D array)")

@@ -7,8 +7,10 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._checks import is_traced
+from .._fit.bounce_fit import BounceFit
 from .._fit.calibrate import Fit, law_units
 from .._xla_log import quietly_compiled
+from .bounce import bounce_setup, reproduces
 from .laplace import gaussian_draws, laplace
 from .likelihood import NOISES, build_model
 from .nuts import diagnostics, poor, run_chains
@@ -38,10 +40,28 @@ def posterior(
 ) -> Posterior:
     """The posterior of `fit`'s free parameters given its data, `p(theta | y)`.
 
-    `fit`: the result of `calibrate` (supported); `fit_bounces` and `fit_oblique` results
-    are not supported yet (TypeError). The likelihood solves every impact with the fit's
-    own forward model (on the universal curves where they served the fit, else the closed
-    form or the integrated solve), compiled once.
+    `fit`: the result of `calibrate` or of `fit_bounces` (one `BounceFit`: for several
+    drops, one posterior per drop); a `fit_oblique` result is a TypeError (an `ObliqueFit`
+    does not keep the rebounds it was fitted to). The likelihood solves every impact with
+    the fit's own forward model (on the universal curves where they served the fit, else
+    the closed form or the integrated solve), compiled once.
+
+    A bounce fit (`_posterior.bounce`): the likelihood is `fit_bounces`'s own chain
+    (`bounce_model.chain_residuals`, its default solve options; a `PosteriorWarning` where
+    it does not reproduce the fit's residuals), one term per detection (or track sample)
+    the fit kept; sampled are the law's free parameters, the nuisance (`t_impact` s,
+    `v_impact` m/s, a fitted `drag` 1/m, a track's `floor` and fitted `length_scale` in
+    its units) and, where `fit_bounces` estimated it, the noise `sigma` (s, or y units).
+    Default priors: the law's and the positive nuisance's as below (loguniform over
+    three decades either side of the fit), `t_impact` uniform within one first flight
+    (`2 v_impact / g`) of the fit, `floor` uniform within the track's span of it, `sigma`
+    loguniform over 1e-6 to 0.1 times that flight (s) or the track's span. Its Laplace
+    approximation uses the Gauss-Newton Hessian of the likelihood (the chain's
+    forward-mode Jacobian, as the fit's standard errors; exact in the priors and noise
+    scale); NUTS its exact gradient. `predict(v0=...)` gives the law's bands of e and T of
+    single impacts at new speeds (the chain's contact solve, the fit's gravity and
+    separation); bands of heights, `observed=True` and `next_measurement` are not
+    offered for a bounce posterior (ValueError).
 
     - `prior`: `{name: (kind, a, b)}` with kind `"loguniform"` (lo, hi), `"uniform"`
       (lo, hi), `"normal"` (mean, sd) or `"lognormal"` (mu, sigma of ln x), SI units. A
@@ -73,13 +93,7 @@ def posterior(
     **Example**: `posterior(calibrate(law, m=1.0, v0=v0s, e=es, T=Ts, sigma_e=0.01,
     sigma_T=0.02 * Ts), prior={"c": ("loguniform", 1e5, 1e8)}, key=jax.random.key(0))`.
     """
-    if not isinstance(fit, Fit) or fit.setup is None:
-        raise TypeError(
-            f"posterior takes the result of calibrate (a Fit), got {type(fit).__name__}; "
-            "fit_bounces and fit_oblique results are not supported yet"
-        )
-    if is_traced(fit.loss) or np.ndim(fit.loss) != 0:
-        raise ValueError("posterior takes one concrete fit, not a traced or vmapped batch")
+    bounce = _check_fit(fit)
     if method not in METHODS:
         raise ValueError(f"method must be 'nuts' or 'laplace', got {method!r}")
     if noise not in NOISES:
@@ -94,8 +108,20 @@ def posterior(
         raise ValueError(f"target_accept must lie in (0, 1), got {target_accept!r}")
     key = jax.random.key(0) if key is None else key
 
-    priors, starts = _priors(fit, prior)
-    model = build_model(fit, priors, noise=noise, nu=nu)
+    if bounce:
+        model, starts, units = bounce_setup(fit, prior, noise=noise, nu=nu)
+        off = reproduces(model, fit, starts)
+        if not off <= REPRODUCED:
+            warnings.warn(
+                f"the bounce fit's model, rebuilt with fit_bounces's default solve options, "
+                f"misses the fit's own residuals by up to {off:.3g} noise scales (a fit with "
+                "other rtol, max_steps or options?): the posterior is of the rebuilt model",
+                PosteriorWarning,
+                stacklevel=2,
+            )
+    else:
+        priors, starts = _priors(fit, prior)
+        model = build_model(fit, priors, noise=noise, nu=nu)
     z0 = jnp.asarray(model.coordinates(starts))
     mode = laplace(model, z0)
     if not bool(mode.converged):
@@ -142,9 +168,10 @@ def posterior(
     values = model.values(jnp.asarray(z))
     samples = {k: np.asarray(values[k]) for k in model.names}
     at_mode = model.values(mode.z)
-    units = law_units(fit.law)
-    units = {k: units.get(k, "") for k in model.free}
-    units.update({k: u for k, u in (("sigma_e", ""), ("sigma_T", "s")) if k in model.names})
+    if not bounce:
+        units = law_units(fit.law)
+        units = {k: units.get(k, "") for k in model.free}
+        units.update({k: u for k, u in (("sigma_e", ""), ("sigma_T", "s")) if k in model.names})
     return Posterior(
         samples=samples,
         z=z,
@@ -162,6 +189,33 @@ def posterior(
         model=model,
         law_parameters={k: float(v) for k, v in fit.law.parameters.items()},
     )
+
+
+# the largest difference (noise scales) between a rebuilt bounce model's residuals at the
+# fit and the fit's own before a warning
+REPRODUCED = 1e-3
+
+
+def _check_fit(fit) -> bool:
+    """Whether `fit` is a bounce fit (else a calibration); TypeError for what `posterior`
+    does not take, ValueError for a traced or batched calibration."""
+    if isinstance(fit, BounceFit):
+        return True
+    if isinstance(fit, (list, tuple)) and fit and all(isinstance(f, BounceFit) for f in fit):
+        raise TypeError(
+            "posterior takes one fit; fit_bounces gave a list (one fit per drop): "
+            "[posterior(f) for f in fits]"
+        )
+    if not isinstance(fit, Fit) or fit.setup is None:
+        raise TypeError(
+            f"posterior takes the result of calibrate (a Fit) or of fit_bounces (a "
+            f"BounceFit), got {type(fit).__name__}"
+            + ("; fit_oblique results are not supported: an ObliqueFit does not keep the "
+               "rebounds it was fitted to" if type(fit).__name__ == "ObliqueFit" else "")
+        )  # fmt: skip
+    if is_traced(fit.loss) or np.ndim(fit.loss) != 0:
+        raise ValueError("posterior takes one concrete fit, not a traced or vmapped batch")
+    return False
 
 
 def _priors(fit, prior):

@@ -57,14 +57,6 @@ def test_calibrate_posterior_bad_input(capsys, drops, extra, contains):
     assert_one_line_error(*run_cli(capsys, argv), contains=contains)
 
 
-def test_fit_posterior_is_refused_in_one_line(capsys, tmp_path):
-    times = tmp_path / "impacts.csv"
-    times.write_text("t\n0.0\n0.5\n0.9\n1.2\n")
-    argv = ["fit", str(times), "--law", "hertz_rate", "--param", "c=2e6", "b1=800",
-            "--mass", "1", "--posterior"]  # fmt: skip
-    assert_one_line_error(*run_cli(capsys, argv), contains="not supported yet")
-
-
 def _posterior_file(tmp_path, samples=True):
     """A fit's JSON with a posterior of three draws, as `calibrate --posterior --json`
     writes it (by hand: the draws are c and b1 about LAW14)."""
