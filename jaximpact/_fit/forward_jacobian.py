@@ -4,7 +4,7 @@ import jax
 import jax.numpy as jnp
 
 
-def with_forward_jacobian(residuals, value_and_jacobian_fn=None):
+def with_forward_jacobian(residuals, value_and_jacobian_fn=None, *, held=False):
     """Wrap `residuals(theta, data) -> r` (1-D arrays) so that any differentiation of it,
     forward or reverse, goes through one `jax.jacfwd` of the impact solves.
 
@@ -13,6 +13,9 @@ def with_forward_jacobian(residuals, value_and_jacobian_fn=None):
     rule returns `J @ dtheta`, which is linear in the tangent, so `jax.grad` (which
     transposes it) works too. `data` is not differentiated. `value_and_jacobian_fn(theta,
     data) -> ((r, aux), J)` may be given to share one compiled Jacobian between call sites.
+    `held=True` holds `J` constant (`stop_gradient`): first derivatives stay exact, and a
+    second one (`jax.hessian` of a function `f` of `r`) is Gauss-Newton's, `J^T (d^2 f /
+    dr^2) J`, with no second derivative through the solves (the posterior's Laplace step).
     """
     if value_and_jacobian_fn is None:
         value_and_jacobian_fn = jax.jit(
@@ -28,6 +31,12 @@ def with_forward_jacobian(residuals, value_and_jacobian_fn=None):
     @wrapped.defjvp
     def _jvp(primals, tangents):
         theta, data = primals
+        if held:
+            fixed = jax.lax.stop_gradient(theta)
+            (value, _), jacobian = value_and_jacobian_fn(fixed, jax.lax.stop_gradient(data))
+            jacobian = jax.lax.stop_gradient(jacobian)
+            # the value's own derivative J dtheta (J held), for a derivative of the rule's
+            return value + jacobian @ (theta - fixed), jacobian @ tangents[0]
         (value, _), jacobian = value_and_jacobian_fn(theta, data)
         return value, jacobian @ tangents[0]
 

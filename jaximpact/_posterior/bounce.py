@@ -34,7 +34,7 @@ from .._fit.bounce_fit import BounceFit
 from .._fit.bounce_model import BounceProblem, chain_residuals, round_up, with_impacts
 from .._fit.calibrate import law_units
 from .._fit.fit_bounces import fit_bounces
-from .._fit.forward_jacobian import value_and_jacobian
+from .._fit.forward_jacobian import with_forward_jacobian
 from .._fit.parameters import law_with, to_unbounded
 from .._laws import AbstractLaw
 from .._solve.bounce import _contact, bounce_options
@@ -149,24 +149,7 @@ def gauss_newton(residuals):
     any function of `r` is exact, and its Hessian (`jax.hessian`, the Laplace
     approximation's) the Gauss-Newton one in `r`, `J^T (d^2 f / dr^2) J` (the curvature the
     fit's standard errors use), without a second derivative through the solves."""
-    jacobian_fn = jax.jit(
-        lambda theta, data: value_and_jacobian(lambda t, d: (residuals(t, d), None), theta, data)
-    )
-
-    @jax.custom_jvp
-    def wrapped(theta, data):
-        return residuals(theta, data)
-
-    @wrapped.defjvp
-    def _jvp(primals, tangents):
-        theta, data = primals
-        fixed = jax.lax.stop_gradient(theta)
-        (value, _), J = jacobian_fn(fixed, jax.lax.stop_gradient(data))
-        J = jax.lax.stop_gradient(J)
-        # the value's own derivative J dtheta (J held), for a derivative of the rule's
-        return value + J @ (theta - fixed), J @ tangents[0]
-
-    return wrapped
+    return with_forward_jacobian(residuals, held=True)
 
 
 def sigma_was_given(fit: BounceFit) -> bool:
