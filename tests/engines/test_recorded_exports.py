@@ -1,7 +1,9 @@
 """The exports as recorded: `Export.to_dict()` of every engine, normal law and tangential law
 that the export tests of tests/engines build, against `recorded_exports.json` (written at
-the code before the engines became tables of sub-models, issue 36). Floats to 1e-12
+the code before the engines became tables of sub-models, issue 36). Floats to 1e-9
 relative, strings, names and keys exactly: a refactoring of `_engines/` changes none of them.
+(Here they agree to 1e-12; 1e-9 leaves room for another machine's XLA, whose CPU code
+rounds a solve's last digits differently, as it moved the gravity table's end at stop 38.)
 
 Record again (only where an export is meant to change, and say why in the commit):
 
@@ -22,7 +24,7 @@ import pytest
 import jaximpact as ji
 
 RECORD = pathlib.Path(__file__).with_name("recorded_exports.json")
-REL = 1e-12
+REL = 1e-9
 
 # the scenes of the export tests (test_export*.py, test_*_tangential.py, test_real_*.py)
 SMALL = dict(m=0.004, v0=1.0, radius=0.005)  # WALL_M, WALL_R
