@@ -106,11 +106,11 @@ class DMT(AbstractNormalModel):
     KEYS = (
         Key("E", "Pa"),
         Key("damp", "1/(m s), viscoelastic damping: b = damp meff Reff^0.5"),
-        Key("cohesion", "J/m^2, the surface energy (half the work of adhesion)"),
+        script.COHESION,
         Key("R_eff", "m, the contact's effective radius (default: from the radius)",
             needed=False),
-        Key("poisson", "default 0.3", needed=False),
-        Key("timestep", "s; without it, no stepping", needed=False),
+        script.POISSON,
+        script.TIMESTEP,
     )
     LAW = "dmt"
     STEPPING = (

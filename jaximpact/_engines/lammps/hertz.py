@@ -135,9 +135,9 @@ class HertzMaterial(AbstractNormalModel):
     KEYS = (
         Key("E", "Pa"),
         Key("coeff_restitution", "in (0, 1]"),
-        Key("poisson", "default 0.3", needed=False),
+        script.POISSON,
         Key("limit_damping", "true or false", needed=False),
-        Key("timestep", "s; without it, no stepping", needed=False),
+        script.TIMESTEP,
     )
     STEPPING = "with a timestep, fix nve/sphere's velocity Verlet: replicated"
     MASS_DEPENDS = "its Young's modulus scales with the mass"

@@ -223,9 +223,9 @@ class JKR(AbstractNormalModel):
     MASS_DEPENDS = "its Young's modulus and cohesion scale with the mass"
     KEYS = (
         Key("E", "Pa"),
-        Key("cohesion", "J/m^2, the surface energy (half the work of adhesion)"),
-        Key("poisson", "default 0.3", needed=False),
-        Key("timestep", "s; without it, no stepping", needed=False),
+        script.COHESION,
+        script.POISSON,
+        script.TIMESTEP,
     )
     LAW = "jkr"
     STEPPING = (

@@ -165,9 +165,9 @@ class JKRViscoelastic(AbstractNormalModel):
     KEYS = (
         Key("E", "Pa"),
         Key("damp", "1/(m s), viscoelastic damping: b = damp meff Reff^0.5"),
-        Key("cohesion", "J/m^2, the surface energy (half the work of adhesion)"),
-        Key("poisson", "default 0.3", needed=False),
-        Key("timestep", "s; without it, no stepping", needed=False),
+        script.COHESION,
+        script.POISSON,
+        script.TIMESTEP,
     )
     LAW = "jkr_viscoelastic"
     STEPPING = (

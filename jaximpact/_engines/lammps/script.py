@@ -6,7 +6,13 @@ normal and a tangential clause (`commands`), the effective radius of its contact
 (`cohesive_stepping`)."""
 
 from .. import _stepping
+from ..base import Key
 from ..materials import check_positive
+
+# the keys every LAMMPS normal model shares (`AbstractNormalModel.KEYS`)
+COHESION = Key("cohesion", "J/m^2, the surface energy (half the work of adhesion)")
+POISSON = Key("poisson", "default 0.3", needed=False)
+TIMESTEP = Key("timestep", "s; without it, no stepping", needed=False)
 
 # LAMMPS's granular pair requires a tangential model: without a tangential law, the
 # frictionless one
