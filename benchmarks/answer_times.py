@@ -63,27 +63,109 @@ def commands(work):
     drops = os.path.join(ROOT, "examples", "data", "drops.csv")
     rebounds = os.path.join(work, "rebounds.csv")
     return [
-        ("simulate", ["simulate", "--law", "hertz_rate", "--param", "c=2e6", "b1=800",
-                      "--mass", "1", "--v0", "2.5"]),
-        ("calibrate (e, T at one speed)", ["calibrate", "--law", "hertz_rate", "--mass", "1",
-                                           "--v0", "2.5", "--e", "0.85", "--T", "7.8e-3"]),
-        ("export lammps --wall", ["export", "lammps", "--law", "hertz_rate", "--param",
-                                  "c=2e6", "b1=800", "--mass", "0.05", "--v0", "1",
-                                  "--radius", "0.01", "--wall"]),
-        ("the same with --tangential mindlin", ["export", "lammps", "--law", "hertz_rate",
-                                                "--param", "c=2e6", "b1=800", "--mass",
-                                                "0.05", "--v0", "1", "--radius", "0.01",
-                                                "--wall", "--tangential", "mindlin",
-                                                "--tparam", "G_star=1e9", "mu=0.3"]),
-        ("fit-oblique, 8 rebounds", ["fit-oblique", rebounds, "--speed", str(SPEED),
-                                     "--mass", str(M), "--radius", str(R), "--law",
-                                     "hunt_crossley", "--param", f"c={C_HERTZ:.6g}", "a=0",
-                                     "--tangential", "mindlin", "--tparam", "G_star=1e10",
-                                     "mu=0.1"]),
-        ("calibrate --law all, e at 6 speeds", ["calibrate", "--law", "all", "--mass", "0.0027",
-                                          "--data", drops]),
+        (
+            "simulate",
+            [
+                "simulate",
+                "--law",
+                "hertz_rate",
+                "--param",
+                "c=2e6",
+                "b1=800",
+                "--mass",
+                "1",
+                "--v0",
+                "2.5",
+            ],
+        ),
+        (
+            "calibrate (e, T at one speed)",
+            [
+                "calibrate",
+                "--law",
+                "hertz_rate",
+                "--mass",
+                "1",
+                "--v0",
+                "2.5",
+                "--e",
+                "0.85",
+                "--T",
+                "7.8e-3",
+            ],
+        ),
+        (
+            "export lammps --wall",
+            [
+                "export",
+                "lammps",
+                "--law",
+                "hertz_rate",
+                "--param",
+                "c=2e6",
+                "b1=800",
+                "--mass",
+                "0.05",
+                "--v0",
+                "1",
+                "--radius",
+                "0.01",
+                "--wall",
+            ],
+        ),
+        (
+            "the same with --tangential mindlin",
+            [
+                "export",
+                "lammps",
+                "--law",
+                "hertz_rate",
+                "--param",
+                "c=2e6",
+                "b1=800",
+                "--mass",
+                "0.05",
+                "--v0",
+                "1",
+                "--radius",
+                "0.01",
+                "--wall",
+                "--tangential",
+                "mindlin",
+                "--tparam",
+                "G_star=1e9",
+                "mu=0.3",
+            ],
+        ),
+        (
+            "fit-oblique, 8 rebounds",
+            [
+                "fit-oblique",
+                rebounds,
+                "--speed",
+                str(SPEED),
+                "--mass",
+                str(M),
+                "--radius",
+                str(R),
+                "--law",
+                "hunt_crossley",
+                "--param",
+                f"c={C_HERTZ:.6g}",
+                "a=0",
+                "--tangential",
+                "mindlin",
+                "--tparam",
+                "G_star=1e10",
+                "mu=0.1",
+            ],
+        ),
+        (
+            "calibrate --law all, e at 6 speeds",
+            ["calibrate", "--law", "all", "--mass", "0.0027", "--data", drops],
+        ),
         ("paper (the seed paper recomputed)", ["paper", "--out", os.path.join(work, "paper")]),
-    ]  # fmt: skip
+    ]
 
 
 def run(argv, cache_home):
@@ -130,27 +212,35 @@ def main():
             def median(runs, k):
                 return statistics.median(r[k] for r in runs)
 
-            rows.append([f"`jaximpact {argv[0]}`: {name}",
-                         f"{median(cold, 0):.1f}", f"{median(cold, 1):.1f}",
-                         f"{median(warm, 0):.1f}", f"{median(warm, 1):.1f}"])  # fmt: skip
+            rows.append(
+                [
+                    f"`jaximpact {argv[0]}`: {name}",
+                    f"{median(cold, 0):.1f}",
+                    f"{median(cold, 1):.1f}",
+                    f"{median(warm, 0):.1f}",
+                    f"{median(warm, 1):.1f}",
+                ]
+            )
             print(" | ".join(rows[-1]), flush=True)
             loads.append(load_average())
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    text = "\n".join([
-        "# Answer times of the README's commands",
-        "",
-        "Generated by `python benchmarks/answer_times.py`. Each command is a fresh process of "
-        "the console script: `cold` with an empty persistent compilation cache, `warm` with "
-        "the cache the cold run filled. Wall and CPU seconds (user + system of the process "
-        "and its threads), median of the repeats. The data are synthetic (made by the "
-        "library: 8 Hertz-Mindlin rebounds; `examples/data/drops.csv`).",
-        "",
-        machine_markdown(machine(), loads),
-        "",
-        table(["command", "cold wall s", "cold CPU s", "warm wall s", "warm CPU s"], rows),
-        "",
-    ])  # fmt: skip
+    text = "\n".join(
+        [
+            "# Answer times of the README's commands",
+            "",
+            "Generated by `python benchmarks/answer_times.py`. Each command is a fresh process of "
+            "the console script: `cold` with an empty persistent compilation cache, `warm` with "
+            "the cache the cold run filled. Wall and CPU seconds (user + system of the process "
+            "and its threads), median of the repeats. The data are synthetic (made by the "
+            "library: 8 Hertz-Mindlin rebounds; `examples/data/drops.csv`).",
+            "",
+            machine_markdown(machine(), loads),
+            "",
+            table(["command", "cold wall s", "cold CPU s", "warm wall s", "warm CPU s"], rows),
+            "",
+        ]
+    )
     write_report(os.path.join(HERE, "answer_times.md"), text)
 
 

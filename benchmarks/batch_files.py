@@ -45,8 +45,12 @@ def child(mode: str, n: int, folder: str, g: float = 0.0):
     source = os.path.join(folder, f"bodies-{n}.csv")
     if mode == "make":
         rng = np.random.default_rng(0)
-        columns = [rng.uniform(1e6, 3e6, n), rng.uniform(100.0, 2000.0, n),
-                   rng.uniform(0.5, 2.0, n), rng.uniform(0.5, 5.0, n)]  # fmt: skip
+        columns = [
+            rng.uniform(1e6, 3e6, n),
+            rng.uniform(100.0, 2000.0, n),
+            rng.uniform(0.5, 2.0, n),
+            rng.uniform(0.5, 5.0, n),
+        ]
         with open(source, "w") as handle:
             handle.write("c,b1,m,v0\n")
             for row in zip(*columns, strict=True):
@@ -73,8 +77,10 @@ def child(mode: str, n: int, folder: str, g: float = 0.0):
 def _run(mode, n, folder, g=0.0):
     done = subprocess.run(
         [sys.executable, __file__, "--child", mode, str(n), folder, repr(g)],
-        capture_output=True, text=True, check=True,
-    )  # fmt: skip
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
@@ -83,21 +89,30 @@ def _processes(n, folder, g, count, mesh="global"):
     output's bytes."""
     source = os.path.join(folder, f"bodies-{n}.csv")
     out = os.path.join(folder, f"impacts-{n}-{count}p.csv")
-    command = ["jaximpact", "batch", source, "--law", "hertz_rate", "--out", out,
-               "--g", repr(g)]  # fmt: skip
+    command = ["jaximpact", "batch", source, "--law", "hertz_rate", "--out", out, "--g", repr(g)]
     if count > 1:
         with socket.socket() as probe:
             probe.bind(("localhost", 0))
             port = probe.getsockname()[1]
-        command += ["--coordinator", f"localhost:{port}", "--num-processes", str(count),
-                    "--mesh", mesh]  # fmt: skip
+        command += [
+            "--coordinator",
+            f"localhost:{port}",
+            "--num-processes",
+            str(count),
+            "--mesh",
+            mesh,
+        ]
     env = {**os.environ, "JAXIMPACT_PROGRESS": "0"}
     start = time.perf_counter()
     procs = [
-        subprocess.Popen(command + (["--process-id", str(k)] if count > 1 else []), env=env,
-                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        subprocess.Popen(
+            command + (["--process-id", str(k)] if count > 1 else []),
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+        )
         for k in range(count)
-    ]  # fmt: skip
+    ]
     for p in procs:
         _, err = p.communicate()
         if p.returncode:
@@ -116,16 +131,32 @@ def main():
     with tempfile.TemporaryDirectory() as folder:
         for path, n, g in CASES:
             made, file, memory = (_run(mode, n, folder, g) for mode in ("make", "file", "memory"))
-            rows.append(dict(path=path, n=n, size_mib=made["size_mib"], file_s=file["seconds"],
-                             memory_s=memory["seconds"], peak_mib=file["peak_mib"],
-                             memory_peak_mib=memory["peak_mib"]))  # fmt: skip
+            rows.append(
+                dict(
+                    path=path,
+                    n=n,
+                    size_mib=made["size_mib"],
+                    file_s=file["seconds"],
+                    memory_s=memory["seconds"],
+                    peak_mib=file["peak_mib"],
+                    memory_peak_mib=memory["peak_mib"],
+                )
+            )
             print(rows[-1], flush=True)
         for path, n, g in PROCESS_CASES:
             one, one_bytes = _processes(n, folder, g, 1)
             two, two_bytes = _processes(n, folder, g, 2, "global")
             local, local_bytes = _processes(n, folder, g, 2, "local")
-            process_rows.append(dict(path=path, n=n, one=one, two=two, local=local,
-                                     same=one_bytes == two_bytes == local_bytes))  # fmt: skip
+            process_rows.append(
+                dict(
+                    path=path,
+                    n=n,
+                    one=one,
+                    two=two,
+                    local=local,
+                    same=one_bytes == two_bytes == local_bytes,
+                )
+            )
             print(process_rows[-1], flush=True)
     load = os.getloadavg()[0]
     lines = [

@@ -120,9 +120,14 @@ def scipy_impact(name, params, v0, rtol):
     event.terminal, event.direction = True, -1
     atol = rtol * np.array([x_star, v0])
     sol = solve_ivp(
-        rhs, (0.0, 1e3 * x_star / v0), [0.0, v0], method="DOP853", rtol=rtol, atol=atol,
+        rhs,
+        (0.0, 1e3 * x_star / v0),
+        [0.0, v0],
+        method="DOP853",
+        rtol=rtol,
+        atol=atol,
         events=[event],
-    )  # fmt: skip
+    )
     if not sol.t_events[0].size:
         return math.nan, math.nan, sol.nfev
     return -sol.y_events[0][0][1] / v0, sol.t_events[0][0], sol.nfev
@@ -148,9 +153,15 @@ def scipy_fit(name, start, speeds, e, T, rtol, method):
     theta0 = np.log([start[k] for k in free])
     t0 = time.perf_counter()
     sol = least_squares(
-        residuals, theta0, method=method, diff_step=2e-6, xtol=1e-12, ftol=1e-12, gtol=1e-12,
+        residuals,
+        theta0,
+        method=method,
+        diff_step=2e-6,
+        xtol=1e-12,
+        ftol=1e-12,
+        gtol=1e-12,
         max_nfev=500,
-    )  # fmt: skip
+    )
     seconds = time.perf_counter() - t0
     params = {k: math.exp(t) for k, t in zip(free, sol.x, strict=True)}
     return dict(
@@ -229,18 +240,31 @@ def run_problems(quick):
         rtol, scipy_error = scipy_rtol_for(name, speeds, jax_error)
         far = {k: v * 10.0 for k, v in TRUE[name].items()}
         table_start = _initial_law(
-            ji.law(name, **far), FREE[name], m=jnp.asarray(M), v0=jnp.asarray(speeds),
-            e=jnp.asarray(e), T=jnp.asarray(T), separation="force",
-        )  # fmt: skip
+            ji.law(name, **far),
+            FREE[name],
+            m=jnp.asarray(M),
+            v0=jnp.asarray(speeds),
+            e=jnp.asarray(e),
+            T=jnp.asarray(T),
+            separation="force",
+        )
         table_start = {k: float(v) for k, v in table_start.parameters.items()}
         label = f"{name}, {len(speeds)} speed{'s' if len(speeds) > 1 else ''}"
-        print(f"{label}: jaximpact solve error {jax_error:.1e}; scipy rtol {rtol:g} "
-              f"({scipy_error:.1e})", flush=True)  # fmt: skip
+        print(
+            f"{label}: jaximpact solve error {jax_error:.1e}; scipy rtol {rtol:g} "
+            f"({scipy_error:.1e})",
+            flush=True,
+        )
         for start_name, start, init in (("x10", far, "given"), ("table", table_start, "auto")):
             row = dict(
-                problem=label, law=name, speeds=len(speeds), start=start_name,
-                jax_solve_error=jax_error, scipy_rtol=rtol, scipy_solve_error=scipy_error,
-            )  # fmt: skip
+                problem=label,
+                law=name,
+                speeds=len(speeds),
+                start=start_name,
+                jax_solve_error=jax_error,
+                scipy_rtol=rtol,
+                scipy_solve_error=scipy_error,
+            )
             for optimizer in ("lbfgs", "lm"):
                 law = ji.law(name, **start)
                 fit_kwargs = dict(m=M, v0=np.asarray(speeds), e=e, T=T, free=FREE[name])
@@ -253,13 +277,20 @@ def run_problems(quick):
                 core = time_call(_fit, *compiled_arguments(fit), rounds=7, max_total_s=5.0)[0]
                 row[optimizer] = dict(
                     core=core,
-                    seconds=median, best=best, compile_s=compile_s,
-                    iterations=int(out.iterations), converged=bool(out.converged),
-                    param_error=param_error(out.params, name), loss=float(out.loss),
-                )  # fmt: skip
-                print(f"  {start_name:5s} {optimizer:5s} {1e3 * median:8.2f} ms "
-                      f"({int(out.iterations)} it, err {row[optimizer]['param_error']:.1e}, "
-                      f"compile {compile_s:.1f} s)", flush=True)  # fmt: skip
+                    seconds=median,
+                    best=best,
+                    compile_s=compile_s,
+                    iterations=int(out.iterations),
+                    converged=bool(out.converged),
+                    param_error=param_error(out.params, name),
+                    loss=float(out.loss),
+                )
+                print(
+                    f"  {start_name:5s} {optimizer:5s} {1e3 * median:8.2f} ms "
+                    f"({int(out.iterations)} it, err {row[optimizer]['param_error']:.1e}, "
+                    f"compile {compile_s:.1f} s)",
+                    flush=True,
+                )
             runs = [
                 scipy_fit(name, start, speeds, e, T, rtol, method)
                 for method in ("trf", "lm")
@@ -268,10 +299,13 @@ def run_problems(quick):
             best_run = min(runs, key=lambda r: r["seconds"])
             best_run["param_error"] = param_error(best_run["params"], name)
             row["scipy"] = best_run
-            print(f"  {start_name:5s} scipy {best_run['method']} "
-                  f"{1e3 * best_run['seconds']:8.1f} ms "
-                  f"({best_run['nfev']} nfev + {best_run['njev']} njev, {best_run['solves']} "
-                  f"solves, err {best_run['param_error']:.1e})", flush=True)  # fmt: skip
+            print(
+                f"  {start_name:5s} scipy {best_run['method']} "
+                f"{1e3 * best_run['seconds']:8.1f} ms "
+                f"({best_run['nfev']} nfev + {best_run['njev']} njev, {best_run['solves']} "
+                f"solves, err {best_run['param_error']:.1e})",
+                flush=True,
+            )
             results.append(row)
     return results
 
@@ -308,8 +342,11 @@ def run_batch(n, chunk):
         t0 = time.perf_counter()
         parts = []
         for i in range(0, n, chunk):
-            parts.append(jax.block_until_ready(batch(masses[i:i + chunk], es[i:i + chunk],
-                                                     Ts[i:i + chunk])))  # fmt: skip
+            parts.append(
+                jax.block_until_ready(
+                    batch(masses[i : i + chunk], es[i : i + chunk], Ts[i : i + chunk])
+                )
+            )
         seconds = time.perf_counter() - t0
         c_fit = np.concatenate([np.asarray(p.params["c"]) for p in parts])
         b_fit = np.concatenate([np.asarray(p.params["b1"]) for p in parts])
@@ -317,13 +354,22 @@ def run_batch(n, chunk):
         iterations = np.concatenate([np.asarray(p.iterations) for p in parts])
         err = np.maximum(np.abs(c_fit / cs - 1), np.abs(b_fit / b1s - 1))
         out[optimizer] = dict(
-            n=n, chunk=chunk, seconds=seconds, per_fit=seconds / n, compile_s=compile_s,
-            converged=float(np.mean(converged)), max_param_error=float(np.max(err)),
-            median_iterations=float(np.median(iterations)), max_iterations=int(iterations.max()),
-        )  # fmt: skip
-        print(f"batch {optimizer}: {n} fits in {seconds:.1f} s ({1e3 * seconds / n:.2f} ms/fit), "
-              f"compile {compile_s:.1f} s, converged {np.mean(converged):.4f}, "
-              f"max param err {np.max(err):.1e}", flush=True)  # fmt: skip
+            n=n,
+            chunk=chunk,
+            seconds=seconds,
+            per_fit=seconds / n,
+            compile_s=compile_s,
+            converged=float(np.mean(converged)),
+            max_param_error=float(np.max(err)),
+            median_iterations=float(np.median(iterations)),
+            max_iterations=int(iterations.max()),
+        )
+        print(
+            f"batch {optimizer}: {n} fits in {seconds:.1f} s ({1e3 * seconds / n:.2f} ms/fit), "
+            f"compile {compile_s:.1f} s, converged {np.mean(converged):.4f}, "
+            f"max param err {np.max(err):.1e}",
+            flush=True,
+        )
     return out
 
 
@@ -359,12 +405,18 @@ def run_first_fits():
         note_load()
         done = subprocess.run(
             [sys.executable, "-c", LIBRARY_FIRST_FIT.replace("{optimizer}", optimizer)],
-            capture_output=True, text=True, env=env, check=True,
-        )  # fmt: skip
+            capture_output=True,
+            text=True,
+            env=env,
+            check=True,
+        )
         imports, first, second = map(float, done.stdout.split())
         out[f"library {optimizer}"] = dict(imports=imports, first=first, second=second)
-        print(f"library {optimizer}: import {imports:.1f} s, first fit {first:.1f} s, "
-              f"second {1e3 * second:.1f} ms", flush=True)  # fmt: skip
+        print(
+            f"library {optimizer}: import {imports:.1f} s, first fit {first:.1f} s, "
+            f"second {1e3 * second:.1f} ms",
+            flush=True,
+        )
     script = os.path.join(os.path.dirname(sys.executable), "jaximpact")
     command = [script] if os.path.exists(script) else [sys.executable, "-m", "jaximpact._cli"]
     for label, extra in (("CLI", {}), ("CLI, EQX_ON_ERROR=nan", {"EQX_ON_ERROR": "nan"})):
@@ -373,9 +425,12 @@ def run_first_fits():
                 note_load()
                 t0 = time.perf_counter()
                 subprocess.run(
-                    command + CLI, capture_output=True, text=True, check=True,
+                    command + CLI,
+                    capture_output=True,
+                    text=True,
+                    check=True,
                     env=dict(env, JAXIMPACT_CACHE_DIR=cache, **extra),
-                )  # fmt: skip
+                )
                 seconds = time.perf_counter() - t0
                 out[f"{label}, {state} cache"] = dict(wall=seconds)
                 print(f"{label}, {state} cache: {seconds:.1f} s", flush=True)
@@ -425,23 +480,45 @@ def report(results):
         "",
     ]
     header = [
-        "problem", "start", "L-BFGS ms (core)", "it", "err", "LM ms (core)", "it", "err",
-        "scipy ms", "nfev+njev (solves)", "err", "jax solve err", "scipy rtol", "ratio best",
+        "problem",
+        "start",
+        "L-BFGS ms (core)",
+        "it",
+        "err",
+        "LM ms (core)",
+        "it",
+        "err",
+        "scipy ms",
+        "nfev+njev (solves)",
+        "err",
+        "jax solve err",
+        "scipy rtol",
+        "ratio best",
         "ratio L-BFGS",
-    ]  # fmt: skip
+    ]
     rows = []
     for r in p:
         lb, lm, sp = r["lbfgs"], r["lm"], r["scipy"]
         best = min(lb["seconds"], lm["seconds"])
-        rows.append([
-            r["problem"], r["start"],
-            f"{ms(lb['seconds'])} ({ms(lb['core'])})", lb["iterations"], fmt(lb["param_error"]),
-            f"{ms(lm['seconds'])} ({ms(lm['core'])})", lm["iterations"], fmt(lm["param_error"]),
-            f"{ms(sp['seconds'])} ({sp['method']})", f"{sp['nfev']}+{sp['njev']} ({sp['solves']})",
-            fmt(sp["param_error"]), fmt(r["jax_solve_error"]),
-            f"{r['scipy_rtol']:g} ({fmt(r['scipy_solve_error'])})",
-            f"**{sp['seconds'] / best:.0f}x**", f"{sp['seconds'] / lb['seconds']:.0f}x",
-        ])  # fmt: skip
+        rows.append(
+            [
+                r["problem"],
+                r["start"],
+                f"{ms(lb['seconds'])} ({ms(lb['core'])})",
+                lb["iterations"],
+                fmt(lb["param_error"]),
+                f"{ms(lm['seconds'])} ({ms(lm['core'])})",
+                lm["iterations"],
+                fmt(lm["param_error"]),
+                f"{ms(sp['seconds'])} ({sp['method']})",
+                f"{sp['nfev']}+{sp['njev']} ({sp['solves']})",
+                fmt(sp["param_error"]),
+                fmt(r["jax_solve_error"]),
+                f"{r['scipy_rtol']:g} ({fmt(r['scipy_solve_error'])})",
+                f"**{sp['seconds'] / best:.0f}x**",
+                f"{sp['seconds'] / lb['seconds']:.0f}x",
+            ]
+        )
     lines.append(table(header, rows))
     lines += [
         "",
@@ -470,8 +547,17 @@ def report(results):
             "```",
             "",
         ]
-        header = ["optimizer", "fits", "chunk", "total s", "ms / fit", "compile s",
-                  "converged", "max param err", "iterations (median, max)"]  # fmt: skip
+        header = [
+            "optimizer",
+            "fits",
+            "chunk",
+            "total s",
+            "ms / fit",
+            "compile s",
+            "converged",
+            "max param err",
+            "iterations (median, max)",
+        ]
         rows = [
             [
                 name,
@@ -483,7 +569,7 @@ def report(results):
                 f"{100 * v['converged']:.2f}%",
                 fmt(v["max_param_error"]),
                 f"{v['median_iterations']:.0f}, {v['max_iterations']}",
-            ]  # fmt: skip
+            ]
             for name, v in b.items()
         ]
         lines += [table(header, rows), ""]
@@ -501,8 +587,14 @@ def report(results):
         rows = []
         for label, v in f.items():
             if "imports" in v:
-                rows.append([label, f"{v['imports']:.1f}", f"{v['first']:.1f}",
-                             f"{1e3 * v['second']:.1f} ms"])  # fmt: skip
+                rows.append(
+                    [
+                        label,
+                        f"{v['imports']:.1f}",
+                        f"{v['first']:.1f}",
+                        f"{1e3 * v['second']:.1f} ms",
+                    ]
+                )
             else:
                 rows.append([label, "-", f"{v['wall']:.1f} (whole command)", "-"])
         lines += [table(["run", "import s", "first fit s", "second fit"], rows), ""]

@@ -100,8 +100,18 @@ def child(name, params, cache):
 def cli(cache):
     env = dict(os.environ, TF_CPP_MIN_LOG_LEVEL="3", JAXIMPACT_CACHE_DIR=cache)
     cmd = [
-        "jaximpact", "simulate", "--law", "hertz_rate", "--param", "c=2e6", "b1=800",
-        "--v0", "2.5", "--mass", "1", "--json",
+        "jaximpact",
+        "simulate",
+        "--law",
+        "hertz_rate",
+        "--param",
+        "c=2e6",
+        "b1=800",
+        "--v0",
+        "2.5",
+        "--mass",
+        "1",
+        "--json",
     ]
     start = time.perf_counter()
     subprocess.run(cmd, capture_output=True, env=env, check=True)
@@ -139,9 +149,17 @@ def run(args):
                 shutil.rmtree(cache, ignore_errors=True)
         row = dict(law=name, path=cold[0]["path"], load=load_average())
         for label, runs in (("cold", cold), ("warm", warm)):
-            for key in ("import_s", "impact_first_s", "impact_second_s", "grad_first_s",
-                        "grad_second_s", "total_s", "cpu_import_s", "cpu_impact_first_s",
-                        "cpu_grad_first_s"):
+            for key in (
+                "import_s",
+                "impact_first_s",
+                "impact_second_s",
+                "grad_first_s",
+                "grad_second_s",
+                "total_s",
+                "cpu_import_s",
+                "cpu_impact_first_s",
+                "cpu_grad_first_s",
+            ):
                 row[f"{label}_{key}"] = median_of(runs, key)
         results["rows"].append(row)
         print(json.dumps(row), flush=True)

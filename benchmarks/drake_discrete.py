@@ -46,8 +46,12 @@ def main():
         x = ji.export(None, "drake", m=M, v0=V0, e=e, T=T, curves=False)
         es_cont, _ = run_drake(x.parameters, m=M, v0=V0)
         header = "| time step (s) | steps per contact | " + " | ".join(APPROXIMATIONS) + " |"
-        lines += [f"## target e = {e}, continuous plant e = {es_cont:.6f}", "", header,
-                  "|" + "---|" * (len(APPROXIMATIONS) + 2)]  # fmt: skip
+        lines += [
+            f"## target e = {e}, continuous plant e = {es_cont:.6f}",
+            "",
+            header,
+            "|" + "---|" * (len(APPROXIMATIONS) + 2),
+        ]
         for h in STEPS:
             cells = []
             for approximation in APPROXIMATIONS:

@@ -147,13 +147,28 @@ print(
 )
 print("|---|---|---|---|---|---|---|---|")
 WALL_CASES = [
-    ("lammps", "LAMMPS 22Jul2025 wall", 0.004, 0.005,
-     [(0.9, 1e-3, False), (0.5, 5e-4, False), (0.1, 1e-4, False), (0.8, 5e-4, True),
-      (0.3, 2e-4, True)]),
-    ("liggghts", "LIGGGHTS 3.8.0 wall", 0.004, 0.005,
-     [(0.9, 1e-3, False), (0.5, 5e-4, False), (0.3, 1e-3, True)]),
+    (
+        "lammps",
+        "LAMMPS 22Jul2025 wall",
+        0.004,
+        0.005,
+        [
+            (0.9, 1e-3, False),
+            (0.5, 5e-4, False),
+            (0.1, 1e-4, False),
+            (0.8, 5e-4, True),
+            (0.3, 2e-4, True),
+        ],
+    ),
+    (
+        "liggghts",
+        "LIGGGHTS 3.8.0 wall",
+        0.004,
+        0.005,
+        [(0.9, 1e-3, False), (0.5, 5e-4, False), (0.3, 1e-3, True)],
+    ),
     ("yade", "Yade wall", 0.01, 0.01, [(0.8, 5e-4, None), (0.5, 1e-3, None), (0.3, 1e-3, None)]),
-]  # fmt: skip
+]
 for engine, name, m, radius, cases in WALL_CASES:
     if engine != "lammps" and not shutil.which(engine):
         print(f"\n{engine} not run: no {engine} executable")
@@ -161,11 +176,22 @@ for engine, name, m, radius, cases in WALL_CASES:
     run = {"lammps": run_lammps, "liggghts": run_liggghts, "yade": run_yade}[engine]
     for e, T, limit in cases:
         kwargs = {} if limit is None else {"limit_damping": limit}
-        x = ji.export(None, engine, m=m, v0=1.0, radius=radius, e=e, T=T, geometry="wall",
-                      curves=False, **kwargs)  # fmt: skip
+        x = ji.export(
+            None,
+            engine,
+            m=m,
+            v0=1.0,
+            radius=radius,
+            e=e,
+            T=T,
+            geometry="wall",
+            curves=False,
+            **kwargs,
+        )
         es, Ts = run(x.parameters, m=m, v0=1.0, radius=radius, phases=PHASES)
-        tag = name + ({"lammps": " limit_damping", "liggghts": " limitForce"}[engine]
-                      if limit else "")  # fmt: skip
+        tag = name + (
+            {"lammps": " limit_damping", "liggghts": " limitForce"}[engine] if limit else ""
+        )
         print(
             f"| {tag} | {e} | {T:g} | {x.e:.5f} | {es.min():.5f} to {es.max():.5f} | "
             f"{x.T:.5g} | {Ts.min():.5g} to {Ts.max():.5g} | {x.timestep:g} |"

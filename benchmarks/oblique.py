@@ -64,8 +64,19 @@ def _oracle(v_n, v_t, oracle_params, rtol):
     out = []
     for vn, vt in zip(np.atleast_1d(v_n), np.atleast_1d(v_t), strict=True):
         try:
-            o = oblique_oracle(c=c, a=0.0, m=m, R=R, inertia=0.4, v_n=float(vn), v_t=float(vt),
-                               omega=0.0, mu=MU, rtol=rtol, **oracle_params)  # fmt: skip
+            o = oblique_oracle(
+                c=c,
+                a=0.0,
+                m=m,
+                R=R,
+                inertia=0.4,
+                v_n=float(vn),
+                v_t=float(vt),
+                omega=0.0,
+                mu=MU,
+                rtol=rtol,
+                **oracle_params,
+            )
             out.append((o["v_t_out"], o["omega_out"], o["switches"]))
         except (RuntimeError, AssertionError):
             out.append((np.nan, np.nan, -1))
@@ -141,8 +152,9 @@ def _rows(name, params, oracle_params):
     import diffrax as dfx
 
     def e_t(mu, adjoint=None):
-        r = ji.oblique_impact(law, tl.replace(mu=mu), m=m, R=R, v_n=v_n1, v_t=v_t1,
-                              adjoint=adjoint, land_events=True)  # fmt: skip
+        r = ji.oblique_impact(
+            law, tl.replace(mu=mu), m=m, R=R, v_n=v_n1, v_t=v_t1, adjoint=adjoint, land_events=True
+        )
         return r.e_t
 
     grad = jax.jit(jax.grad(e_t))

@@ -40,13 +40,28 @@ def main():
 
     rng = np.random.default_rng(0)
     laws = {
-        "kelvin_voigt": (ji.law("kelvin_voigt", c=1e5, b=1.5), 0.025, 0.005, [1e4, 1e5, 1e6],
-                         [1e7, 1e8]),
-        "tsuji": (ji.law("tsuji", c=4.2e9, b=15.0), 2.6e-4, 2.5e-3, [1e6, 1e7, 1e8],
-                  [1e9, 1.35e10]),
-        "hunt_crossley": (ji.law("hunt_crossley", c=4.2e9, a=0.05), 2.6e-4, 2.5e-3,
-                          [1e6, 1e7, 1e8], [1e9, 1.35e10]),
-    }  # fmt: skip
+        "kelvin_voigt": (
+            ji.law("kelvin_voigt", c=1e5, b=1.5),
+            0.025,
+            0.005,
+            [1e4, 1e5, 1e6],
+            [1e7, 1e8],
+        ),
+        "tsuji": (
+            ji.law("tsuji", c=4.2e9, b=15.0),
+            2.6e-4,
+            2.5e-3,
+            [1e6, 1e7, 1e8],
+            [1e9, 1.35e10],
+        ),
+        "hunt_crossley": (
+            ji.law("hunt_crossley", c=4.2e9, a=0.05),
+            2.6e-4,
+            2.5e-3,
+            [1e6, 1e7, 1e8],
+            [1e9, 1.35e10],
+        ),
+    }
     loads, rows, bad = [load_average()], [], []
     start = time.perf_counter()
     for name, (law, m, R, kts, G_stars) in laws.items():
@@ -73,16 +88,37 @@ def main():
                     ):
                         tl = ji.tangential_law(tname, **{key: 1.0, "mu": 0.1})
                         tl = tl.replace(**{key: k, "mu": mu})
-                        r = oblique_impact(law, tl, m=m, R=R, v_n=a, v_t=b, separation=sep,
-                                           contact_point=share, throw=False)  # fmt: skip
+                        r = oblique_impact(
+                            law,
+                            tl,
+                            m=m,
+                            R=R,
+                            v_n=a,
+                            v_t=b,
+                            separation=sep,
+                            contact_point=share,
+                            throw=False,
+                        )
                         return r.status
 
                     status = np.asarray(jax.jit(jax.vmap(one))(ks, mus, v_n, v_t))
                     failed = np.nonzero(status != ji.Status.separated)[0]
-                    rows.append([name, tname, f"{share:g}", separation, str(status.size),
-                                 str(failed.size)])  # fmt: skip
-                    bad += [(name, tname, share, separation, ks[i], mus[i], angles[i],
-                             ji.Status(int(status[i])).name) for i in failed]  # fmt: skip
+                    rows.append(
+                        [name, tname, f"{share:g}", separation, str(status.size), str(failed.size)]
+                    )
+                    bad += [
+                        (
+                            name,
+                            tname,
+                            share,
+                            separation,
+                            ks[i],
+                            mus[i],
+                            angles[i],
+                            ji.Status(int(status[i])).name,
+                        )
+                        for i in failed
+                    ]
         loads.append(load_average())
     total = sum(int(r[4]) for r in rows)
     text = "\n".join(
@@ -107,7 +143,7 @@ def main():
                     "not separated",
                 ],
                 rows,
-            ),  # fmt: skip
+            ),
             "",
             *([f"- {b}" for b in bad] or ["Every impact separated."]),
             "",

@@ -115,19 +115,19 @@ def _rows(law_name):
             f"{t_one * 1e6:.1f} µs, e error {err_one:.1e}",
             scipy_cell,
             f"{t_scipy / t_one:.0f}x",
-        ],  # fmt: skip
+        ],
         [
             f"{law_name}: per impact, vmap of {speeds.size} speeds ({label})",
             f"{t_many * 1e6:.2f} µs, max e error {err_many:.1e}",
             scipy_cell,
             f"{t_scipy / t_many:.0f}x",
-        ],  # fmt: skip
+        ],
         [
             f"{law_name}: per impact, vmap of {speeds.size} speeds (integrated, diffrax)",
             f"{t_int * 1e6:.1f} µs, max e error {err_int:.1e}",
             scipy_cell,
             f"{t_scipy / t_int:.0f}x",
-        ],  # fmt: skip
+        ],
     ]
 
 

@@ -158,10 +158,27 @@ def measure_cold(repeats):
         "import jax; jax.config.update('jax_enable_x64', True); import jaximpact as ji; "
         "ji.impact(ji.law('hertz_rate', c=2e6, b1=800.0), m=1.0, v0=2.5).e.block_until_ready()",
     ]
-    cli = [python, "-m", "jaximpact._cli", "simulate", "--law", "hertz_rate", "--param",
-           "c=2e6", "b1=800", "--v0", "2.5", "--mass", "1"]  # fmt: skip
-    main_job = [python, "examples/calibrate_e_and_T.py", "--plot",
-                os.path.join(tempfile.gettempdir(), "similarity_bench.png")]  # fmt: skip
+    cli = [
+        python,
+        "-m",
+        "jaximpact._cli",
+        "simulate",
+        "--law",
+        "hertz_rate",
+        "--param",
+        "c=2e6",
+        "b1=800",
+        "--v0",
+        "2.5",
+        "--mass",
+        "1",
+    ]
+    main_job = [
+        python,
+        "examples/calibrate_e_and_T.py",
+        "--plot",
+        os.path.join(tempfile.gettempdir(), "similarity_bench.png"),
+    ]
     rows = []
     for label, command in (
         ("bare JAX process, one array", bare),
@@ -220,7 +237,7 @@ def report(info, loads, cases, fits, cold):
                 ]
                 for r in cases
             ],
-        ),  # fmt: skip
+        ),
         "",
         "Targets (issue 13): one impact at least 300x scipy, a vmapped batch at least 10,000x per "
         "impact, both at an error of at most 1e-9.",
@@ -249,7 +266,7 @@ def report(info, loads, cases, fits, cold):
                 ]
                 for r in fits
             ],
-        ),  # fmt: skip
+        ),
         "",
         "Target: at least 1000x scipy.",
         "",
@@ -269,7 +286,7 @@ def report(info, loads, cases, fits, cold):
                 ]
                 for r in cold
             ],
-        ),  # fmt: skip
+        ),
         "",
         "Targets: one impact in a fresh process at most 1 s more than the bare JAX process, a "
         "cold `jaximpact simulate` at most 1.5 s more, the README's main job under 5 s.",

@@ -262,7 +262,7 @@ def report(results):
         "What the remaining out-of-steps members are (measured on the members listed at the "
         "end of each run):",
         "",
-        "- float64, `hertz_viscous` under `\"penetration\"`, over-damped (beta up to 30): the "
+        '- float64, `hertz_viscous` under `"penetration"`, over-damped (beta up to 30): the '
         "body creeps back on the slow manifold `b v = -c x^1.5`, so `x ~ t^-2` never reaches 0 "
         "(the reference calls it captured) while the fast mode `b/m` keeps the explicit "
         "solver's step small: Tsit5 needs more than the default 4096 steps to reach the rest "
@@ -272,7 +272,7 @@ def report(results):
         "- float32: `rtol`, `atol` and `rest_tol` are raised to 1e-7, 1e-7 and 1e-5 (a warning "
         "says so): at the float64 defaults the step controller chased rounding noise (about 700 "
         "steps per impact instead of 20 to 30) and creeping bodies never met the rest threshold "
-        "(11 of 80 Kelvin-Voigt members out of steps under `\"penetration\"`, 4 Bingham). "
+        '(11 of 80 Kelvin-Voigt members out of steps under `"penetration"`, 4 Bingham). '
         "What is left: the creeping `hertz_viscous` members as in float64 (and one creeping "
         "Kelvin-Voigt member), and heavily damped members whose rebound is below float32's "
         "resolution of a rest (reference e of 2e-4 for `hertz_viscous` under the force "

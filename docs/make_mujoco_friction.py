@@ -38,11 +38,12 @@ if __name__ == "__main__":
     for name, (law, tangential, m, R, v0) in CASES.items():
         x = ji.export(law, "mujoco", m=m, v0=v0, radius=R, tangential=tangential, curves=False)
         damping = -x.parameters["solref"][1]
-        print(f"\n{name}: e = {x.e:.4f}, T = {x.T:.3g} s, step {x.timestep:.3g} s, "
-              f"damping x T = {damping * x.T:.2f}\n")  # fmt: skip
+        print(
+            f"\n{name}: e = {x.e:.4f}, T = {x.T:.3g} s, step {x.timestep:.3g} s, "
+            f"damping x T = {damping * x.T:.2f}\n"
+        )
         print("| angle (deg) | MuJoCo e_t | law's e_t | MuJoCo normal e | MuJoCo spin (rad/s) |")
         print("|---|---|---|---|---|")
-        rows = zip(x.angles, x.e_t_engine, x.e_t_target, x.e_n_engine, x.omega_engine,
-                   strict=True)  # fmt: skip
+        rows = zip(x.angles, x.e_t_engine, x.e_t_target, x.e_n_engine, x.omega_engine, strict=True)
         for angle, e_t, law_e_t, e_n, omega in rows:
             print(f"| {angle:g} | {e_t:.4f} | {law_e_t:.4f} | {e_n:.4f} | {omega:.4g} |")

@@ -37,16 +37,33 @@ G = E / (2 * (1 + NU))
 
 # Chung & Ooi Test 4 reference (Kratos benchmark4_graph1_ref, graph2, graph3 "Al. oxide")
 REF_THETA = [5.17, 10.16, 14.99, 20.06, 25.05, 30.12, 35.03, 40.02, 50, 59.98, 69.96, 80.02, 85.01]
-REF_E_T = [0.948, 0.687, 0.624, 0.616, 0.634, 0.684, 0.737, 0.781, 0.845, 0.893, 0.932, 0.966,
-           0.983]  # fmt: skip
+REF_E_T = [
+    0.948,
+    0.687,
+    0.624,
+    0.616,
+    0.634,
+    0.684,
+    0.737,
+    0.781,
+    0.845,
+    0.893,
+    0.932,
+    0.966,
+    0.983,
+]
 REF_OMEGA = [19, 213, 378, 511, 599, 617, 582, 545, 457, 357, 246, 126, 63]
 REF_ANGLE = [3.8, -1.6, -5.5, -7.5, -7.5, -3.5, 3.4, 11.6, 29.4, 47.8, 64.6, 78.7, 84.5]
 # Kharaz et al. 2001 (Lethe's digitisation: e_t, spin; Kratos': contact-point angle)
-KH_E_T = ([1.84, 3.70, 9.50, 20.01, 30.13, 39.38, 49.69, 60.02],
-          [0.793, 0.745, 0.673, 0.597, 0.688, 0.771, 0.848, 0.901])  # fmt: skip
+KH_E_T = (
+    [1.84, 3.70, 9.50, 20.01, 30.13, 39.38, 49.69, 60.02],
+    [0.793, 0.745, 0.673, 0.597, 0.688, 0.771, 0.848, 0.901],
+)
 KH_OMEGA = ([6.14, 10.99, 21.25, 31.16, 39.14, 50.35, 60.33], [136, 266, 578, 613, 595, 453, 382])
-KH_ANGLE = ([2.10, 3.94, 9.72, 20.31, 30.16, 39.12, 49.51, 59.90, 70.46, 78.86, 84.78],
-            [0.8, 0.8, -1.1, -8.5, -2.6, 9.9, 30.0, 50.0, 66.9, 78.9, 85.7])  # fmt: skip
+KH_ANGLE = (
+    [2.10, 3.94, 9.72, 20.31, 30.16, 39.12, 49.51, 59.90, 70.46, 78.86, 84.78],
+    [0.8, 0.8, -1.1, -8.5, -2.6, 9.9, 30.0, 50.0, 66.9, 78.9, 85.7],
+)
 
 
 def tsuji_damping(e):
@@ -85,9 +102,15 @@ def rigid(degrees):
     sliding_angle = np.rad2deg(np.arctan2(v_t - 3.5 * MU * (1 + E_N) * v_n, E_N * v_n))
     sliding_omega = 2.5 * MU * (1 + E_N) * v_n / R
     rolling_omega = v_t / 1.4 / R
-    return dict(e_t=np.asarray(out["e_t"]), slide=slide, sliding_e_t=sliding_e_t,
-                rolling_e_t=rolling_e_t, sliding_angle=sliding_angle,
-                sliding_omega=sliding_omega, rolling_omega=rolling_omega)  # fmt: skip
+    return dict(
+        e_t=np.asarray(out["e_t"]),
+        slide=slide,
+        sliding_e_t=sliding_e_t,
+        rolling_e_t=rolling_e_t,
+        sliding_angle=sliding_angle,
+        sliding_omega=sliding_omega,
+        rolling_omega=rolling_omega,
+    )
 
 
 def main():
@@ -95,8 +118,10 @@ def main():
     curves = {name: sweep(name, degrees) for name in ("mindlin", "mindlin_force")}
     limits = rigid(degrees)
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
-    styles = {"mindlin": ("C0", "-", "Hertz-Mindlin, displacement history"),
-              "mindlin_force": ("C1", "--", "Hertz-Mindlin, force history")}  # fmt: skip
+    styles = {
+        "mindlin": ("C0", "-", "Hertz-Mindlin, displacement history"),
+        "mindlin_force": ("C1", "--", "Hertz-Mindlin, force history"),
+    }
     for name, (e_t, omega, angle, _) in curves.items():
         color, line, label = styles[name]
         axes[0].plot(degrees, e_t, line, color=color, label=label)
@@ -137,9 +162,11 @@ def main():
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for k, theta in enumerate(REF_THETA):
         d, f = table["mindlin"], table["mindlin_force"]
-        print(f"| {theta:.1f} | {REF_E_T[k]:.3f} | {d[0][k]:.3f} | {f[0][k]:.3f} "
-              f"| {REF_OMEGA[k]} | {d[1][k]:.0f} | {f[1][k]:.0f} | {REF_ANGLE[k]:.1f} "
-              f"| {d[2][k]:.1f} | {f[2][k]:.1f} | {d[3][k]}, {f[3][k]} |")  # fmt: skip
+        print(
+            f"| {theta:.1f} | {REF_E_T[k]:.3f} | {d[0][k]:.3f} | {f[0][k]:.3f} "
+            f"| {REF_OMEGA[k]} | {d[1][k]:.0f} | {f[1][k]:.0f} | {REF_ANGLE[k]:.1f} "
+            f"| {d[2][k]:.1f} | {f[2][k]:.1f} | {d[3][k]}, {f[3][k]} |"
+        )
     for name, (e_t, omega, angle, _) in table.items():
         print(
             f"{name}: max |e_t - ref| = {np.max(np.abs(e_t - REF_E_T)):.4f}, "

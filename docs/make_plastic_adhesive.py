@@ -49,8 +49,13 @@ def main(path=None):
         ratio, restitutions(PLASTIC, M, ratio * v_y, "auto"), label="jaximpact, closed form"
     )
     points = jnp.logspace(-0.3, 3.8, 12)
-    left.semilogx(points, restitutions(PLASTIC, M, points * v_y, "integrate"), "o", mfc="none",
-                  label="jaximpact, integrated")  # fmt: skip
+    left.semilogx(
+        points,
+        restitutions(PLASTIC, M, points * v_y, "integrate"),
+        "o",
+        mfc="none",
+        label="jaximpact, integrated",
+    )
     left.semilogx(ratio, thornton_restitution(ratio), "k:", label="Thornton (1997), formula")
     tail = ratio[ratio > 3]
     left.semilogx(tail, 1.185 * tail**-0.25, "--", color="gray", label="1.185 (v_y/v0)^(1/4)")
@@ -61,10 +66,16 @@ def main(path=None):
         ratio, restitutions(ADHESIVE, M_A, ratio * v_s, "auto"), label="jaximpact, closed form"
     )
     points = jnp.logspace(-0.4, 1.9, 12)
-    right.semilogx(points, restitutions(ADHESIVE, M_A, points * v_s, "integrate"), "o",
-                   mfc="none", label="jaximpact, integrated")  # fmt: skip
-    right.semilogx(ratio, jnp.sqrt(jnp.clip(1 - ratio**-2, 0, 1)), "k:",
-                   label="(1 - (V_s/v0)^2)^(1/2)")  # fmt: skip
+    right.semilogx(
+        points,
+        restitutions(ADHESIVE, M_A, points * v_s, "integrate"),
+        "o",
+        mfc="none",
+        label="jaximpact, integrated",
+    )
+    right.semilogx(
+        ratio, jnp.sqrt(jnp.clip(1 - ratio**-2, 0, 1)), "k:", label="(1 - (V_s/v0)^2)^(1/2)"
+    )
     right.set(xlabel="v0 / V_s", ylabel="e", title="JKR adhesive (R = 2.45 µm, w = 0.2 J/m²)")
     right.legend(fontsize=8)
     fig.tight_layout()

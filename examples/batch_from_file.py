@@ -93,8 +93,10 @@ def plot(out, path):
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for name, colour in (("similarity", "tab:blue"), ("integrated", "tab:orange")):
         rows = out["path"] == name
-        label = {"similarity": "no gravity (universal curves)",
-                 "integrated": "g = 9.81 m/s^2 (integrated)"}[name]  # fmt: skip
+        label = {
+            "similarity": "no gravity (universal curves)",
+            "integrated": "g = 9.81 m/s^2 (integrated)",
+        }[name]
         # law 14, F = c x^1.5 + b1 x^0.5 v: at the scale x* = (m v0^2/c)^(2/5) the damping
         # term over the elastic one is b1 v0 / (c x*) = b1 v0^0.2 / (c^0.6 m^0.4)
         c, b1, m, v0 = (out[k][rows] for k in ("c", "b1", "m", "v0"))

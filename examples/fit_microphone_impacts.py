@@ -148,8 +148,10 @@ def main():
                 sigma = np.median([r["fit"].sigma for r in rows])
                 ratio = sigma / TIMING_NOISE
                 judged = "within" if ratio < 2 else f"{ratio:.1f} times"
-                print(f"  {ball}, {name}: median timing residual {sigma * 1e3:.2f} ms, "
-                      f"{judged} the noise")  # fmt: skip
+                print(
+                    f"  {ball}, {name}: median timing residual {sigma * 1e3:.2f} ms, "
+                    f"{judged} the noise"
+                )
 
     print("\nper drop (first law):")
     name = args.laws[0]

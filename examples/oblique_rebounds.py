@@ -52,8 +52,10 @@ def main():
     print(f"\n35 oblique impacts (one vmap, compiling included): {seconds:.1f} s")
     print("angle (deg)   e_t      spin after (rad/s)   rebound angle of the contact point (deg)")
     for k in range(0, 35, 5):
-        print(f"{degrees[k]:8.1f}   {float(curve.e_t[k]):7.4f}   {float(curve.omega_out[k]):12.1f}"
-              f"   {math.degrees(float(curve.angle_out_contact[k])):14.2f}")  # fmt: skip
+        print(
+            f"{degrees[k]:8.1f}   {float(curve.e_t[k]):7.4f}   {float(curve.omega_out[k]):12.1f}"
+            f"   {math.degrees(float(curve.angle_out_contact[k])):14.2f}"
+        )
 
     # 2. mu and G* back from SYNTHETIC e_t at 8 angles (the law's, plus noise)
     rng = np.random.default_rng(1)
@@ -64,21 +66,36 @@ def main():
     start = time.perf_counter()
     # started from the materials' G* and a guessed mu; start_scan=0: no grid of starts (a
     # start far off may stop in another phase's minimum: leave the default scan on then)
-    fit = ji.fit_oblique(law, truth.replace(mu=0.15), m=M, R=R, v_n=vn8, v_t=vt8, e_t=e_t,
-                         sigma_e_t=np.full(chosen.size, args.noise), free=("G_star", "mu"),
-                         start_scan=0)  # fmt: skip
-    print(f"\nfit to SYNTHETIC e_t at {chosen.size} angles (sigma {args.noise:g}), started from "
-          f"G* = 13.5 GPa, mu = 0.15: {time.perf_counter() - start:.1f} s")  # fmt: skip
+    fit = ji.fit_oblique(
+        law,
+        truth.replace(mu=0.15),
+        m=M,
+        R=R,
+        v_n=vn8,
+        v_t=vt8,
+        e_t=e_t,
+        sigma_e_t=np.full(chosen.size, args.noise),
+        free=("G_star", "mu"),
+        start_scan=0,
+    )
+    print(
+        f"\nfit to SYNTHETIC e_t at {chosen.size} angles (sigma {args.noise:g}), started from "
+        f"G* = 13.5 GPa, mu = 0.15: {time.perf_counter() - start:.1f} s"
+    )
     for name, true in (("G_star", G_STAR), ("mu", MU)):
         value, error = float(fit.params[name]), float(fit.stderr[name])
-        print(f"  {name:6s} = {value:.4g} +- {error:.2g} (made with {true:.4g}: "
-              f"{(value - true) / error:+.1f} standard errors off)")  # fmt: skip
-    print(f"  rms of e_t {float(fit.rms_e_t):.4f}, "
-          f"reduced chi-square {float(fit.reduced_chi2):.2f}")  # fmt: skip
+        print(
+            f"  {name:6s} = {value:.4g} +- {error:.2g} (made with {true:.4g}: "
+            f"{(value - true) / error:+.1f} standard errors off)"
+        )
+    print(
+        f"  rms of e_t {float(fit.rms_e_t):.4f}, reduced chi-square {float(fit.reduced_chi2):.2f}"
+    )
 
     # 3. to LAMMPS: the same Mindlin law, and the e_t LAMMPS realises at its step
-    x = ji.export(law, "lammps", m=M, v0=SPEED, radius=R, geometry="wall",
-                  tangential=fit.tangential)  # fmt: skip
+    x = ji.export(
+        law, "lammps", m=M, v0=SPEED, radius=R, geometry="wall", tangential=fit.tangential
+    )
     print(f"\nLAMMPS: {x.parameters['fix_wall']}")
     print("angle (deg)   law's e_t   LAMMPS realises")
     for angle, want, got in zip(x.angles, x.e_t_target, x.e_t_engine, strict=True):

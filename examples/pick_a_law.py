@@ -100,9 +100,10 @@ def main():
     for r in ranking:
         units = UNITS[r.name]
         params = ", ".join(
-            f"{k} = {float(v):.4g} {units.get(k, '')}".rstrip() for k, v in r.fit.params.items()
+            f"{k} = {float(v):.4g} {units.get(k, '')}".rstrip()
+            for k, v in r.fit.params.items()
             if k in r.fit.free
-        )  # fmt: skip
+        )
         print(f"{r.name:<15} {r.reduced_chi2:8.2f} {r.p_value:8.2g} {r.aic:8.1f}   {params}")
     best = ranking[0]
     print(

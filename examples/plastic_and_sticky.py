@@ -38,23 +38,40 @@ def main():
     speeds = np.array([0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0])  # m/s
     e = np.asarray(jax.vmap(lambda v: ji.impact(steel, m=m, v0=v).e)(speeds))
     for v, e_v in zip(speeds, e, strict=True):
-        print(f"  v0 = {v:4g} m/s: e = {e_v:.4f}  (Thornton's 1.185 (v_y/v0)^(1/4) = "
-              f"{1.185 * (v_y / v) ** 0.25:.4f})")  # fmt: skip
+        print(
+            f"  v0 = {v:4g} m/s: e = {e_v:.4f}  (Thornton's 1.185 (v_y/v0)^(1/4) = "
+            f"{1.185 * (v_y / v) ** 0.25:.4f})"
+        )
 
     # the yield stress back from SYNTHETIC e(v): the law's, plus noise
     rng = np.random.default_rng(0)
     measured = e + rng.normal(0.0, args.noise, e.size)
-    fit = ji.calibrate(steel.replace(x_y=1e-6), m=m, v0=speeds, e=measured,
-                       sigma_e=np.full(e.size, args.noise), free=("x_y",))  # fmt: skip
+    fit = ji.calibrate(
+        steel.replace(x_y=1e-6),
+        m=m,
+        v0=speeds,
+        e=measured,
+        sigma_e=np.full(e.size, args.noise),
+        free=("x_y",),
+    )
     p_y = ji.yield_pressure(float(fit.params["x_y"]), E=E, nu=nu, R=R, E2=math.inf)
-    print(f"  fitted to SYNTHETIC e(v) (sigma {args.noise:g}): yield stress Y = p_y / 1.6 = "
-          f"{p_y / 1.6 / 1e9:.3f} GPa (made with {Y / 1e9:g}), reduced chi-square "
-          f"{float(fit.reduced_chi2):.2f}")  # fmt: skip
-    ranking = ji.compare_laws(m=m, v0=speeds, e=measured, sigma_e=np.full(e.size, args.noise),
-                              laws=("thornton", "hertz_rate", "hunt_crossley", "kelvin_voigt"),
-                              progress=False)  # fmt: skip
-    print("  ranked by AIC: " + ", ".join(
-        f"{r.name} (reduced chi-square {float(r.reduced_chi2):.3g})" for r in ranking))  # fmt: skip
+    print(
+        f"  fitted to SYNTHETIC e(v) (sigma {args.noise:g}): yield stress Y = p_y / 1.6 = "
+        f"{p_y / 1.6 / 1e9:.3f} GPa (made with {Y / 1e9:g}), reduced chi-square "
+        f"{float(fit.reduced_chi2):.2f}"
+    )
+    ranking = ji.compare_laws(
+        m=m,
+        v0=speeds,
+        e=measured,
+        sigma_e=np.full(e.size, args.noise),
+        laws=("thornton", "hertz_rate", "hunt_crossley", "kelvin_voigt"),
+        progress=False,
+    )
+    print(
+        "  ranked by AIC: "
+        + ", ".join(f"{r.name} (reduced chi-square {float(r.reduced_chi2):.3g})" for r in ranking)
+    )
 
     # 2. an ammonium fluorescein microsphere on silicon (Thornton & Ning's particle)
     Rp, rho, w = 2.45e-6, 1350.0, 0.2  # m, kg/m^3, J/m^2 (the work of adhesion)
@@ -68,8 +85,10 @@ def main():
     impacts = jax.vmap(lambda v: ji.impact(sticky, m=mp, v0=v))(fast)
     for v, e_v, status in zip(fast, np.asarray(impacts.e), np.asarray(impacts.status), strict=True):
         exact = math.sqrt(max(1.0 - (V_s / v) ** 2, 0.0))
-        print(f"  v0 = {v:3g} m/s: e = {e_v:.4f} ({ji.Status(int(status)).name}; "
-              f"JKR's (1 - (V_s/v0)^2)^(1/2) = {exact:.4f})")  # fmt: skip
+        print(
+            f"  v0 = {v:3g} m/s: e = {e_v:.4f} ({ji.Status(int(status)).name}; "
+            f"JKR's (1 - (V_s/v0)^2)^(1/2) = {exact:.4f})"
+        )
 
     if args.plot:
         import matplotlib

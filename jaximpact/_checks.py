@@ -114,8 +114,9 @@ class MemberChecks:
         invalid = self.invalid
         # 0 for a valid member (value and derivatives unchanged); NaN with NaN derivatives
         # with respect to the checked values for an invalid one
-        moved = sum(jnp.sum(jnp.asarray(v, float) - jax.lax.stop_gradient(v))
-                    for v in self._checked)  # fmt: skip
+        moved = sum(
+            jnp.sum(jnp.asarray(v, float) - jax.lax.stop_gradient(v)) for v in self._checked
+        )
         poison = jnp.where(invalid, jnp.nan, 0.0) * moved
 
         def blank(leaf):

@@ -147,8 +147,7 @@ def output_lock(path):
             holder = _holder(fd)
             os.close(fd)
             raise ValueError(
-                f"another run{holder} is writing {path}; wait for it or choose another "
-                "output file"
+                f"another run{holder} is writing {path}; wait for it or choose another output file"
             ) from None
         try:  # the file locked is still the one under the name (not one its holder removed)
             if os.path.samestat(os.fstat(fd), os.stat(name)):
@@ -235,9 +234,7 @@ def open_text(path):
     if encoding is not None:  # the codec reads the mark: its byte order, then drops it
         return open(path, encoding=encoding, newline=None)
     if b"\0" in head:
-        raise NotText(
-            "not a text file (a NUL byte in it; save the table as CSV, UTF-8 or UTF-16)"
-        )
+        raise NotText("not a text file (a NUL byte in it; save the table as CSV, UTF-8 or UTF-16)")
     return open(path, encoding="utf-8-sig", errors="surrogateescape", newline=None)
 
 

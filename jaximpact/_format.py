@@ -5,8 +5,17 @@ the library's tables and reports, the results' `repr`, `summary()` and `to_dict(
 import math
 
 _MULTIPLE_UNITS = {"N", "Pa", "W"}
-_PREFIXES = [(1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, ""), (1e-3, "m"), (1e-6, "µ"), (1e-9, "n"),
-             (1e-12, "p"), (1e-15, "f")]  # fmt: skip
+_PREFIXES = [
+    (1e9, "G"),
+    (1e6, "M"),
+    (1e3, "k"),
+    (1.0, ""),
+    (1e-3, "m"),
+    (1e-6, "µ"),
+    (1e-9, "n"),
+    (1e-12, "p"),
+    (1e-15, "f"),
+]
 
 
 def format_number(value, digits: int = 6) -> str:

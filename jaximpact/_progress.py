@@ -228,4 +228,3 @@ def metered(progress, total: int, label: str):
         yield meter
     finally:
         meter.close()
-

@@ -82,10 +82,14 @@ SLOW_BY_COST = (
     # a bounce fit and its Laplace posterior, one module fixture: about 50 CPU s
     *(
         f"tests/posterior/test_bounce_posterior.py::{name}"
-        for name in ("test_laplace_agrees_with_the_fit", "test_record_text_and_dict",
-                     "test_bands_of_single_impacts", "test_bad_priors_and_unsupported_fits",
-                     "test_cli_fit_posterior")
-    ),  # fmt: skip
+        for name in (
+            "test_laplace_agrees_with_the_fit",
+            "test_record_text_and_dict",
+            "test_bands_of_single_impacts",
+            "test_bad_priors_and_unsupported_fits",
+            "test_cli_fit_posterior",
+        )
+    ),
     "tests/solve/test_gradients.py::test_contact_time_derivative_at_zero_damping",
     "tests/fit/test_fit_bounces.py::test_cli_refuses_impact_times_going_backwards",
     "tests/laws/test_closed_forms_linear.py::test_matches_scipy",
@@ -97,11 +101,18 @@ SLOW_BY_COST = (
     "tests/batch/test_carried_columns.py::test_text_columns_are_carried_through_with_a_users_law",
     *(
         f"tests/engines/test_recorded_exports.py::test_the_export_is_as_recorded[{case}]"
-        for case in ("mujoco targets", "lammps spheres", "lammps dmt spheres",
-                     "lammps jkr_viscoelastic spheres", "lammps dmt wall",
-                     "lammps jkr_viscoelastic wall")
-    ),  # fmt: skip
+        for case in (
+            "mujoco targets",
+            "lammps spheres",
+            "lammps dmt spheres",
+            "lammps jkr_viscoelastic spheres",
+            "lammps dmt wall",
+            "lammps jkr_viscoelastic wall",
+        )
+    ),
 )
+
+
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
     for item in items:

@@ -20,6 +20,7 @@ over-damped Kelvin-Voigt) or reaching the horizon is reported as "captured".
 For stuck/captured e = 0 and T is the time the body came to rest (inf if it only
 approaches rest asymptotically).
 """
+
 from __future__ import annotations
 
 import math
@@ -44,8 +45,13 @@ def _law(name, prm):
         "hertz_viscous": lambda: (1.5, prm["b"], 0.0, 0.0, 0.0),
         "hertz_modified": lambda: (1.5, prm["b"], 1.0, 0.0, 0.0),
         "hertz_rate": lambda: (1.5, prm["b1"], 0.5, 0.0, 0.0),
-        "hunt_crossley": lambda: (prm.get("n", 1.5), 1.5 * prm["a"] * c,
-                                  prm.get("n", 1.5), 0.0, 0.0),
+        "hunt_crossley": lambda: (
+            prm.get("n", 1.5),
+            1.5 * prm["a"] * c,
+            prm.get("n", 1.5),
+            0.0,
+            0.0,
+        ),
     }
     if name not in table:
         raise ValueError(f"unknown law {name!r}")
@@ -82,7 +88,7 @@ def _solve(name, params, m, v0, separation, g, rtol):
     law = None if maxwell else _law(name, params)
     n = 1.0 if maxwell else law[1]
     xs = v0 * math.sqrt(m / c) if maxwell else (m * v0**2 / c) ** (1.0 / (n + 1.0))
-    ts, Fs = xs / v0, c * xs**n                       # time and force scales
+    ts, Fs = xs / v0, c * xs**n  # time and force scales
     atol = 1e-2 * rtol * np.array([xs, v0] + ([Fs] if maxwell else []))
     kw = dict(method="DOP853", rtol=rtol, atol=atol, dense_output=True)
 
@@ -108,8 +114,18 @@ def _solve(name, params, m, v0, separation, g, rtol):
         s_, q_ = 0.5 * mu, math.sqrt(max(0.25 * mu * mu - 1.0, 1e-300))
         tau_p = math.atanh(q_ / s_) / q_ if q_ > 1e-8 else 1.0 / s_
         phi_p = math.exp(-s_ * tau_p) * (math.sinh(q_ * tau_p) / q_ if q_ > 1e-8 else tau_p)
-        return dict(x_max=mu * xs, t_max=math.inf, e=0.0, T=math.inf, status="captured",
-                    F_max=phi_p * c * xs), None, None
+        return (
+            dict(
+                x_max=mu * xs,
+                t_max=math.inf,
+                e=0.0,
+                T=math.inf,
+                status="captured",
+                F_max=phi_p * c * xs,
+            ),
+            None,
+            None,
+        )
 
     # ---- phase 1: compression, until v = 0 ------------------------------------
     y0 = [0.0, v0] + ([0.0] if maxwell else [])
@@ -132,7 +148,7 @@ def _solve(name, params, m, v0, separation, g, rtol):
             vals.append(np.max(F_of(yy, 1 if sol is s1 else -1)))
         return float(max(vals))
 
-    if F_of(ytop, -1) - m * g <= 0.0:                 # cannot rebound: stuck at x_max
+    if F_of(ytop, -1) - m * g <= 0.0:  # cannot rebound: stuck at x_max
         # (without a dry force: over-damped Maxwell, whose speed and force only decay
         # towards 0 together; held without a dry force is a capture)
         out.update(e=0.0, T=t_max, status="stuck" if dry else "captured", F_max=fmax([s1]))
@@ -147,13 +163,14 @@ def _solve(name, params, m, v0, separation, g, rtol):
         _, _, d, p, _, pr = law
         if pr > 0.0 or p == 0.0 or d == 0.0:
             sep = lambda t, y, s: _force(law, y[0], y[1], s) / Fs
-        elif n == p:                                  # F = x^p (c + d v), Hunt-Crossley type:
+        elif n == p:  # F = x^p (c + d v), Hunt-Crossley type:
             # m (c + d v)' = d (m g - x^p (c + d v)), so c + d v only decays towards 0 while
             # x > 0 (its sign there is rounding noise): the force vanishes at x = 0 only
             sep = lambda t, y, s: y[0] / xs
-        else:                                         # F = x^p (c x^(n-p) + d v)
-            sep = lambda t, y, s: min(y[0] / xs,
-                                      (c * _pow(y[0], n - p) + d * y[1]) / (c * xs ** (n - p)))
+        else:  # F = x^p (c x^(n-p) + d v)
+            sep = lambda t, y, s: min(
+                y[0] / xs, (c * _pow(y[0], n - p) + d * y[1]) / (c * xs ** (n - p))
+            )
     events = [event(sep, -1), event(lambda t, y, s: y[1] / v0, 1)]
     if separation == "penetration":
         events.append(event(lambda t, y, s: max(y[0] / x_max, -y[1] / v0) - _CAPTURE_TOL, -1))
@@ -166,14 +183,22 @@ def _solve(name, params, m, v0, separation, g, rtol):
         out.update(e=-v_out / v0, T=float(s2.t_events[0][0]), status="separated")
     elif s2.t_events[1].size:
         out.update(e=0.0, T=float(s2.t_events[1][0]), status="stuck" if dry else "captured")
-    else:                                             # asymptotic rest or horizon
+    else:  # asymptotic rest or horizon
         out.update(e=0.0, T=math.inf, status="captured")
     out["F_max"] = fmax([s1, s2])
     return out, s1, s2
 
 
-def reference_impact(name: str, params: dict, *, m: float, v0: float,
-                     separation: str = "force", g: float = 0.0, rtol: float = 1e-12) -> dict:
+def reference_impact(
+    name: str,
+    params: dict,
+    *,
+    m: float,
+    v0: float,
+    separation: str = "force",
+    g: float = 0.0,
+    rtol: float = 1e-12,
+) -> dict:
     """returns dict(e=..., T=..., x_max=..., t_max=..., F_max=...,
     status="separated"|"stuck"|"captured")"""
     return _solve(name, params, m, v0, separation, g, rtol)[0]
@@ -208,15 +233,19 @@ if __name__ == "__main__":
         ("hunt_crossley", dict(c=2e6, a=0.1)),
         ("maxwell", dict(c=2e6, b=2000)),
     ]
-    print(f"{'law':22s} {'params':26s} {'sep':11s} {'e':>17s} {'T':>22s} "
-          f"{'x_max':>22s} {'F_max':>12s} status")
+    print(
+        f"{'law':22s} {'params':26s} {'sep':11s} {'e':>17s} {'T':>22s} "
+        f"{'x_max':>22s} {'F_max':>12s} status"
+    )
     res = {}
     for name, prm in cases:
         for sep in ("force", "penetration"):
             r = reference_impact(name, prm, m=m, v0=v0, separation=sep)
             res[name, tuple(prm.items()), sep] = r
-            print(f"{name:22s} {str(prm):26s} {sep:11s} {r['e']:17.14f} {r['T']:22.16e} "
-                  f"{r['x_max']:22.16e} {r['F_max']:12.6e} {r['status']}")
+            print(
+                f"{name:22s} {str(prm):26s} {sep:11s} {r['e']:17.14f} {r['T']:22.16e} "
+                f"{r['x_max']:22.16e} {r['F_max']:12.6e} {r['status']}"
+            )
 
     def check(label, got, want, tol):
         err = abs(got / want - 1.0)
@@ -238,11 +267,16 @@ if __name__ == "__main__":
     check("maxwell force T", mx["T"], 2 * math.pi * b * math.sqrt(c * m) / (c * q), 1e-10)
     alpha = 1.5 * 0.1 * v0
     rhs_hc = alpha - math.log1p(alpha)
-    e_hc = brentq(lambda e: -alpha * e - math.log1p(-alpha * e) - rhs_hc, 1e-12, 1.0,
-                  xtol=1e-16, rtol=1e-15)
+    e_hc = brentq(
+        lambda e: -alpha * e - math.log1p(-alpha * e) - rhs_hc, 1e-12, 1.0, xtol=1e-16, rtol=1e-15
+    )
     for sep in ("force", "penetration"):
-        check(f"hunt_crossley {sep} e", res["hunt_crossley", (("c", 2e6), ("a", 0.1)), sep]["e"],
-              e_hc, 1e-10)
+        check(
+            f"hunt_crossley {sep} e",
+            res["hunt_crossley", (("c", 2e6), ("a", 0.1)), sep]["e"],
+            e_hc,
+            1e-10,
+        )
     od = dict(c=1e4, b=1000)
     rp = reference_impact("kelvin_voigt", od, m=1.0, v0=1.0, separation="penetration")
     rf = reference_impact("kelvin_voigt", od, m=1.0, v0=1.0, separation="force")
@@ -250,7 +284,8 @@ if __name__ == "__main__":
     print(f"  over-damped KV force:       {rf}")
     assert rp["status"] == "captured" and rp["e"] == 0.0
     assert rf["status"] == "separated" and math.isfinite(rf["T"]) and rf["e"] > 0
-    xs, vs = reference_trajectory("kelvin_voigt", dict(c=2e6, b=400), m=m, v0=v0,
-                                  ts=np.linspace(0, kv("force")["T"], 5))
+    xs, vs = reference_trajectory(
+        "kelvin_voigt", dict(c=2e6, b=400), m=m, v0=v0, ts=np.linspace(0, kv("force")["T"], 5)
+    )
     print(f"  trajectory x={xs}\n             v={vs}")
     print("all checks passed")

@@ -103,11 +103,15 @@ def test_mujoco_from_targets_needs_no_mass_because_solref_is_per_unit_mass(m):
 
 def test_the_mass_changes_what_the_engines_are_given():
     """Why it is asked for: Chrono's and Yade's inputs scale with m (E and density)."""
-    a, b = (ji.export(None, "chrono", m=m, v0=1.0, e=0.5, T=1e-3, radius=0.01, curves=False)
-            for m in (0.05, 0.1))  # fmt: skip
+    a, b = (
+        ji.export(None, "chrono", m=m, v0=1.0, e=0.5, T=1e-3, radius=0.01, curves=False)
+        for m in (0.05, 0.1)
+    )
     assert b.parameters["SetYoungModulus"] == pytest.approx(2 * a.parameters["SetYoungModulus"])
-    a, b = (ji.export(None, "yade", m=m, v0=1.0, e=0.5, T=1e-3, radius=0.01, curves=False)
-            for m in (0.05, 0.1))  # fmt: skip
+    a, b = (
+        ji.export(None, "yade", m=m, v0=1.0, e=0.5, T=1e-3, radius=0.01, curves=False)
+        for m in (0.05, 0.1)
+    )
     assert b.parameters["density"] == pytest.approx(2 * a.parameters["density"])
 
 
@@ -144,8 +148,13 @@ def test_check_rows_refuses_the_first_row_where_a_column_and_an_option_disagree(
 def test_check_rows_separation_column_against_its_option():
     values = {"separation": np.array(["force", "penetration"], object)}
     with pytest.raises(ValueError, match="line 3, column separation: .*--separation"):
-        check_rows("hertz_rate", values, {"c": 1.0, "b1": 1.0, "m": 1.0, "v0": 1.0}, _where,
-                   {"separation": "force"})  # fmt: skip
+        check_rows(
+            "hertz_rate",
+            values,
+            {"c": 1.0, "b1": 1.0, "m": 1.0, "v0": 1.0},
+            _where,
+            {"separation": "force"},
+        )
 
 
 @pytest.fixture
@@ -173,14 +182,26 @@ def test_cli_batch_refuses_a_column_that_disagrees_with_an_option(bodies, option
 
 def test_batch_file_refuses_the_same_from_python(bodies):
     with pytest.raises(ValueError, match="column m: m = 2.0 disagrees with --mass \\(m=\\) 1"):
-        ji.batch_file(bodies, bodies.parent / "o.csv", "hertz_rate", params={"b1": 800.0},
-                      m=1.0, progress=False)  # fmt: skip
+        ji.batch_file(
+            bodies,
+            bodies.parent / "o.csv",
+            "hertz_rate",
+            params={"b1": 800.0},
+            m=1.0,
+            progress=False,
+        )
 
 
 def test_batch_file_takes_a_column_that_agrees_with_its_option(bodies):
     out = bodies.parent / "o.csv"
-    result = ji.batch_file(bodies, out, "hertz_rate", params={"b1": 800.0, "c": 2e6},
-                           progress=False, separation="force")  # fmt: skip
+    result = ji.batch_file(
+        bodies,
+        out,
+        "hertz_rate",
+        params={"b1": 800.0, "c": 2e6},
+        progress=False,
+        separation="force",
+    )
     assert result.rows == 2 and out.exists()
 
 
@@ -197,9 +218,13 @@ def test_batch_file_takes_a_column_that_agrees_with_its_option(bodies):
 def test_unrealised_says_why_exactly_when_a_criterion_fails(e, T, steps):
     target_e, target_T = 0.5, 1e-3
     why = _stepping.unrealised(
-        e, T, target_e=target_e, target_T=target_T, steps_per_contact=steps,
+        e,
+        T,
+        target_e=target_e,
+        target_T=target_T,
+        steps_per_contact=steps,
         parameters={"k": 1.0, "solref": [0.1, 1.0]},
-    )  # fmt: skip
+    )
     impact = math.isfinite(e) and math.isfinite(T) and 0 <= e <= 1.005 and T > 0
     resolved = steps is None or steps >= _stepping.RESOLVED_STEPS
     near = impact and abs(e / target_e - 1) <= 0.05 and abs(T / target_T - 1) <= 0.05
@@ -208,8 +233,14 @@ def test_unrealised_says_why_exactly_when_a_criterion_fails(e, T, steps):
 
 
 def test_unrealised_refuses_a_parameter_that_is_not_finite():
-    why = _stepping.unrealised(0.5, 1e-3, target_e=0.5, target_T=1e-3, steps_per_contact=100,
-                               parameters={"solref": [float("nan"), 1.0]})  # fmt: skip
+    why = _stepping.unrealised(
+        0.5,
+        1e-3,
+        target_e=0.5,
+        target_T=1e-3,
+        steps_per_contact=100,
+        parameters={"solref": [float("nan"), 1.0]},
+    )
     assert "solref is not a finite number" in why
 
 
@@ -292,18 +323,45 @@ def test_cli_laws_fits_the_terminal_and_json_stays_full(capsys, monkeypatch):
 
 def _bench_data(n, cache="/root/.cache/jaximpact/jax-xla"):
     names = ["kelvin_voigt", "kelvin_voigt (integrate)", "maxwell", "hertz_rate", "hunt_crossley"]
-    row = dict(path="integrated", err_e=1.2e-12, err_T=3.4e-11, single_s=2.3e-5, compile_s=1.5,
-               batch_s=1.1e-6, batch_compile_s=2.2, scipy_rtol=1e-9, scipy_err_e=5e-10,
-               scipy_s=3.5e-3, ratio_single=152.0, ratio_batch=3181.0, target_single_met=True,
-               target_batch_met=False, batch_size=1000, rounds=7)  # fmt: skip
-    machine = dict(cpu_count=2, processor="x86_64", jax="0.10.2", backend="cpu", scipy="1.16",
-                   python="3.12.3", load_average="1.2, 1.0, 0.9", load_average_end="1.5, 1.1",
-                   compilation_cache=cache)  # fmt: skip
-    euler = dict(dt=2e-5, law="hertz_rate", e=0.83, e_ref=0.84, err_e=1e-2, err_T=1e-3,
-                 single_s=0.2)  # fmt: skip
-    return dict(machine=machine, conditions=dict(quick=False, m=1.0, v0=2.5),
-                rows=[dict(row, case=names[i % 5]) for i in range(n)],
-                targets=dict(error_e=1e-13), euler=euler)  # fmt: skip
+    row = dict(
+        path="integrated",
+        err_e=1.2e-12,
+        err_T=3.4e-11,
+        single_s=2.3e-5,
+        compile_s=1.5,
+        batch_s=1.1e-6,
+        batch_compile_s=2.2,
+        scipy_rtol=1e-9,
+        scipy_err_e=5e-10,
+        scipy_s=3.5e-3,
+        ratio_single=152.0,
+        ratio_batch=3181.0,
+        target_single_met=True,
+        target_batch_met=False,
+        batch_size=1000,
+        rounds=7,
+    )
+    machine = dict(
+        cpu_count=2,
+        processor="x86_64",
+        jax="0.10.2",
+        backend="cpu",
+        scipy="1.16",
+        python="3.12.3",
+        load_average="1.2, 1.0, 0.9",
+        load_average_end="1.5, 1.1",
+        compilation_cache=cache,
+    )
+    euler = dict(
+        dt=2e-5, law="hertz_rate", e=0.83, e_ref=0.84, err_e=1e-2, err_T=1e-3, single_s=0.2
+    )
+    return dict(
+        machine=machine,
+        conditions=dict(quick=False, m=1.0, v0=2.5),
+        rows=[dict(row, case=names[i % 5]) for i in range(n)],
+        targets=dict(error_e=1e-13),
+        euler=euler,
+    )
 
 
 @settings(max_examples=60, deadline=None)
@@ -330,9 +388,10 @@ def test_format_table_fits_where_it_can_and_loses_no_word(data, columns, n_rows,
     cell = st.lists(_WORD, min_size=1, max_size=4).map(" ".join)
     header = data.draw(st.lists(cell, min_size=columns, max_size=columns))
     rows = data.draw(
-        st.lists(st.lists(cell, min_size=columns, max_size=columns), min_size=n_rows,
-                 max_size=n_rows)
-    )  # fmt: skip
+        st.lists(
+            st.lists(cell, min_size=columns, max_size=columns), min_size=n_rows, max_size=n_rows
+        )
+    )
     wrap = data.draw(st.lists(st.integers(0, columns - 1), unique=True, max_size=columns))
     lines = format_table(header, rows, width=width, wrap=wrap)
     dashes = {"-" * k for k in range(1, 200)}
@@ -341,10 +400,12 @@ def test_format_table_fits_where_it_can_and_loses_no_word(data, columns, n_rows,
     # fits wherever the first column beside any other one, each narrowed as far as it
     # goes (a cell of free text to its longest word, a header to its longest word), does
     least = [
-        max([max(map(len, r[i].split())) if i in wrap else len(r[i]) for r in rows]
-            + [max(map(len, header[i].split()))])
+        max(
+            [max(map(len, r[i].split())) if i in wrap else len(r[i]) for r in rows]
+            + [max(map(len, header[i].split()))]
+        )
         for i in range(columns)
-    ]  # fmt: skip
+    ]
     if all(least[0] + 2 + least[i] <= width for i in range(1, columns)) and least[0] <= width:
         assert max(map(len, lines)) <= width
 
@@ -372,7 +433,19 @@ def test_simulate_sweeps_several_speeds(capsys, monkeypatch):
 
 
 def test_simulate_sweep_checks_every_speed_first(capsys):
-    argv = ["simulate", "--mass", "1", "--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "1", "-2"]
+    argv = [
+        "simulate",
+        "--mass",
+        "1",
+        "--law",
+        "hertz_rate",
+        "--param",
+        "c=2e6",
+        "b1=800",
+        "--v0",
+        "1",
+        "-2",
+    ]
     assert_one_line_error(*run_cli(capsys, argv), contains="--v0 -2: the impact speed v0")
 
 
@@ -401,8 +474,20 @@ def test_calibrate_json_then_export_from_it(tmp_path, capsys):
     """The round trip of the issue, on calibrate's own JSON: the export's target is the
     fitted law's e and T at the fit's mass and speed, and equals the same export typed
     out by hand."""
-    argv = ["calibrate", "--law", "hertz_rate", "--mass", "0.05", "--v0", "2.5", "--e",
-            "0.85", "--T", "7.8e-3", "--json"]  # fmt: skip
+    argv = [
+        "calibrate",
+        "--law",
+        "hertz_rate",
+        "--mass",
+        "0.05",
+        "--v0",
+        "2.5",
+        "--e",
+        "0.85",
+        "--T",
+        "7.8e-3",
+        "--json",
+    ]
     status, out, err = run_cli(capsys, argv)
     assert status == 0, err
     path = tmp_path / "fit.json"
@@ -417,13 +502,30 @@ def test_calibrate_json_then_export_from_it(tmp_path, capsys):
 
 def test_export_from_a_fit_is_the_export_of_its_law(tmp_path, capsys):
     path = _fit(tmp_path)
-    status, out, err = run_cli(capsys, ["export", "lammps", "--from", path, "--radius", "0.01",
-                                        "--json", "--timestep", "1e-5"])  # fmt: skip
+    status, out, err = run_cli(
+        capsys,
+        ["export", "lammps", "--from", path, "--radius", "0.01", "--json", "--timestep", "1e-5"],
+    )
     assert status == 0, err
     fit = json.loads(open(path).read())
-    by_hand = ["export", "--engine", "lammps", "--law", "hertz_rate", "--param",
-               *(f"{k}={v!r}" for k, v in fit["params"].items()), "--mass", "0.05", "--v0",
-               "2.5", "--radius", "0.01", "--json", "--timestep", "1e-5"]  # fmt: skip
+    by_hand = [
+        "export",
+        "--engine",
+        "lammps",
+        "--law",
+        "hertz_rate",
+        "--param",
+        *(f"{k}={v!r}" for k, v in fit["params"].items()),
+        "--mass",
+        "0.05",
+        "--v0",
+        "2.5",
+        "--radius",
+        "0.01",
+        "--json",
+        "--timestep",
+        "1e-5",
+    ]
     status, again, err = run_cli(capsys, by_hand)
     assert status == 0, err
     a, b = json.loads(out), json.loads(again)
@@ -449,8 +551,9 @@ def test_export_from_a_fit_is_the_export_of_its_law(tmp_path, capsys):
         (dict(separation="penetration"), [], "fitted with separation 'penetration'"),
     ],
 )
-def test_export_from_refuses_missing_and_mismatched_fields(tmp_path, capsys, changes, argv,
-                                                           contains):  # fmt: skip
+def test_export_from_refuses_missing_and_mismatched_fields(
+    tmp_path, capsys, changes, argv, contains
+):
     path = _fit(tmp_path, **changes)
     status, out, err = run_cli(capsys, ["export", "mujoco", "--from", path, *argv])
     assert_one_line_error(status, out, err, contains=contains)
@@ -474,8 +577,17 @@ def test_export_from_a_ranking_takes_its_best_or_the_law_named(tmp_path, capsys)
     best = {"law": "hertz_rate", "params": {"c": 1.02e5, "b1": 36.8}, "rows": [{"v0": 2.5}]}
     other = {"law": "kelvin_voigt", "params": {"c": 5e3, "b": 2.0}, "rows": [{"v0": 2.5}]}
     path = tmp_path / "all.json"
-    path.write_text(json.dumps({"m": 0.05, "separation": "force", "g": 0.0,
-                                "best": "hertz_rate", "ranking": [best, other]}))  # fmt: skip
+    path.write_text(
+        json.dumps(
+            {
+                "m": 0.05,
+                "separation": "force",
+                "g": 0.0,
+                "best": "hertz_rate",
+                "ranking": [best, other],
+            }
+        )
+    )
     status, out, err = run_cli(capsys, ["export", "mujoco", "--from", str(path), "--json"])
     assert status == 0, err
     assert json.loads(out)["target_e"] == pytest.approx(

@@ -89,8 +89,13 @@ def _refused(name: str, key: str, value: float) -> bool:
     Thornton's yield overlap and the adhesive laws' radius > 0."""
     if not math.isfinite(value):
         return True
-    positive = {"maxwell": ("b",), "thornton": ("x_y",), "jkr": ("R",), "dmt": ("R",),
-                "jkr_viscoelastic": ("R",)}.get(name, ())  # fmt: skip
+    positive = {
+        "maxwell": ("b",),
+        "thornton": ("x_y",),
+        "jkr": ("R",),
+        "dmt": ("R",),
+        "jkr_viscoelastic": ("R",),
+    }.get(name, ())
     if key in ("c", "n") or key in positive:
         return value <= 0
     if key == "e_nominal":
@@ -340,9 +345,12 @@ def test_batch_rows_float64_cannot_hold_get_a_status(v0, c):
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         out = ji.impact_batch(
-            "hertz_rate", {"c": np.asarray(c), "b1": 800.0}, m=1.0, v0=np.asarray(v0),
+            "hertz_rate",
+            {"c": np.asarray(c), "b1": 800.0},
+            m=1.0,
+            v0=np.asarray(v0),
             progress=False,
-        )  # fmt: skip
+        )
     invalid = out["status"] == ji.Status.invalid
     for key in ("e", "T", "x_max", "F_max"):
         assert np.all(np.isfinite(out[key][~invalid])), (key, out)
@@ -543,7 +551,9 @@ def test_cli_simulate_answers_or_says_why(capsys, c, v0):
     status, out, err = run_cli(
         capsys,
         [
-            "simulate", "--mass", "1",
+            "simulate",
+            "--mass",
+            "1",
             "--law",
             "hertz_rate",
             "--param",
@@ -553,7 +563,7 @@ def test_cli_simulate_answers_or_says_why(capsys, c, v0):
             "--v0",
             v0,
             "--json",
-        ],  # fmt: skip
+        ],
     )
     if status == 0:
         assert err == "" and '"e"' in out
@@ -612,9 +622,19 @@ def test_cli_engine_e_takes_only_what_it_reads(capsys, params):
     every value a number (a misspelt key was once ignored, a text value a traceback)."""
     status, out, err = run_cli(
         capsys,
-        ["engine-e", "--engine", "mujoco", "--params", json.dumps(params), "--mass", "0.05",
-         "--speed", "1", "--json"],
-    )  # fmt: skip
+        [
+            "engine-e",
+            "--engine",
+            "mujoco",
+            "--params",
+            json.dumps(params),
+            "--mass",
+            "0.05",
+            "--speed",
+            "1",
+            "--json",
+        ],
+    )
     if status != 0:
         assert_one_line_error(status, out, err)
         return
@@ -631,9 +651,21 @@ def test_cli_export_answers_or_says_why(capsys, e, T):
     OverflowError with exit status 1)."""
     status, out, err = run_cli(
         capsys,
-        ["export", "--engine", "mujoco", "--e", e, "--T", T, "--mass", "0.05", "--v0", "1",
-         "--json"],
-    )  # fmt: skip
+        [
+            "export",
+            "--engine",
+            "mujoco",
+            "--e",
+            e,
+            "--T",
+            T,
+            "--mass",
+            "0.05",
+            "--v0",
+            "1",
+            "--json",
+        ],
+    )
     if status == 0:
         assert err == "" and json.loads(out)
     else:
@@ -646,7 +678,8 @@ def test_cli_calibrate_with_any_duration(capsys, T):
     """T = 1e300 s once ended in an OverflowError (exit status 1). A warning may come
     before the error: each on its own line, `jaximpact: warning: ...`."""
     status, out, err = run_cli(
-        capsys, ["calibrate", "--mass", "1", "--law", "hertz_rate", "--v0", "2.5", "--e", "0.8", "--T", T]
+        capsys,
+        ["calibrate", "--mass", "1", "--law", "hertz_rate", "--v0", "2.5", "--e", "0.8", "--T", T],
     )
     lines = err.splitlines()
     assert all(line.startswith("jaximpact: warning: ") for line in lines[:-1]), err
@@ -661,9 +694,19 @@ def test_cli_fit_options_out_of_range(capsys, tmp_path, option):
     path.write_text("t\n0.3\n0.7\n1.0\n1.2\n")
     status, out, err = run_cli(
         capsys,
-        ["fit", "--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--mass", "0.05", *option,
-         str(path)],
-    )  # fmt: skip
+        [
+            "fit",
+            "--law",
+            "hertz_rate",
+            "--param",
+            "c=2e6",
+            "b1=800",
+            "--mass",
+            "0.05",
+            *option,
+            str(path),
+        ],
+    )
     assert_one_line_error(status, out, err, contains="sigma")
 
 

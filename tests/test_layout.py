@@ -79,3 +79,25 @@ def test_no_law_name_comparisons_outside_the_laws(path):
                     if isinstance(v, ast.Constant) and v.value in names
                 ]
     assert not found, f"law names compared outside the law table: {found}"
+
+
+FORMATTED = ("jaximpact", "tests", "benchmarks", "examples", "docs")
+
+
+def test_ruff_formats_the_code():
+    """ruff's formatter decides the layout (pyproject.toml's [tool.ruff]), with no `fmt: skip`."""
+    pytest.importorskip("ruff")
+    import subprocess
+    import sys
+
+    root = PACKAGE.parent
+    checked = subprocess.run(
+        [sys.executable, "-m", "ruff", "format", "--check", *FORMATTED],
+        cwd=root,
+        capture_output=True,
+        text=True,
+    )
+    assert checked.returncode == 0, checked.stdout + checked.stderr
+    marker = "# fmt" + ": skip"
+    skips = [p for d in FORMATTED for p in (root / d).rglob("*.py") if marker in p.read_text()]
+    assert not skips, f"{marker} in {skips}: let ruff format decide"

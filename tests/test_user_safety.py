@@ -36,9 +36,14 @@ def _write_bodies(path: Path, n: int = 2, seed: int = 1) -> str:
     rng = np.random.default_rng(seed)
     lines = ["c,b1,m,v0"] + [
         f"{c!r},{b!r},{m!r},{v!r}"
-        for c, b, m, v in zip(rng.uniform(1e6, 3e6, n), rng.uniform(100, 2000, n),
-                              rng.uniform(0.5, 2.0, n), rng.uniform(0.5, 5.0, n), strict=True)
-    ]  # fmt: skip
+        for c, b, m, v in zip(
+            rng.uniform(1e6, 3e6, n),
+            rng.uniform(100, 2000, n),
+            rng.uniform(0.5, 2.0, n),
+            rng.uniform(0.5, 5.0, n),
+            strict=True,
+        )
+    ]
     text = "\n".join(lines) + "\n"
     path.write_text(text)
     return text
@@ -118,9 +123,19 @@ def test_cli_refuses_an_output_that_is_an_input_before_any_work(capsys, tmp_path
         assert_one_line_error(status, out_text, err, contains="is the input")
     Path("data.csv").write_text("v0,e\n2.5,0.8\n")
     status, out_text, err = run_cli(
-        capsys, ["calibrate", "--mass", "1", "--law", "hertz_rate", "--data", "data.csv", "--plot",
-                 "./data.csv"],
-    )  # fmt: skip
+        capsys,
+        [
+            "calibrate",
+            "--mass",
+            "1",
+            "--law",
+            "hertz_rate",
+            "--data",
+            "data.csv",
+            "--plot",
+            "./data.csv",
+        ],
+    )
     assert_one_line_error(status, out_text, err, contains="is the input")
     assert Path("bodies.csv").read_text() == CSV and Path("data.csv").read_text().startswith("v0")
 
@@ -246,9 +261,13 @@ ROWS = 12_000  # at 20 rows a chunk: 600 chunks, a few seconds of batch
 def _bodies_for_a_long_run(path: Path, rows: int):
     rng = np.random.default_rng(3)
     data = np.column_stack(
-        [rng.uniform(1e6, 3e6, rows), rng.uniform(100, 2000, rows), rng.uniform(0.5, 2, rows),
-         rng.uniform(0.5, 5, rows)]
-    )  # fmt: skip
+        [
+            rng.uniform(1e6, 3e6, rows),
+            rng.uniform(100, 2000, rows),
+            rng.uniform(0.5, 2, rows),
+            rng.uniform(0.5, 5, rows),
+        ]
+    )
     np.savetxt(path, data, delimiter=",", header="c,b1,m,v0", comments="", fmt="%.17g")
 
 
@@ -318,8 +337,9 @@ def test_an_interrupted_batch_stops_says_what_it_kept_and_resume_completes_it(
 )
 def test_an_interrupted_calibrate_all_stops_with_one_line(signum, after, fitting):
     """At several moments (importing JAX; the fits under way) and for both signals."""
-    child = _cli("calibrate", "--law", "all", "--mass", "1", "--v0", "2.5", "--e", "0.8",
-                 "--T", "7.8e-3")
+    child = _cli(
+        "calibrate", "--law", "all", "--mass", "1", "--v0", "2.5", "--e", "0.8", "--T", "7.8e-3"
+    )
     time.sleep(after)
     assert child.poll() is None
     start = time.perf_counter()
@@ -354,7 +374,18 @@ def test_check_scale_refuses_tiny_and_huge_alike(exponent, sign):
 
 @pytest.mark.parametrize("m", ["1e-300", "1e300", "1e-151", "1e151"])
 def test_cli_refuses_a_mass_float64_cannot_carry(capsys, m):
-    argv = ["simulate", "--mass", "1", "--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "2.5"]
+    argv = [
+        "simulate",
+        "--mass",
+        "1",
+        "--law",
+        "hertz_rate",
+        "--param",
+        "c=2e6",
+        "b1=800",
+        "--v0",
+        "2.5",
+    ]
     status, out, err = run_cli(capsys, [*argv, "--mass", m])
     assert_one_line_error(status, out, err, contains="1e-150 to 1e150")
 
@@ -518,15 +549,19 @@ def test_impact_refuses_a_mass_float64_cannot_carry(m):
 @pytest.mark.parametrize(
     "call, said",
     [
-        (lambda: ji.law("hertz", c=1e9),
-         "did you mean hertz_viscous, hertz_modified or hertz_rate?"),
+        (
+            lambda: ji.law("hertz", c=1e9),
+            "did you mean hertz_viscous, hertz_modified or hertz_rate?",
+        ),
         (lambda: ji.law("Hunt-Crossley", c=1e9), "did you mean hunt_crossley?"),
         (lambda: ji.law("jkrr", c=1e9), "did you mean jkr?"),
         (lambda: ji.tangential_law("Mindlin", G_star=1e10, mu=0.3), "did you mean mindlin?"),
-        (lambda: ji.export(ji.law("kelvin_voigt", c=1e6, b=10.0), "Lammps", m=1.0, v0=1.0),
-         "did you mean lammps?"),
+        (
+            lambda: ji.export(ji.law("kelvin_voigt", c=1e6, b=10.0), "Lammps", m=1.0, v0=1.0),
+            "did you mean lammps?",
+        ),
     ],
-)  # fmt: skip
+)
 def test_a_mistyped_name_is_told_the_nearest_names(call, said):
     """A law, tangential law or engine named as people say it (`hertz`, `Hunt-Crossley`) is
     refused in one line that names the nearest names first, then lists them all."""

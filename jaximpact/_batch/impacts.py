@@ -177,8 +177,15 @@ def batch_path(law, separation, *, method="auto", rtol=1e-11, g=0.0, **impact_op
     params = {k: np.atleast_1d(np.asarray(v, dtype=float)) for k, v in law.parameters.items()}
     skeleton, params = _fix_shape(law_skeleton(law), params)
     gravity = not (isinstance(g, (int, float)) and g == 0)
-    path, _ = _member_path(skeleton, params, gravity, separation=separation, method=method,
-                           solver=impact_options.get("solver"), rtol=rtol)  # fmt: skip
+    path, _ = _member_path(
+        skeleton,
+        params,
+        gravity,
+        separation=separation,
+        method=method,
+        solver=impact_options.get("solver"),
+        rtol=rtol,
+    )
     return _LABELS.get(path.name, path.name)
 
 
@@ -323,23 +330,31 @@ def run_impacts(
     solve = solve_options("impact_batch", options, refused=BATCH_DECIDES, **keywords)
     solve = with_defaults(solve, max_steps=4096, tau_max=1e4, rest_tol=1e-7, peaks=True)
     rtol = check_choices(separation, method, solve.rtol, table_law=skeleton[0] == "law")
-    check_options(rtol=rtol, atol=solve.atol, rest_tol=solve.rest_tol,
-                  max_steps=solve.max_steps, tau_max=solve.tau_max)  # fmt: skip
+    check_options(
+        rtol=rtol,
+        atol=solve.atol,
+        rest_tol=solve.rest_tol,
+        max_steps=solve.max_steps,
+        tau_max=solve.tau_max,
+    )
     skeleton, params = _fix_shape(skeleton, params)
     gravity = not bool(np.all(kinematics["g"] == 0.0))
     rows = {"params": params, "m": kinematics["m"], "v0": kinematics["v0"]}
     if gravity:
         rows["g"] = kinematics["g"]
     solver, peaks = solve.solver, solve.peaks
-    path, plain = _member_path(skeleton, params, gravity, separation=separation, method=method,
-                               solver=solver, rtol=rtol)  # fmt: skip
+    path, plain = _member_path(
+        skeleton, params, gravity, separation=separation, method=method, solver=solver, rtol=rtol
+    )
     # one program over every process's devices pairs the processes' calls: each gives the
     # same rows, which a second pass over each one's own left rows would not
     spans = isinstance(run.get("devices"), str) and run["devices"] == GLOBAL
-    grid = not spans and grid_serves(path, plain, method=method, solver=solver, rtol=rtol,
-                                     gravity=gravity)  # fmt: skip
-    options = make_options(path, with_tolerances(solve, rtol), separation=separation,
-                           gravity=gravity)  # fmt: skip
+    grid = not spans and grid_serves(
+        path, plain, method=method, solver=solver, rtol=rtol, gravity=gravity
+    )
+    options = make_options(
+        path, with_tolerances(solve, rtol), separation=separation, gravity=gravity
+    )
     computed = tuple(name for name in fields if name != "path")
     try:
         member = _impact_member(skeleton, computed, options, gravity)
@@ -353,8 +368,14 @@ def run_impacts(
     paths = np.full(rows["m"].shape, name)
     if grid:  # every row on the grid, then the rows it did not serve integrated
         on_grid = _grid_member(skeleton, _grid_fields(computed, plain, peaks), separation)
-        out = run_batch(on_grid, rows, chunk_size=chunk, cost=None,
-                        description=f"impacts ({label}) on the grid", **batch)  # fmt: skip
+        out = run_batch(
+            on_grid,
+            rows,
+            chunk_size=chunk,
+            cost=None,
+            description=f"impacts ({label}) on the grid",
+            **batch,
+        )
         served = out.pop("served")
         paths = np.where(served, "grid", name)
         left = np.flatnonzero(~served)  # gathered on the host: one more batched pass
@@ -364,8 +385,14 @@ def run_impacts(
             if order == "cost":
                 kept = {k: v[left] for k, v in kinematics.items()}
                 cost = cost_key(skeleton, part["params"], **kept)
-            rest = run_batch(member, part, chunk_size=chunk, cost=cost,
-                             description=f"impacts ({label}) the grid left", **batch)  # fmt: skip
+            rest = run_batch(
+                member,
+                part,
+                chunk_size=chunk,
+                cost=cost,
+                description=f"impacts ({label}) the grid left",
+                **batch,
+            )
             for key, values in rest.items():
                 out[key][left] = values
         name = "grid" if served.all() else name
@@ -373,8 +400,9 @@ def run_impacts(
         cost = None
         if order == "cost" and path.integrates:
             cost = cost_key(skeleton, params, **kinematics)
-        out = run_batch(member, rows, chunk_size=chunk, cost=cost,
-                        description=f"impacts ({label})", **batch)  # fmt: skip
+        out = run_batch(
+            member, rows, chunk_size=chunk, cost=cost, description=f"impacts ({label})", **batch
+        )
     out = {key: out[key] for key in computed if key in out}
     if "path" in fields:
         out["path"] = paths

@@ -44,33 +44,44 @@ def add_batch(subparsers):
         "source", type=Path, metavar="IN", help="CSV or Parquet file, one body per row"
     )
     parser.add_argument(
-        "--law", required=True, metavar="NAME",
+        "--law",
+        required=True,
+        metavar="NAME",
         help="see `jaximpact laws`; or a user's law FILE.py:NAME, the function NAME(x, v, "
         "params) of a Python file",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--param", action="extend", nargs="+", default=[], metavar="NAME=VALUE",
+        "--param",
+        action="extend",
+        nargs="+",
+        default=[],
+        metavar="NAME=VALUE",
         help="a law parameter for every row, SI units (--param c=2e6 b1=800, or repeated)",
-    )  # fmt: skip
+    )
     parser.add_argument("--mass", type=float, metavar="KG", help="m for every row, kg")
     parser.add_argument("--v0", type=float, metavar="M/S", help="impact speed for every row")
     parser.add_argument(
         "--g", type=float, metavar="M/S^2", help="gravity for every row (default 0)"
     )
     parser.add_argument(
-        "--separation", choices=("force", "penetration"),
+        "--separation",
+        choices=("force", "penetration"),
         help="end of contact for every row (default force)",
-    )  # fmt: skip
+    )
     parser.add_argument("--out", required=True, type=Path, metavar="OUT", help="file to write")
     parser.add_argument(
-        "--chunk-rows", type=int, default=100_000, metavar="N",
+        "--chunk-rows",
+        type=int,
+        default=100_000,
+        metavar="N",
         help="rows per chunk (default 100000): the unit of memory, of work and of --resume",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--resume", action="store_true",
+        "--resume",
+        action="store_true",
         help="reuse the chunks an interrupted run left in OUT.parts/ whose inputs and "
         "settings are unchanged (a finished run leaves none)",
-    )  # fmt: skip
+    )
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
     group = parser.add_argument_group("several processes (jax.distributed)")
     group.add_argument(
@@ -82,12 +93,14 @@ def add_batch(subparsers):
     group.add_argument("--num-processes", type=int, metavar="N", help="processes in all")
     group.add_argument("--process-id", type=int, metavar="K", help="this process, 0 .. N-1")
     group.add_argument(
-        "--mesh", choices=("local", "global"), default="local",
+        "--mesh",
+        choices=("local", "global"),
+        default="local",
         help="local (default): each process computes its chunks on its own devices without "
         "waiting for the others; global: each round of chunks, one per process, runs as one "
         "jitted program over a mesh of every process's devices, in lockstep (slower on the "
         "integrated path; the same file either way)",
-    )  # fmt: skip
+    )
     parser.set_defaults(handler=run_batch_command)
 
 
@@ -103,8 +116,10 @@ def _start_processes(args):
     if not args.distributed:
         missing = [k for k, v in given.items() if v is None]
         if missing:
-            raise CLIError(f"{', '.join(missing)} missing: give all three, or --distributed "
-                           "under SLURM or Open MPI")  # fmt: skip
+            raise CLIError(
+                f"{', '.join(missing)} missing: give all three, or --distributed "
+                "under SLURM or Open MPI"
+            )
     n, k = args.num_processes, args.process_id
     if n is not None and n < 1:
         raise CLIError(f"--num-processes must be at least 1, got {n}")

@@ -130,28 +130,42 @@ def add_calibrate(subparsers):
 def add_posterior_arguments(parser):
     """`--posterior [nuts|laplace]`, `--draws`, `--seed`, `--prior` (`jaximpact.posterior`)."""
     parser.add_argument(
-        "--posterior", nargs="?", const="nuts", choices=("nuts", "laplace"), metavar="METHOD",
+        "--posterior",
+        nargs="?",
+        const="nuts",
+        choices=("nuts", "laplace"),
+        metavar="METHOD",
         help="also sample the posterior of the fitted parameters (jaximpact.posterior): "
         "'nuts' (the default; 4 chains) or 'laplace' (the Gaussian at the mode, fast); "
         "prints medians with 90 %% intervals and the diagnostics, --plot writes the pairs "
         "plot and the bands over the data, --json adds the posterior's summary and 200 of "
         "its draws (what 'jaximpact export --from' reads for the engine's band)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--draws", type=int, default=2000, metavar="N",
+        "--draws",
+        type=int,
+        default=2000,
+        metavar="N",
         help="with --posterior: draws per chain (default 2000, 4 chains)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--seed", type=int, default=0, metavar="N",
+        "--seed",
+        type=int,
+        default=0,
+        metavar="N",
         help="with --posterior: the random seed (default 0)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--prior", action="extend", nargs="+", default=[], metavar="NAME=KIND:A:B",
+        "--prior",
+        action="extend",
+        nargs="+",
+        default=[],
+        metavar="NAME=KIND:A:B",
         help="with --posterior: a parameter's prior, SI units, KIND one of loguniform "
         "(A, B: the range), uniform, normal (mean, sd), lognormal (mu, sigma of ln x), e.g. "
         "--prior c=loguniform:1e5:1e8 (default: loguniform over three decades either side "
         "of the fitted value)",
-    )  # fmt: skip
+    )
 
 
 def posterior_options(args) -> dict | None:
@@ -160,8 +174,15 @@ def posterior_options(args) -> dict | None:
     from .._posterior.priors import parse_prior
 
     if args.posterior is None:
-        given = [f for f, v in (("--prior", args.prior), ("--draws", args.draws != 2000),
-                                ("--seed", args.seed != 0)) if v]  # fmt: skip
+        given = [
+            f
+            for f, v in (
+                ("--prior", args.prior),
+                ("--draws", args.draws != 2000),
+                ("--seed", args.seed != 0),
+            )
+            if v
+        ]
         if given:
             raise CLIError(f"{' and '.join(given)} need --posterior")
         return None
@@ -198,8 +219,13 @@ def sample_posterior(fit, options):
 
     with metered(heartbeat_meter(), 1, f"posterior ({options['method']})") as bar:
         key = jax.random.key(options["seed"])
-        post = posterior(fit, prior=options["prior"] or None, method=options["method"],
-                         num_samples=options["draws"], key=key)  # fmt: skip
+        post = posterior(
+            fit,
+            prior=options["prior"] or None,
+            method=options["method"],
+            num_samples=options["draws"],
+            key=key,
+        )
         bar.update(1, "done")
     record = post.to_dict(samples=False)
     rows = post.draw_indices(JSON_DRAWS)
@@ -328,8 +354,10 @@ def run_calibrate(args):
                 "drop --free and --param"
             )
         if args.posterior is not None:
-            raise CLIError("--posterior takes one law: give --law NAME (the ranking of --law "
-                           "all has no posterior)")  # fmt: skip
+            raise CLIError(
+                "--posterior takes one law: give --law NAME (the ranking of --law "
+                "all has no posterior)"
+            )
         return _run_all(args, data)
     return _run_one(args, data, sampling)
 
@@ -479,8 +507,10 @@ def _run_all(args, data):
     rankings, failed = [], {}
     with metered(heartbeat_meter(), len(laws), "fitting laws") as bar:
         for done, name in enumerate(laws):
-            set_note(f"{done} of {len(laws)} laws fitted, nothing written (the ranking is "
-                     "printed at the end)")  # fmt: skip
+            set_note(
+                f"{done} of {len(laws)} laws fitted, nothing written (the ranking is "
+                "printed at the end)"
+            )
             check_interrupt()  # a safe point between fits: a Ctrl-C stops here at the latest
             try:  # one law at a time: the verdict on the best one comes at the end
                 rankings += compare_laws(laws=(name,), progress=False, warn=False, **kwargs)
@@ -623,9 +653,13 @@ def _wrapped(head, text, width=100):
     import textwrap
 
     return textwrap.fill(
-        text, width=width, initial_indent=head, subsequent_indent=" " * len(head),
-        break_on_hyphens=False, break_long_words=False,
-    )  # fmt: skip
+        text,
+        width=width,
+        initial_indent=head,
+        subsequent_indent=" " * len(head),
+        break_on_hyphens=False,
+        break_long_words=False,
+    )
 
 
 def _sanity_text(record):
@@ -688,8 +722,12 @@ def _one_text(result, data):
             )
             why.append(f"{', '.join(assumed)}: {origin}")
         lines.append(f"fixed      {_params_text(result['law'], kept)}")
-        lines.append(_wrapped("           ", f"(not fitted: {'; '.join(why)}; --param sets "
-                                             "a value, --free fits it)"))  # fmt: skip
+        lines.append(
+            _wrapped(
+                "           ",
+                f"(not fitted: {'; '.join(why)}; --param sets a value, --free fits it)",
+            )
+        )
     lines.append(
         _wrapped(
             "fit        ",

@@ -142,13 +142,20 @@ def add_tangential_arguments(parser, *, required: bool, help: str, tparam_help: 
     """`--tangential NAME` (one of `TANGENTIAL_CHOICES`) and `--tparam NAME=VALUE ...`,
     a tangential law and its parameters (SI units); `tangential_from_args` builds it."""
     parser.add_argument(
-        "--tangential", required=required, choices=TANGENTIAL_CHOICES, metavar="NAME",
+        "--tangential",
+        required=required,
+        choices=TANGENTIAL_CHOICES,
+        metavar="NAME",
         help=f"{help} (one of {', '.join(TANGENTIAL_CHOICES)})",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--tparam", action="extend", nargs="+", default=[], metavar="NAME=VALUE",
+        "--tparam",
+        action="extend",
+        nargs="+",
+        default=[],
+        metavar="NAME=VALUE",
         help=tparam_help,
-    )  # fmt: skip
+    )
 
 
 def tangential_from_args(args):
@@ -410,8 +417,9 @@ def check_file_law(law):
         read = parameters_read(law.fn, law.params)
     except MissingParameter as error:
         key = error.args[0]
-        raise CLIError(f"{text} reads params[{json.dumps(key)}]: give it with --param "
-                       f"{key}=...") from None  # fmt: skip
+        raise CLIError(
+            f"{text} reads params[{json.dumps(key)}]: give it with --param {key}=..."
+        ) from None
     except Exception as error:  # the user's function: where it failed, in one line
         raise CLIError(
             f"{text} failed when called as NAME(x, v, params) with numbers ("
@@ -420,8 +428,10 @@ def check_file_law(law):
     unread = [k for k in law.params if k not in read]
     if unread:
         reads = ", ".join(read) or "no parameter"
-        raise CLIError(f"--param {unread[0]}: {text} does not read params["
-                       f"{json.dumps(unread[0])}] (it reads {reads})")  # fmt: skip
+        raise CLIError(
+            f"--param {unread[0]}: {text} does not read params["
+            f"{json.dumps(unread[0])}] (it reads {reads})"
+        )
 
 
 _LOADED: dict = {}  # (file, SHA-256 of its bytes) -> its module: a file loaded once
@@ -438,12 +448,16 @@ def load_law_function(text: str):
     where, _, name = text.rpartition(":")
     flag = f"--law {text}"
     if not where or not name:
-        raise CLIError(f"{flag}: a user's law is FILE.py:NAME, the file and the name of its "
-                       "function NAME(x, v, params)")  # fmt: skip
+        raise CLIError(
+            f"{flag}: a user's law is FILE.py:NAME, the file and the name of its "
+            "function NAME(x, v, params)"
+        )
     path = Path(where)
     if path.suffix != ".py":
-        raise CLIError(f"{flag}: {where} is not a .py file; a user's law is FILE.py:NAME, a "
-                       "function NAME(x, v, params) in a Python file")  # fmt: skip
+        raise CLIError(
+            f"{flag}: {where} is not a .py file; a user's law is FILE.py:NAME, a "
+            "function NAME(x, v, params) in a Python file"
+        )
     if not path.exists():
         raise CLIError(f"{flag}: no such file {where}")
     if not path.is_file():
@@ -465,22 +479,31 @@ def load_law_function(text: str):
         except (Exception, SystemExit) as error:
             del sys.modules[module_name]
             line = _line_in(error, path)
-            raise CLIError(f"{flag}: importing {where} raised {type(error).__name__}{line}: "
-                           f"{_first_line(error)}") from None  # fmt: skip
+            raise CLIError(
+                f"{flag}: importing {where} raised {type(error).__name__}{line}: "
+                f"{_first_line(error)}"
+            ) from None
         _LOADED[key] = module
     if not hasattr(module, name):
         from .._choices import nearest_names
 
-        own = [k for k, v in vars(module).items() if callable(v) and not k.startswith("_")
-               and getattr(v, "__module__", None) == module.__name__]  # fmt: skip
+        own = [
+            k
+            for k, v in vars(module).items()
+            if callable(v)
+            and not k.startswith("_")
+            and getattr(v, "__module__", None) == module.__name__
+        ]
         near = nearest_names(name, own)
         hint = f" (did you mean {' or '.join(near)}?)" if near else ""
         has = f"its callables: {', '.join(own)}" if own else "it defines no function"
         raise CLIError(f"{flag}: {where} has no {name!r}{hint}; {has}")
     fn = getattr(module, name)
     if not callable(fn):
-        raise CLIError(f"{flag}: {name} in {where} is a {type(fn).__name__}, not a function "
-                       f"{name}(x, v, params)")  # fmt: skip
+        raise CLIError(
+            f"{flag}: {name} in {where} is a {type(fn).__name__}, not a function "
+            f"{name}(x, v, params)"
+        )
     return fn
 
 
@@ -508,8 +531,11 @@ def _line_in(error, where) -> str:
     if isinstance(error, SyntaxError) and error.filename is not None:
         if str(Path(error.filename).resolve()) == file and error.lineno:
             return f" at line {error.lineno}"
-    frames = [f for f in traceback.extract_tb(error.__traceback__)
-              if str(Path(f.filename).resolve()) == file]  # fmt: skip
+    frames = [
+        f
+        for f in traceback.extract_tb(error.__traceback__)
+        if str(Path(f.filename).resolve()) == file
+    ]
     return f" at line {frames[-1].lineno}" if frames else ""
 
 
@@ -724,8 +750,10 @@ def read_fit_record(path: str, law: str | None = None):
     except OSError as error:
         raise CLIError(f"{where}: cannot read it ({error.strerror or error})") from None
     except UnicodeDecodeError as error:
-        raise CLIError(f"{where}: not JSON ({error.reason}); write it with 'jaximpact "
-                       "calibrate ... --json > FILE'") from None  # fmt: skip
+        raise CLIError(
+            f"{where}: not JSON ({error.reason}); write it with 'jaximpact "
+            "calibrate ... --json > FILE'"
+        ) from None
     try:
         data = json.loads(text)
     except json.JSONDecodeError as error:

@@ -87,78 +87,98 @@ def add_export(subparsers):
         "jaximpact export mujoco --from fit.json",
     )
     parser.add_argument(
-        "engine_name", nargs="?", metavar="ENGINE",
+        "engine_name",
+        nargs="?",
+        metavar="ENGINE",
         help=f"{_names()} (or --engine NAME)",
-    )  # fmt: skip
+    )
     parser.add_argument("--engine", metavar="NAME", help="the engine, as ENGINE")
     parser.add_argument(
-        "--from", dest="source", metavar="FILE",
+        "--from",
+        dest="source",
+        metavar="FILE",
         help="a fit to export: the JSON that 'jaximpact calibrate --json' (or 'simulate "
         "--json') writes, '-' for stdin; its law, parameters, mass and speed are used. From "
         "'calibrate --posterior --json': the law at the posterior medians, and the band "
         "(5-95 %%) of what the engine realises over the draws the file holds",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--band-draws", type=int, default=200, metavar="N",
+        "--band-draws",
+        type=int,
+        default=200,
+        metavar="N",
         help="with --from a posterior: the engine's band over N of its draws (default 200; "
         "one export each: about 10 ms for LAMMPS, 0.5 s for MuJoCo)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--law", metavar="NAME",
+        "--law",
+        metavar="NAME",
         help="a law of 'jaximpact laws', or a user's law FILE.py:NAME, the function "
         "NAME(x, v, params) of a Python file (its parameters all from --param)",
-    )  # fmt: skip
+    )
     parser.add_argument("--param", action="extend", nargs="+", default=[], metavar="NAME=VALUE")
     parser.add_argument("--e", type=float, help="target restitution in (0, 1] (without --law)")
     parser.add_argument("--T", type=float, metavar="S", help="target contact duration, s")
     parser.add_argument(
-        "--mass", type=float, metavar="KG",
+        "--mass",
+        type=float,
+        metavar="KG",
         help="mass, kg (two-sphere engines: of each sphere); required, except for "
         f"{_labels(lambda e: e.MASS_DEPENDS is None)} from --e/--T, and with --from (the "
         "fit's)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--v0", type=float, metavar="M/S",
+        "--v0",
+        type=float,
+        metavar="M/S",
         help="impact speed, m/s (with --from: the fit's, if it has one speed)",
-    )  # fmt: skip
+    )
     parser.add_argument("--timestep", type=float, metavar="S", help="the engine's step, s")
     _add_radius(parser)
     parser.add_argument(
-        "--poisson", type=float,
+        "--poisson",
+        type=float,
         help=f"Poisson's ratio ({_labels(_takes('poisson'))}; default 0.3)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--limit-damping", action="store_true",
+        "--limit-damping",
+        action="store_true",
         help=f"{_labels(_takes('limit_damping'))}: keep the force non-attractive",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--wall", action="store_true",
+        "--wall",
+        action="store_true",
         help=f"{_labels(lambda e: e.TWO_SPHERES and 'wall' in e.SCENES)}: one sphere of "
         "--mass and --radius hitting a fixed flat wall at --v0 (the drop test), instead of "
         "two spheres",
-    )  # fmt: skip
+    )
     add_tangential_arguments(
-        parser, required=False,
+        parser,
+        required=False,
         help=f"{_labels(lambda e: bool(e.TANGENTIAL or e.FRICTION))}: also export the "
         "tangential law NAME with --tparam (MuJoCo and Drake take its mu alone), and print "
         "the e_t, spin and normal e the engine realises from 5 to 75 degrees, beside the "
         "law's e_t",
         tparam_help="the tangential law's parameters, SI units, e.g. --tparam "
         "G_star=1.35e10 mu=0.092",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--no-strict", dest="strict", action="store_false",
+        "--no-strict",
+        dest="strict",
+        action="store_false",
         help="export what the engine cannot realise at --timestep anyway, with a warning",
-    )  # fmt: skip
+    )
     add_output_arguments(parser, plot=False)
     parser.set_defaults(handler=_run_export)
 
 
 def _add_radius(parser):
     parser.add_argument(
-        "--radius", type=float, metavar="M",
+        "--radius",
+        type=float,
+        metavar="M",
         help=f"sphere radius, m ({_labels(lambda e: e.TWO_SPHERES)})",
-    )  # fmt: skip
+    )
 
 
 def _engine_name(args) -> str:
@@ -254,8 +274,13 @@ def _run_export(args):
             data["warnings"] = [said if w == str(message) else w for w in data["warnings"]]
             warnings.warn(said, UnrealisedWarning, stacklevel=1)
         else:
-            warnings.warn_explicit(message, caught_warning.category, caught_warning.filename,
-                                   caught_warning.lineno, source=caught_warning.source)  # fmt: skip
+            warnings.warn_explicit(
+                message,
+                caught_warning.category,
+                caught_warning.filename,
+                caught_warning.lineno,
+                source=caught_warning.source,
+            )
     data["warnings"] = [*notes, *data["warnings"]]
     if args.source is not None:
         data["from"] = str(args.source)
@@ -280,11 +305,13 @@ def _run_export(args):
                 else ""
             ),
             *(
-                [f"band     e {x.e_band[0]:.5g} to {x.e_band[1]:.5g}, T {x.T_band[0]:.5g} to "
-                 f"{x.T_band[1]:.5g} s (5-95 % over {x.band_draws} posterior draws, that step)"]
+                [
+                    f"band     e {x.e_band[0]:.5g} to {x.e_band[1]:.5g}, T {x.T_band[0]:.5g} to "
+                    f"{x.T_band[1]:.5g} s (5-95 % over {x.band_draws} posterior draws, that step)"
+                ]
                 if x.e_band is not None
                 else []
-            ),  # fmt: skip
+            ),
             "parameters:",
             *(f"  {k} = {v}" for k, v in x.parameters.items()),
             "snippet:",
@@ -297,18 +324,22 @@ def _run_export(args):
                 law_e = f"   {x.e_target[i]:.5g}" if with_law else ""
                 lines.append(f"  {format_number(v):>9}   {x.e_engine[i]:.5g}{law_e}")
         if x.tangential is not None:
-            lines.append(f"tangential {x.tangential.name}: what the engine realises at v0 "
-                         "(no spin before)")  # fmt: skip
+            lines.append(
+                f"tangential {x.tangential.name}: what the engine realises at v0 (no spin before)"
+            )
             law = x.e_t_target is not None
             # two spheres: relative e_t and e, each sphere's spin (they turn alike)
             pair = "two equal spheres" in x.scene
             spin = "each spin (rad/s)" if pair else "spin after (rad/s)"
-            lines.append(f"  angle (deg)   e_t       {spin:<18}   e normal"
-                         + ("   e_t law" if law else ""))  # fmt: skip
+            lines.append(
+                f"  angle (deg)   e_t       {spin:<18}   e normal" + ("   e_t law" if law else "")
+            )
             rows = zip(x.angles, x.e_t_engine, x.omega_engine, x.e_n_engine, strict=True)
             for k, (angle, e_t, omega, e_n) in enumerate(rows):
-                lines.append(f"  {angle:11g}   {e_t:.5f}   {omega:<18.4g}   {e_n:.5f}"
-                             + (f"    {x.e_t_target[k]:.5f}" if law else ""))  # fmt: skip
+                lines.append(
+                    f"  {angle:11g}   {e_t:.5f}   {omega:<18.4g}   {e_n:.5f}"
+                    + (f"    {x.e_t_target[k]:.5f}" if law else "")
+                )
         lines += [f"warning: {w}" for w in data["warnings"]]
         return "\n".join(lines)
 
@@ -325,19 +356,36 @@ def _band(x, posterior: dict, name: str, args, tangential):
 
     origin = " at the posterior medians"
     if "samples" not in posterior or "z" not in posterior:
-        return x, origin, ["no engine band: the posterior in the file holds no draws (write "
-                           "it with 'jaximpact calibrate --posterior --json')"]  # fmt: skip
+        return (
+            x,
+            origin,
+            [
+                "no engine band: the posterior in the file holds no draws (write "
+                "it with 'jaximpact calibrate --posterior --json')"
+            ],
+        )
     if is_file_law(name):
         return x, origin, ["no engine band for a user's law (FILE.py:NAME) read from JSON"]
     try:
         post = Posterior.from_dict(posterior)
     except (KeyError, TypeError, ValueError) as error:
-        raise CLIError(f"--from {args.source}: its posterior is not one that 'jaximpact "
-                       f"calibrate --posterior --json' writes ({error})") from None  # fmt: skip
-    x = with_band(x, post, band_draws=args.band_draws, progress=heartbeat_meter(),
-                  m=args.mass, v0=args.v0,
-                  radius=args.radius, poisson=args.poisson, limit_damping=args.limit_damping,
-                  geometry="wall" if args.wall else None, tangential=tangential)  # fmt: skip
+        raise CLIError(
+            f"--from {args.source}: its posterior is not one that 'jaximpact "
+            f"calibrate --posterior --json' writes ({error})"
+        ) from None
+    x = with_band(
+        x,
+        post,
+        band_draws=args.band_draws,
+        progress=heartbeat_meter(),
+        m=args.mass,
+        v0=args.v0,
+        radius=args.radius,
+        poisson=args.poisson,
+        limit_damping=args.limit_damping,
+        geometry="wall" if args.wall else None,
+        tangential=tangential,
+    )
     thinned = posterior.get("thinned", {})
     of = f", of {thinned['of']}" if isinstance(thinned, dict) and "of" in thinned else ""
     return x, f"{origin} (band over {x.band_draws} of its draws{of})", []
@@ -458,10 +506,12 @@ def add_engine_e(subparsers):
     )
     parser.add_argument("--params", required=True, metavar="JSON", help="engine parameters")
     parser.add_argument(
-        "--mass", type=float, metavar="KG",
+        "--mass",
+        type=float,
+        metavar="KG",
         help="mass, kg (two-sphere engines: of each sphere); required except for "
         f"{_labels(lambda e: e.MASS_DEPENDS is None)}, whose parameters are per unit mass",
-    )  # fmt: skip
+    )
     parser.add_argument("--speed", type=float, nargs="+", required=True, metavar="M/S")
     _add_radius(parser)
     add_output_arguments(parser, plot=False)

@@ -32,10 +32,12 @@ def add_laws(subparsers):
         "jaximpact laws --json",
     )
     parser.add_argument(
-        "names", nargs="*", metavar="NAME",
+        "names",
+        nargs="*",
+        metavar="NAME",
         help="only these laws, normal or tangential; a name's beginning shows every law it "
         "begins (hertz: hertz_viscous, hertz_modified, hertz_rate)",
-    )  # fmt: skip
+    )
     add_output_arguments(parser, plot=False)
     parser.set_defaults(handler=_run_laws)
 
@@ -96,18 +98,27 @@ def _tangential_text(rows, width) -> list[str]:
     import textwrap
 
     table = [
-        (r["name"], r["formula"],
-         _params_text(r) + (f" (or {', '.join(r['also'])})" if r["also"] else ""))
+        (
+            r["name"],
+            r["formula"],
+            _params_text(r) + (f" (or {', '.join(r['also'])})" if r["also"] else ""),
+        )
         for r in rows
-    ]  # fmt: skip
+    ]
     notes = [f"engines: {r['engines']}; ref.: {r['reference']}" for r in rows]
     intro = (
         "Tangential laws (--tangential NAME --tparam ...): F_t in N on the sphere at its "
         "contact point, u its slip (m/s), delta the spring's stretch (m), x the overlap (m), "
         "m the sphere's mass (kg), R its radius (m)."
     )
-    lines = format_table(("name", "F_t [N]", "parameters"), table, width=width, wrap=(1, 2),
-                         notes=notes, note_column=1)  # fmt: skip
+    lines = format_table(
+        ("name", "F_t [N]", "parameters"),
+        table,
+        width=width,
+        wrap=(1, 2),
+        notes=notes,
+        note_column=1,
+    )
     return [*textwrap.wrap(intro, width), "", *lines]
 
 
@@ -136,10 +147,14 @@ def _laws_text(rows, width=None, tangential=()) -> str:
                 lines += [
                     line.replace(KEEP_TOGETHER, " ")
                     for line in textwrap.wrap(
-                        text, width, initial_indent="    ", subsequent_indent="      ",
-                        break_long_words=False, break_on_hyphens=False,
+                        text,
+                        width,
+                        initial_indent="    ",
+                        subsequent_indent="      ",
+                        break_long_words=False,
+                        break_on_hyphens=False,
                     )
-                ]  # fmt: skip
+                ]
     intro = (
         "Force laws: F(x, v) in N, positive pushing the body out; x = penetration (m), "
         "v = dx/dt (m/s). Equation numbers: Polukoshko, Viba, Kononova & Sokolova, Proc. "
@@ -173,5 +188,8 @@ def _run_laws(args):
     rows, tangential = _law_rows(), _tangential_rows()
     if args.names:
         rows, tangential = _chosen(rows, tangential, args.names)
-    emit(args, {"laws": rows, "tangential_laws": tangential},
-         lambda: _laws_text(rows, tangential=tangential))  # fmt: skip
+    emit(
+        args,
+        {"laws": rows, "tangential_laws": tangential},
+        lambda: _laws_text(rows, tangential=tangential),
+    )

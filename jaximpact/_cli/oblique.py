@@ -69,11 +69,13 @@ def add_fit_oblique(subparsers):
     parser.add_argument("file", type=Path, metavar="FILE.csv", help="the measured rebounds")
     add_law_arguments(parser, required=False)
     parser.add_argument(
-        "--from", dest="source", metavar="FIT.json",
+        "--from",
+        dest="source",
+        metavar="FIT.json",
         help="the normal law from a fit: the JSON of 'jaximpact calibrate --json' (one "
         "law, or --law all's ranking: its best, or the one --law names), instead of --law "
         "and --param; its mass must be --mass",
-    )  # fmt: skip
+    )
     add_tangential_arguments(
         parser,
         required=True,
@@ -115,15 +117,20 @@ def _add_sphere_arguments(parser, contact_point_use: str, prefix: str = ""):
     """`--inertia` and `--contact-point`, the sphere's moment of inertia and where its
     tangential force acts (`prefix`: what the help says first, e.g. "with --tangential: ")."""
     parser.add_argument(
-        "--inertia", type=float, default=0.4, metavar="K",
+        "--inertia",
+        type=float,
+        default=0.4,
+        metavar="K",
         help=f"{prefix}moment of inertia over m R^2 (default 0.4, a solid sphere)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--contact-point", choices=("surface", "midpoint", "plane"), default="surface",
+        "--contact-point",
+        choices=("surface", "midpoint", "plane"),
+        default="surface",
         help=f"{prefix}where the tangential force acts: lever arm R (surface, LAMMPS; the "
         "default), R - x/2 (midpoint: LIGGGHTS, MuJoCo, Drake), R - x (plane: Yade's wall); "
         f"{contact_point_use}",
-    )  # fmt: skip
+    )
 
 
 def add_oblique_impact_arguments(parser):
@@ -137,32 +144,51 @@ def add_oblique_impact_arguments(parser):
         "--tparam G_star=1.35e10 mu=0.092 (mindlin also takes G=... nu=...)",
     )
     parser.add_argument(
-        "--radius", type=float, metavar="M",
+        "--radius",
+        type=float,
+        metavar="M",
         help="with --tangential: the sphere's radius, m (> 0)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--angle", type=float, nargs="+", metavar="DEG",
+        "--angle",
+        type=float,
+        nargs="+",
+        metavar="DEG",
         help="with --tangential: the incidence from the normal, degrees in [0, 90) (--v0 is "
         "the speed: v_n = v0 cos, v_t = v0 sin); several for a sweep of e_t(angle)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--omega", type=float, default=0.0, metavar="RAD/S",
+        "--omega",
+        type=float,
+        default=0.0,
+        metavar="RAD/S",
         help="with --tangential: the spin before impact, rad/s (default 0; omega = v_t / R "
         "rolls without slip)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--max-segments", type=int, default=16, metavar="N",
+        "--max-segments",
+        type=int,
+        default=16,
+        metavar="N",
         help="with --tangential: the most stick and slip phases one impact may have (default "
         "16); an impact that needs more ends out_of_steps and says so",
-    )  # fmt: skip
+    )
     _add_sphere_arguments(parser, "as the engine you export to", "with --tangential: ")
 
 
 # the fields of an oblique impact printed by `simulate`: name, unit ("" a pure number,
 # "deg" an angle shown in degrees, None a count), in order
-_OBLIQUE_FIELDS = (("e", ""), ("e_t", ""), ("e_t_contact", ""), ("v_t_out", "m/s"),
-                   ("omega_out", "rad/s"), ("angle_out", "deg"),
-                   ("angle_out_contact", "deg"), ("T", "s"), ("num_switches", None))  # fmt: skip
+_OBLIQUE_FIELDS = (
+    ("e", ""),
+    ("e_t", ""),
+    ("e_t_contact", ""),
+    ("v_t_out", "m/s"),
+    ("omega_out", "rad/s"),
+    ("angle_out", "deg"),
+    ("angle_out_contact", "deg"),
+    ("T", "s"),
+    ("num_switches", None),
+)
 
 
 def check_oblique_arguments(args) -> None:
@@ -237,11 +263,20 @@ def run_oblique_impact(args, law, head: list[str]) -> int:
     for angle in args.angle:
         theta = math.radians(angle)
         result = oblique_impact(
-            law, tangential, m=args.mass, R=args.radius, v_n=v0 * math.cos(theta),
-            v_t=v0 * math.sin(theta), omega=args.omega, inertia=args.inertia, g=args.gravity,
-            separation=args.separation, contact_point=args.contact_point,
-            max_segments=args.max_segments, throw=False,
-        )  # fmt: skip
+            law,
+            tangential,
+            m=args.mass,
+            R=args.radius,
+            v_n=v0 * math.cos(theta),
+            v_t=v0 * math.sin(theta),
+            omega=args.omega,
+            inertia=args.inertia,
+            g=args.gravity,
+            separation=args.separation,
+            contact_point=args.contact_point,
+            max_segments=args.max_segments,
+            throw=False,
+        )
         data = {"angle_deg": angle, "v0": v0, **result.to_dict()}
         for name in ("angle_out", "angle_out_contact"):
             value = data[name]
@@ -259,18 +294,23 @@ def run_oblique_impact(args, law, head: list[str]) -> int:
     if len(runs) == 1:
         (data,) = runs
         lines += [f"{'angle':<17} = {data['angle_deg']:g} deg"]
-        lines += [f"{name:<17} = {_oblique_cell(data, name, unit, True)}"
-                  for name, unit in _OBLIQUE_FIELDS]  # fmt: skip
+        lines += [
+            f"{name:<17} = {_oblique_cell(data, name, unit, True)}"
+            for name, unit in _OBLIQUE_FIELDS
+        ]
         lines.append(f"{'status':<17} = {data['status']}")
     else:
         header = ["angle (deg)"] + [
             f"{name} ({unit})" if unit else name for name, unit in _OBLIQUE_FIELDS
         ]
         rows = [
-            [f"{d['angle_deg']:g}", *(_oblique_cell(d, n, u, False) for n, u in _OBLIQUE_FIELDS),
-             d["status"]]
+            [
+                f"{d['angle_deg']:g}",
+                *(_oblique_cell(d, n, u, False) for n, u in _OBLIQUE_FIELDS),
+                d["status"],
+            ]
             for d in runs
-        ]  # fmt: skip
+        ]
         lines += format_table(header + ["status"], rows)
     lines += ["", *textwrap.wrap(_OBLIQUE_LEGEND, 92)]
     if args.plot is not None:
@@ -452,11 +492,22 @@ def run_fit_oblique(args):
     label = f"fitting {args.tangential} to {rows['v_n'].size} rebounds"
     with metered(heartbeat_meter(), 1, label) as bar:  # a first fit compiles for 40-75 s
         fit = fit_oblique(
-            law, tangential, m=args.mass, R=args.radius, v_n=rows["v_n"], v_t=rows["v_t"],
-            omega=rows["omega"], e_t=measured["e_t"], omega_out=measured["omega_out"],
-            free=free, inertia=args.inertia, g=g, contact_point=args.contact_point, **sigmas,
+            law,
+            tangential,
+            m=args.mass,
+            R=args.radius,
+            v_n=rows["v_n"],
+            v_t=rows["v_t"],
+            omega=rows["omega"],
+            e_t=measured["e_t"],
+            omega_out=measured["omega_out"],
+            free=free,
+            inertia=args.inertia,
+            g=g,
+            contact_point=args.contact_point,
+            **sigmas,
             **({"separation": normal["separation"]} if normal else {}),
-        )  # fmt: skip
+        )
         bar.update(1, "done")
     if args.plot is not None:
         _plot(args.plot, rows, fit)
@@ -494,8 +545,12 @@ def normal_law_from_fit(path: Path, name: str | None, mass: float):
         raise CLIError(f"{where}: {error}") from None
     if record.get("converged") is False:
         warnings.warn(f"the fit in {path} did not converge", stacklevel=2)
-    out = {"law": law_name, "params": {k: float(v) for k, v in params.items()},
-           "separation": separation, "from": str(path)}  # fmt: skip
+    out = {
+        "law": law_name,
+        "params": {k: float(v) for k, v in params.items()},
+        "separation": separation,
+        "from": str(path),
+    }
     return law, out
 
 
@@ -515,9 +570,15 @@ def _report(fit, rows, check, normal=None) -> str:
     from .._format import format_quantity
 
     lines = [
-        *([f"normal law {normal['law']} from {normal['from']} ("
-           + ", ".join(f"{k} = {v:g}" for k, v in normal["params"].items())
-           + f"; separation by {normal['separation']})"] if normal else []),
+        *(
+            [
+                f"normal law {normal['law']} from {normal['from']} ("
+                + ", ".join(f"{k} = {v:g}" for k, v in normal["params"].items())
+                + f"; separation by {normal['separation']})"
+            ]
+            if normal
+            else []
+        ),
         fit.summary(),
         f"check: at v_n = {check['v_n']:.4g} m/s the normal law with this mass gives a contact "
         f"time of {format_quantity(check['T'], 's')}, x_max {format_quantity(check['x_max'], 'm')}"

@@ -144,9 +144,16 @@ def reference_impact(
         # a separation, its fall back; the separation must come before it. (V - 1e-14:
         # negative at the start, where V = 0, so that the bracket is never [0, +])
         _, end, _ = _solve(
-            restitution, t_max, tau_max, lambda y: y[1] - 1e-14, beta, n, p, direction=True,
+            restitution,
+            t_max,
+            tau_max,
+            lambda y: y[1] - 1e-14,
+            beta,
+            n,
+            p,
+            direction=True,
             **options,
-        )  # fmt: skip
+        )
     y_end, tau_end, ended = _solve(
         restitution,
         t_max,

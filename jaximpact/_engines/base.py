@@ -80,7 +80,6 @@ class Stepping:
     run: Callable[[float], tuple[np.ndarray, np.ndarray]]
 
 
-
 @dataclasses.dataclass(frozen=True)
 class Scene:
     """The collision an export is designed for: each body's mass `m` (kg), the impact speed
@@ -144,8 +143,16 @@ class AbstractNormalModel(abc.ABC):
         _check_declared(cls, AbstractNormalModel, NORMAL_FACTS)
 
     @abc.abstractmethod
-    def design(self, e: float, T: float | None, scene: Scene, *, timestep: float | None = None,
-               poisson: float = 0.3, limit_damping: bool = False) -> Design:  # fmt: skip
+    def design(
+        self,
+        e: float,
+        T: float | None,
+        scene: Scene,
+        *,
+        timestep: float | None = None,
+        poisson: float = 0.3,
+        limit_damping: bool = False,
+    ) -> Design:
         """The parameters that realise restitution `e` and duration `T` (s; None where the
         engine has a default) in `scene`, at the engine's step `timestep` (s; None: a
         recommended one), with the spheres' `poisson` ratio where the engine takes it and
@@ -301,8 +308,16 @@ class AbstractEngine(abc.ABC):
 
 # the facts every final class declares (class attributes), checked when its class is made
 FACTS = ("NAME", "LABEL", "SCENES", "TWO_SPHERES", "CONTINUOUS_PLANT", "NORMAL", "TANGENTIAL")
-NORMAL_FACTS = ("NAME", "LAW", "KEYS", "STEPPING", "MASS_DEPENDS", "ALLOWS_LIMIT_DAMPING",
-                "NEAREST", "SCENES")  # fmt: skip
+NORMAL_FACTS = (
+    "NAME",
+    "LAW",
+    "KEYS",
+    "STEPPING",
+    "MASS_DEPENDS",
+    "ALLOWS_LIMIT_DAMPING",
+    "NEAREST",
+    "SCENES",
+)
 TANGENTIAL_FACTS = ("MODEL", "FRICTION", "CONTACT_POINT")
 
 

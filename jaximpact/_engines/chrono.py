@@ -55,10 +55,13 @@ class SMCHertz(AbstractNormalModel):
     NAME = "ChSystemSMC.Hertz"
     LAW = hertz.HertzMaterial.LAW
     KEYS = (
-        *(key for key in hertz.HertzMaterial.KEYS
-          if key.name in ("E", "coeff_restitution", "poisson")),
+        *(
+            key
+            for key in hertz.HertzMaterial.KEYS
+            if key.name in ("E", "coeff_restitution", "poisson")
+        ),
         Key("limit_damping", "true or false; its force is always kept non-attractive", False),
-    )  # fmt: skip
+    )
     STEPPING = (
         "its implicit stepper is not replicated: the continuous law's e and T, at a "
         "recommended step of T/100 or less"
@@ -68,8 +71,9 @@ class SMCHertz(AbstractNormalModel):
     NEAREST = "its tsuji law"
     SCENES = None
 
-    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
-               limit_damping=False) -> Design:  # fmt: skip
+    def design(
+        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
+    ) -> Design:
         """`ChContactMaterialSMC` inputs for target `e` and `T` (s): two spheres of mass `m`
         (kg) and radius `radius` (m) at relative speed `v0` (m/s), or with `geometry="wall"`
         a sphere on a fixed ground box of its material (`E_eff = E/(2 (1 - nu^2))`,

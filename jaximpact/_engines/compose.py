@@ -55,15 +55,32 @@ class Request:
         return self.scene.law
 
 
-def request(chosen: AbstractEngine, law_or_fit, *, m, v0, timestep, radius, poisson, e, T,
-            limit_damping, geometry, tangential, engines, missing_mass) -> Request:  # fmt: skip
+def request(
+    chosen: AbstractEngine,
+    law_or_fit,
+    *,
+    m,
+    v0,
+    timestep,
+    radius,
+    poisson,
+    e,
+    T,
+    limit_damping,
+    geometry,
+    tangential,
+    engines,
+    missing_mass,
+) -> Request:
     """The `Request` of `export`'s arguments to engine `chosen`, each refused in one line in
     `export`'s order: what needs no law's impact first (a law's e and T compile)."""
     geometry = scene_geometry(chosen, geometry)
     normal, lacked = normal_model(chosen, None if law_or_fit is None else law_of(law_or_fit))
     if limit_damping and not normal.ALLOWS_LIMIT_DAMPING:  # as GranularModel::init()
-        raise ValueError(f"{chosen.LABEL} refuses limit_damping with its {normal.NAME} model "
-                         "(a cohesive normal model): drop limit_damping")  # fmt: skip
+        raise ValueError(
+            f"{chosen.LABEL} refuses limit_damping with its {normal.NAME} model "
+            "(a cohesive normal model): drop limit_damping"
+        )
     v0, speeds = given_speeds(v0, lacked, chosen)
     if m is None and (law_or_fit is not None or chosen.MASS_DEPENDS is not None):
         raise ValueError(missing_mass(chosen.NAME, law_or_fit is not None, "pass m= (kg)"))
@@ -77,8 +94,18 @@ def request(chosen: AbstractEngine, law_or_fit, *, m, v0, timestep, radius, pois
     if chosen.TWO_SPHERES and target_T is None:
         raise ValueError(f"{chosen.NAME} needs a contact duration: pass T= (s) or a law")
     options = dict(poisson=0.3 if poisson is None else poisson, limit_damping=limit_damping)
-    return Request(chosen, normal, lacked, slot, Scene(m, v0, radius, geometry, source), speeds,
-                   timestep, target_e, target_T, options)  # fmt: skip
+    return Request(
+        chosen,
+        normal,
+        lacked,
+        slot,
+        Scene(m, v0, radius, geometry, source),
+        speeds,
+        timestep,
+        target_e,
+        target_T,
+        options,
+    )
 
 
 def design(asked: Request, tangential) -> Design:
@@ -88,8 +115,9 @@ def design(asked: Request, tangential) -> Design:
     normal, slot, options = asked.normal, asked.slot, asked.options
 
     def make(timestep):
-        return normal.design(asked.target_e, asked.target_T, asked.scene, timestep=timestep,
-                             **options)  # fmt: skip
+        return normal.design(
+            asked.target_e, asked.target_T, asked.scene, timestep=timestep, **options
+        )
 
     out = make(asked.timestep)
     if slot is None:
@@ -119,8 +147,14 @@ def refusal(asked: Request, out: Design, *, strict: bool) -> list[str]:
     if reason is None:
         return []
     step = working_step(asked.normal, asked.target_e, target_T, asked.scene, asked.options)
-    refused = UnrealisedExport(asked.chosen.NAME, out.timestep, reason, step,
-                               continuous=asked.chosen.CONTINUOUS_PLANT, T=target_T)  # fmt: skip
+    refused = UnrealisedExport(
+        asked.chosen.NAME,
+        out.timestep,
+        reason,
+        step,
+        continuous=asked.chosen.CONTINUOUS_PLANT,
+        T=target_T,
+    )
     if strict:
         raise refused
     anyway = UnrealisedWarning(refused)
@@ -135,14 +169,31 @@ def report(asked: Request, out: Design, engine_law, *, curves: bool):
     if not (curves or asked.lacked):
         return {}, [], []
     scene, normal = asked.scene, asked.normal
-    stepping = None if out.stepping is None else normal.stepper(out.stepping, m=scene.m,
-                                                                radius=scene.radius)  # fmt: skip
+    stepping = (
+        None
+        if out.stepping is None
+        else normal.stepper(out.stepping, m=scene.m, radius=scene.radius)
+    )
     law_m = contact_mass(asked.chosen, scene.m, scene.geometry)
-    fields, note = responses(engine_law, law_m, out, stepping, scene.law, m=scene.m,
-                             v0=scene.v0, speeds=asked.speeds)  # fmt: skip
+    fields, note = responses(
+        engine_law, law_m, out, stepping, scene.law, m=scene.m, v0=scene.v0, speeds=asked.speeds
+    )
     if asked.lacked and (note or asked.speeds is not None):
-        return fields, [nearest(asked.chosen, normal, scene.law, fields, asked.target_e,
-                                fitted=asked.speeds is not None, v0=scene.v0)], []  # fmt: skip
+        return (
+            fields,
+            [
+                nearest(
+                    asked.chosen,
+                    normal,
+                    scene.law,
+                    fields,
+                    asked.target_e,
+                    fitted=asked.speeds is not None,
+                    v0=scene.v0,
+                )
+            ],
+            [],
+        )
     return fields, [], [note] if note else []
 
 
@@ -157,9 +208,20 @@ def tangential(asked: Request, out: Design, engine_law, given):
     scene = asked.scene
     exported = given.forces_scaled(contact_mass(asked.chosen, scene.m, scene.geometry) / scene.m)
     parameters = asked.slot.parameters(out, exported)
-    fields, lines = tangential_promise(asked.chosen, asked.slot, out, parameters, engine_law,
-                                       exported, scene.law, given, m=scene.m, v0=scene.v0,
-                                       radius=scene.radius, geometry=scene.geometry)  # fmt: skip
+    fields, lines = tangential_promise(
+        asked.chosen,
+        asked.slot,
+        out,
+        parameters,
+        engine_law,
+        exported,
+        scene.law,
+        given,
+        m=scene.m,
+        v0=scene.v0,
+        radius=scene.radius,
+        geometry=scene.geometry,
+    )
     return parameters, fields, lines
 
 
@@ -174,8 +236,13 @@ def modulus(asked: Request, engine_law, exported) -> list[str]:
     if c is None and scene.law is not None:  # the engine's law is not Hertz's: the given law's
         c = hertz_constant(scene.law, scene.v0)
         c = None if c is None else c * law_m / scene.m
-    return modulus_warnings(c, exported, radius=scene.radius, poisson=asked.options["poisson"],
-                            two_spheres=law_m != scene.m)  # fmt: skip
+    return modulus_warnings(
+        c,
+        exported,
+        radius=scene.radius,
+        poisson=asked.options["poisson"],
+        two_spheres=law_m != scene.m,
+    )
 
 
 def _radius(chosen: AbstractEngine, radius, geometry: str, tangential):
@@ -209,9 +276,8 @@ def _slot(chosen: AbstractEngine, tangential, timestep, engines):
         )
     if slot is None:
         model = next(iter(chosen.TANGENTIAL.values())).MODEL
-        raise ValueError(f"{model}, not {tangential.name!r}: export a "
-                         f"{' or '.join(chosen.TANGENTIAL)} law")  # fmt: skip
+        raise ValueError(
+            f"{model}, not {tangential.name!r}: export a {' or '.join(chosen.TANGENTIAL)} law"
+        )
     slot.check(tangential, timestep=timestep)
     return slot
-
-

@@ -253,17 +253,43 @@ def export(
     **Example**: `export(law("hertz_rate", c=2e6, b1=800.0), "mujoco", m=1.0, v0=2.5).parameters`.
     """
     if _is_posterior(law_or_fit):
-        return _posterior_export(law_or_fit, engine, band_draws=band_draws, progress=progress,
-                                 m=m, v0=v0, timestep=timestep, radius=radius, poisson=poisson,
-                                 e=e, T=T, limit_damping=limit_damping, geometry=geometry,
-                                 curves=curves, strict=strict, tangential=tangential)  # fmt: skip
+        return _posterior_export(
+            law_or_fit,
+            engine,
+            band_draws=band_draws,
+            progress=progress,
+            m=m,
+            v0=v0,
+            timestep=timestep,
+            radius=radius,
+            poisson=poisson,
+            e=e,
+            T=T,
+            limit_damping=limit_damping,
+            geometry=geometry,
+            curves=curves,
+            strict=strict,
+            tangential=tangential,
+        )
     chosen = _engine(engine)
     # the normal model, and what is refused without the law's impact (a law's e and T
     # compile), then the law's e and T (or the targets)
-    asked = compose.request(chosen, law_or_fit, m=m, v0=v0, timestep=timestep, radius=radius,
-                            poisson=poisson, e=e, T=T, limit_damping=limit_damping,
-                            geometry=geometry, tangential=tangential, engines=ENGINES,
-                            missing_mass=missing_mass)  # fmt: skip
+    asked = compose.request(
+        chosen,
+        law_or_fit,
+        m=m,
+        v0=v0,
+        timestep=timestep,
+        radius=radius,
+        poisson=poisson,
+        e=e,
+        T=T,
+        limit_damping=limit_damping,
+        geometry=geometry,
+        tangential=tangential,
+        engines=ENGINES,
+        missing_mass=missing_mass,
+    )
     out = compose.design(asked, tangential)  # the normal model designed (and its tie)
     warnings = [*compose.refusal(asked, out, strict=strict), *out.warnings]
     engine_law = asked.normal.law(out.parameters, asked.m)
@@ -283,8 +309,10 @@ def export(
         v0=asked.scene.v0,
         law=engine_law,
         law_m=contact_mass(chosen, asked.m, asked.scene.geometry),
-        **{f: getattr(out, f) for f in ("e", "T", "timestep", "e_range", "T_range",
-                                        "steps_per_contact", "separation")},  # fmt: skip
+        **{
+            f: getattr(out, f)
+            for f in ("e", "T", "timestep", "e_range", "T_range", "steps_per_contact", "separation")
+        },
         **response,
         **oblique,
     )
@@ -326,8 +354,13 @@ def with_band(x: Export, post, *, band_draws: int = 200, progress=True, **option
             f"{band['failed']} of {band['failed'] + band['draws']} posterior draws left out of "
             "the band: their laws do not separate at this m and v0, or the engine refused them"
         )
-    return dataclasses.replace(x, e_band=band["e_band"], T_band=band["T_band"],
-                               band_draws=band["draws"], warnings=tuple(lines))  # fmt: skip
+    return dataclasses.replace(
+        x,
+        e_band=band["e_band"],
+        T_band=band["T_band"],
+        band_draws=band["draws"],
+        warnings=tuple(lines),
+    )
 
 
 def _normal_for(chosen: AbstractEngine, parameters: dict):
@@ -339,8 +372,11 @@ def _normal_for(chosen: AbstractEngine, parameters: dict):
     needs = [{k.name for k in model.KEYS if k.needed} for model in rows]
     common = set.intersection(*needs)
     named = parameters.get("normal")
-    held = [(len(need - common), i) for i, (model, need) in enumerate(zip(rows, needs))
-            if need - common <= set(parameters) and named in (None, model.NAME)]  # fmt: skip
+    held = [
+        (len(need - common), i)
+        for i, (model, need) in enumerate(zip(rows, needs))
+        if need - common <= set(parameters) and named in (None, model.NAME)
+    ]
     return rows[max(held, key=lambda h: (h[0], -h[1]), default=(0, 0))[1]]
 
 

@@ -118,8 +118,9 @@ def hertz_stiffness(E, nu, R, E2=None, nu2=None, R2=None) -> float:
     """
     R = _positive("R", R, "m")
     R_star = R if R2 is None else effective_radius(R, R2)
-    return _representable("c", 4.0 / 3.0 * effective_modulus(E, nu, E2, nu2) * math.sqrt(R_star),
-                          "N/m^1.5")  # fmt: skip
+    return _representable(
+        "c", 4.0 / 3.0 * effective_modulus(E, nu, E2, nu2) * math.sqrt(R_star), "N/m^1.5"
+    )
 
 
 def yield_overlap(E, nu, R, *, p_y=None, Y=None, E2=None, nu2=None, R2=None) -> float:
@@ -227,11 +228,15 @@ def modulus_warnings(c, tangential, *, radius: float, poisson: float, two_sphere
             f"({low:g} Pa, a soft gel, to {high:g} Pa, diamond): check the law's units, m, v0 "
             "and radius"
         )
-    shear = [] if tangential is None else [
-        (key, float(tangential.params[key]))
-        for key, unit in tangential.spec.units.items()
-        if unit == "Pa" and key in tangential.params
-    ]  # fmt: skip
+    shear = (
+        []
+        if tangential is None
+        else [
+            (key, float(tangential.params[key]))
+            for key, unit in tangential.spec.units.items()
+            if unit == "Pa" and key in tangential.params
+        ]
+    )
     expected = E_star * (1.0 - poisson) / (2.0 * (2.0 - poisson))
     for name, G_star in shear:
         ratio = G_star / expected

@@ -17,16 +17,40 @@ E_T_WARN = 0.005
 TURN_WARN = 0.01
 
 
-def tangential_promise(chosen, slot, design, parameters, engine_law, tangential, source,
-                       given, *, m, v0, radius, geometry):  # fmt: skip
+def tangential_promise(
+    chosen,
+    slot,
+    design,
+    parameters,
+    engine_law,
+    tangential,
+    source,
+    given,
+    *,
+    m,
+    v0,
+    radius,
+    geometry,
+):
     """`(fields, warnings)`: the `Export` fields of the oblique promise of engine `chosen`
     with its tangential model `slot` (`_oblique_promise`, for the normal `design` and the
     exported `parameters`), and the warnings that go with it: the model's `notes`, what its
     friction makes of the law (`FRICTION`) or how far its e_t departs from the law's, and
     where two spheres turn their line of centres."""
-    oblique = _oblique_promise(chosen, slot, parameters, engine_law, design.separation,
-                               tangential, source, given, m=m, v0=v0, radius=radius,
-                               geometry=geometry)  # fmt: skip
+    oblique = _oblique_promise(
+        chosen,
+        slot,
+        parameters,
+        engine_law,
+        design.separation,
+        tangential,
+        source,
+        given,
+        m=m,
+        v0=v0,
+        radius=radius,
+        geometry=geometry,
+    )
     warnings = slot.notes(parameters, tangential)
     if slot.FRICTION is not None:
         warnings.append(_friction_note(slot, given, oblique))
@@ -37,8 +61,21 @@ def tangential_promise(chosen, slot, design, parameters, engine_law, tangential,
     return oblique, warnings
 
 
-def _oblique_promise(chosen, slot, parameters, engine_law, separation, tangential, source,
-                     given, *, m, v0, radius, geometry):  # fmt: skip
+def _oblique_promise(
+    chosen,
+    slot,
+    parameters,
+    engine_law,
+    separation,
+    tangential,
+    source,
+    given,
+    *,
+    m,
+    v0,
+    radius,
+    geometry,
+):
     """The oblique impacts at speed `v0` (m/s) from `OBLIQUE_ANGLES` (no spin before) that
     the engine realises with `parameters`: its own stepping where it is replicated
     (`slot.oblique`, the mean over first-touch phases), else its continuous laws (its
@@ -60,10 +97,20 @@ def _oblique_promise(chosen, slot, parameters, engine_law, separation, tangentia
         # a soft spring sticks and slips many times (throw=False: a solve that still
         # fails is NaN in the promise, not an error of the export)
         body = scene if body is None else body
-        rows = [oblique_impact(normal_law, tangential_law, **body, v_n=float(a), v_t=float(b),
-                               separation=ends, contact_point=contact_point,
-                               max_segments=64, throw=False)
-                for a, b in zip(v_n, v_t, strict=True)]  # fmt: skip
+        rows = [
+            oblique_impact(
+                normal_law,
+                tangential_law,
+                **body,
+                v_n=float(a),
+                v_t=float(b),
+                separation=ends,
+                contact_point=contact_point,
+                max_segments=64,
+                throw=False,
+            )
+            for a, b in zip(v_n, v_t, strict=True)
+        ]
         return tuple(
             np.array([[float(getattr(r, k)) for r in rows] for k in ("e", "e_t", "omega_out")])
         )
@@ -82,9 +129,14 @@ def _oblique_promise(chosen, slot, parameters, engine_law, separation, tangentia
     if source is not None:
         at_m = dict(scene, m=m)
         target = tuple(map(float, continuous(source, given, ends="force", body=at_m)[1]))
-    return dict(tangential=tangential, angles=OBLIQUE_ANGLES, e_t_engine=tuple(map(float, e_t)),
-                omega_engine=tuple(map(float, omega)), e_n_engine=tuple(map(float, e_n)),
-                e_t_target=target)  # fmt: skip
+    return dict(
+        tangential=tangential,
+        angles=OBLIQUE_ANGLES,
+        e_t_engine=tuple(map(float, e_t)),
+        omega_engine=tuple(map(float, omega)),
+        e_n_engine=tuple(map(float, e_n)),
+        e_t_target=target,
+    )
 
 
 def _friction_note(slot, tangential, oblique) -> str:

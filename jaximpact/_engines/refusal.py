@@ -13,8 +13,9 @@ class UnrealisedExport(ValueError):
     engine also has a continuous plant (time step 0); `T` (s): the target duration, by
     which the steps are also told as T/n."""
 
-    def __init__(self, engine: str, step, reason: str, working, *, continuous: bool = False,
-                 T=None):  # fmt: skip
+    def __init__(
+        self, engine: str, step, reason: str, working, *, continuous: bool = False, T=None
+    ):
         self.engine, self.step, self.reason, self.working = engine, step, reason, working
         self.continuous, self.T = continuous, T
         super().__init__(self.message("strict=False"))
@@ -59,9 +60,13 @@ def unrealised(out: Design, target_e: float, target_T) -> str | None:
     h = out.timestep
     steps = target_T / h if (h and target_T is not None) else None
     return _stepping.unrealised(
-        out.e, out.T, target_e=target_e, target_T=target_T, steps_per_contact=steps,
+        out.e,
+        out.T,
+        target_e=target_e,
+        target_T=target_T,
+        steps_per_contact=steps,
         parameters=out.parameters,
-    )  # fmt: skip
+    )
 
 
 def working_step(normal, target_e: float, target_T, scene, options: dict):

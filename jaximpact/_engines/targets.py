@@ -82,8 +82,7 @@ def targets(law_or_fit, *, e, T, m: float, v0: float, speeds=None):
     return source, float(result.e), float(result.T)
 
 
-def responses(engine_law, m_engine: float, out: Design, stepping, source, *, m, v0,
-               speeds=None):  # fmt: skip
+def responses(engine_law, m_engine: float, out: Design, stepping, source, *, m, v0, speeds=None):
     """`(fields, note)`: the `Export` fields `speeds` (m/s, `v0` times `SPEED_FACTORS`, or
     the `speeds` given),
     `e_engine`, `T_engine` (what the engine realises: its `stepping`'s mean over first-touch
@@ -144,8 +143,16 @@ def given_speeds(v0, lacked, chosen: AbstractEngine):
     return float(np.sqrt(speeds[0] * speeds[-1])), tuple(speeds)
 
 
-def nearest(chosen: AbstractEngine, normal, source, fields: dict, target_e: float, *,
-            fitted: bool, v0: float) -> str:  # fmt: skip
+def nearest(
+    chosen: AbstractEngine,
+    normal,
+    source,
+    fields: dict,
+    target_e: float,
+    *,
+    fitted: bool,
+    v0: float,
+) -> str:
     """The one line for a law with a contact state (`source`) that engine `chosen` does not
     have: the nearest law it has (its normal model `normal`'s `NEAREST`), how it was set (`fitted`:
     the middle of the law's e over the speeds given, else e and T at `v0`), and the worst

@@ -137,8 +137,9 @@ class ViscElMat(AbstractNormalModel):
     NEAREST = "its kelvin_voigt law"
     SCENES = None
 
-    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
-               limit_damping=False) -> Design:  # fmt: skip
+    def design(
+        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
+    ) -> Design:
         """ViscElMat inputs and O.dt for target `e` and `T` (s), two spheres of mass `m`
         (kg) and radius `radius` (m) at relative speed `v0` (m/s) or (`geometry="wall"`) one
         such sphere on a fixed wall of mass 0; `e` and `T` of the design are the replica's
@@ -220,8 +221,13 @@ class ViscElMat(AbstractNormalModel):
             raise ValueError(f"NewtonIntegrator damping must lie in [0, 1), got {damping!r}")
         tc = check_positive("tc", parameters["tc"], "s")
         en = check_restitution(parameters["en"], "en")
-        stepping = {"tc": tc, "en": en, "timestep": h, "damping": damping,
-                    "geometry": parameters.get("geometry", "spheres")}  # fmt: skip
+        stepping = {
+            "tc": tc,
+            "en": en,
+            "timestep": h,
+            "damping": damping,
+            "geometry": parameters.get("geometry", "spheres"),
+        }
         return Stepping(h, lambda v: replica(stepping, m, v))
 
 

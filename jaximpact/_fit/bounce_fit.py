@@ -86,8 +86,10 @@ class BounceFit(eqx.Module):
         law's name)."""
         units = units or ("s" if self.kind == "impacts" else "y units")
         converged = "converged" if self.converged else "NOT converged"
-        lines = [f"{title or self.law.name}: {self.kind}, {converged} after {self.iterations} "
-                 f"iterations, noise {format_number(self.sigma, 3)} {units}"]  # fmt: skip
+        lines = [
+            f"{title or self.law.name}: {self.kind}, {converged} after {self.iterations} "
+            f"iterations, noise {format_number(self.sigma, 3)} {units}"
+        ]
         law_unit = law_units(self.law)
         for key, value in self.params.items():
             unit = law_unit.get(key, "")
@@ -100,23 +102,30 @@ class BounceFit(eqx.Module):
                 shown += "  (held)"
             lines.append(f"  {key:<12} = {shown}")
         q = self.nuisance
-        lines.append(f"  first impact at {q['t_impact']:.4f} s, {q['v_impact']:.4f} m/s "
-                     f"(drop height {q['drop_height']:.4f} m)")  # fmt: skip
+        lines.append(
+            f"  first impact at {q['t_impact']:.4f} s, {q['v_impact']:.4f} m/s "
+            f"(drop height {q['drop_height']:.4f} m)"
+        )
         if "floor" in q:
-            lines.append(f"  floor {format_number(q['floor'])}, scale "
-                         f"{format_number(q['length_scale'])} {units}/m")  # fmt: skip
+            lines.append(
+                f"  floor {format_number(q['floor'])}, scale "
+                f"{format_number(q['length_scale'])} {units}/m"
+            )
         if "drag" in q:
             lines.append(f"  drag {format_number(q['drag'])} 1/m")
         if self.kind == "impacts":
-            lines.append(f"  used {np.size(self.times)} detections; dropped "
-                         f"{list(map(int, self.dropped))}, missed impacts "
-                         f"{list(map(int, self.missed))}")  # fmt: skip
+            lines.append(
+                f"  used {np.size(self.times)} detections; dropped "
+                f"{list(map(int, self.dropped))}, missed impacts "
+                f"{list(map(int, self.missed))}"
+            )
         else:
             lines.append(f"  used {np.size(self.t)} samples; dropped {np.size(self.dropped)}")
         lines.append("  impact  speed (m/s)  e")
         for k in range(min(self.num_impacts, 12)):
-            lines.append(f"  {k:>6}  {self.impact_speeds[k]:11.4f}  {self.e[k]:.4f} ± "
-                         f"{self.e_stderr[k]:.4f}")  # fmt: skip
+            lines.append(
+                f"  {k:>6}  {self.impact_speeds[k]:11.4f}  {self.e[k]:.4f} ± {self.e_stderr[k]:.4f}"
+            )
         if self.num_impacts > 12:
             lines.append(f"  ... {self.num_impacts - 12} more")
         return "\n".join(lines)
@@ -127,13 +136,26 @@ class BounceFit(eqx.Module):
         `stderr`, `free`, `undetermined`, `nuisance`, per modelled impact `e`, `e_stderr`,
         `impact_speeds`, `impact_times`, `T`, and `sigma`, `dof`, `loss`, `converged`,
         `iterations`, `dropped`, `used` (detections or samples), `missed` (impact fits)."""
-        data = dict(kind=self.kind, law=self.law.name, params=self.params, stderr=self.stderr,
-                    free=list(self.free), undetermined=list(self.undetermined),
-                    nuisance=self.nuisance, e=self.e, e_stderr=self.e_stderr,
-                    impact_speeds=self.impact_speeds, impact_times=self.impact_times,
-                    T=self.T, sigma=self.sigma, dof=self.dof, loss=self.loss,
-                    converged=self.converged, iterations=self.iterations,
-                    dropped=self.dropped)  # fmt: skip
+        data = dict(
+            kind=self.kind,
+            law=self.law.name,
+            params=self.params,
+            stderr=self.stderr,
+            free=list(self.free),
+            undetermined=list(self.undetermined),
+            nuisance=self.nuisance,
+            e=self.e,
+            e_stderr=self.e_stderr,
+            impact_speeds=self.impact_speeds,
+            impact_times=self.impact_times,
+            T=self.T,
+            sigma=self.sigma,
+            dof=self.dof,
+            loss=self.loss,
+            converged=self.converged,
+            iterations=self.iterations,
+            dropped=self.dropped,
+        )
         if self.kind == "impacts":
             data.update(missed=self.missed, used=int(np.size(self.times)))
         else:

@@ -217,18 +217,44 @@ class Fit(eqx.Module):
         `loss`, `history`, per speed `v0`, `e`, `T`, `e_target`, `T_target`, `x_max`,
         `F_max`, `residuals`, the mass `m`, and the `notes`. Concrete fits only (not
         inside `jit`)."""
-        names = ("params", "stderr", "converged", "reproduces", "target_tol", "iterations",
-                 "loss", "history", "m", "v0", "e", "T", "e_target", "T_target", "x_max",
-                 "F_max", "residuals")  # fmt: skip
+        names = (
+            "params",
+            "stderr",
+            "converged",
+            "reproduces",
+            "target_tol",
+            "iterations",
+            "loss",
+            "history",
+            "m",
+            "v0",
+            "e",
+            "T",
+            "e_target",
+            "T_target",
+            "x_max",
+            "F_max",
+            "residuals",
+        )
         out = {k: jsonable(getattr(self, k)) for k in names}
         if self.n_data is not None:
-            out.update({k: jsonable(getattr(self, k)) for k in ("n_data", "dof", "chi2",
-                        "reduced_chi2", "p_value", "rms_e", "rms_T")})  # fmt: skip
+            out.update(
+                {
+                    k: jsonable(getattr(self, k))
+                    for k in ("n_data", "dof", "chi2", "reduced_chi2", "p_value", "rms_e", "rms_T")
+                }
+            )
         law = {"name": self.law.name}
         law["parameters"] = out["params"]
-        return {"law": law, **out, "free": list(self.free), "optimizer": self.optimizer,
-                "undetermined": list(self.undetermined), "weighted": self.weighted,
-                "notes": list(self.notes)}  # fmt: skip
+        return {
+            "law": law,
+            **out,
+            "free": list(self.free),
+            "optimizer": self.optimizer,
+            "undetermined": list(self.undetermined),
+            "weighted": self.weighted,
+            "notes": list(self.notes),
+        }
 
     def __repr__(self) -> str:
         return self.summary()
@@ -295,9 +321,10 @@ def reproduces_text(fit) -> str:
     """Whether every residual is within `target_tol`, and what that tolerance means."""
     tol = format_number(float(fit.target_tol))
     meaning = (
-        f"{tol} standard deviations (the sigmas given)" if fit.weighted
+        f"{tol} standard deviations (the sigmas given)"
+        if fit.weighted
         else f"{tol} (no sigmas: the data to numerical precision, as synthetic data are)"
-    )  # fmt: skip
+    )
     if bool(fit.reproduces):
         return f"True: every residual within target_tol = {meaning}"
     largest = format_number(float(fit.max_residual), 3)
@@ -497,7 +524,7 @@ def _start_on_curves(law, free, *, m, v0, e, T, has_T, key):
 
 def _residual_function(
     law, free, *, m, separation, g, rtol, has_e, has_T, curves=None, closed_form=False
-):  # fmt: skip
+):
     """`_residuals` with the options of a fit at tolerance `rtol` on the path that `curves`
     (a `CurveKey`, or a two-group table's key) and `closed_form` name, every other option at
     `calibrate`'s default (for a caller that rebuilds a fit's forward model by keywords)."""
@@ -512,9 +539,15 @@ def _impact_options(path, solve: SolveOptions, *, separation, g) -> ImpactOption
     left out (the final evaluation asks for them) and diffrax's `ForwardMode` (the fit's
     Jacobian is a forward-mode one, `with_forward_jacobian`)."""
     solve = with_defaults(
-        solve, atol=solve.rtol, max_steps=4096, tau_max=1e4, rest_tol=1e-9, solver=dfx.Tsit5(),
-        adjoint=dfx.ForwardMode(), peaks=False,
-    )  # fmt: skip
+        solve,
+        atol=solve.rtol,
+        max_steps=4096,
+        tau_max=1e4,
+        rest_tol=1e-9,
+        solver=dfx.Tsit5(),
+        adjoint=dfx.ForwardMode(),
+        peaks=False,
+    )
     return make_options(path, solve, separation=separation, gravity=not is_no_gravity(g))
 
 
@@ -703,8 +736,15 @@ def calibrate(
     undetermined, undetermined_why = _undetermined(law, free, e=e, T=T, g_is_zero=g_is_zero)
     solve = solve_options(calibrate, options, rtol=rtol, refused=FIT_DECIDES)
     # the path, once: its curves are loaded (or built) now, before the fit is compiled
-    path = choose_path(law, separation=separation, method=method, g=g, solver=solve.solver,
-                       rtol=solve.rtol, fit=True)  # fmt: skip
+    path = choose_path(
+        law,
+        separation=separation,
+        method=method,
+        g=g,
+        solver=solve.solver,
+        rtol=solve.rtol,
+        fit=True,
+    )
     start_on_curves = init == "auto" and path.name == "similarity"
     if init == "auto" and not start_on_curves:
         law = _initial_law(law, free, m=m, v0=v0, e=e, T=T, separation=separation)
@@ -731,8 +771,14 @@ def calibrate(
     )
     # g = 0 as a Python number is static to filter_jit (a numpy scalar would be traced):
     # the formulas without gravity are compiled alone
-    fit = _fit(law, data, m, 0.0 if g_is_zero else jnp.asarray(g, dtype=float),
-               np.float64(target_tol), options)  # fmt: skip
+    fit = _fit(
+        law,
+        data,
+        m,
+        0.0 if g_is_zero else jnp.asarray(g, dtype=float),
+        np.float64(target_tol),
+        options,
+    )
     fit = checks.refuse(fit, keep=("target_tol", "n_data"), converged=False, reproduces=False)
     fit = dataclasses.replace(fit, sigma_e=sigma_e, sigma_T=sigma_T)  # for `posterior`
     e_only = T is None and g_is_zero and shape_of(law) is not None

@@ -213,10 +213,21 @@ def fit_bounces(
                 "give either a trajectory (t=..., y=...) or impact_times=..., not both"
             )
         options = dict(
-            m=m, free=free, g=g, separation=separation, drag=drag, fit_drag=fit_drag,
-            sigma=sigma, clean_tol=clean_tol, outlier_sigma=outlier_sigma, max_iter=max_iter,
-            tol=tol, rtol=rtol, max_steps=max_steps, options=options,
-        )  # fmt: skip
+            m=m,
+            free=free,
+            g=g,
+            separation=separation,
+            drag=drag,
+            fit_drag=fit_drag,
+            sigma=sigma,
+            clean_tol=clean_tol,
+            outlier_sigma=outlier_sigma,
+            max_iter=max_iter,
+            tol=tol,
+            rtol=rtol,
+            max_steps=max_steps,
+            options=options,
+        )
         for i, times in enumerate(impact_times):  # every drop checked before any is fitted
             try:
                 prepare_impacts(times_in_order(times, "impact_times"), clean_tol)
@@ -249,8 +260,7 @@ def fit_bounces(
             f"cannot fit {', '.join(unknown)}: the law's parameters are {', '.join(law.parameters)}"
         )
     kind = "impacts" if impact_times is not None else "trajectory"
-    solve = solve_options(fit_bounces, options, rtol=rtol, max_steps=max_steps,
-                          refused=FIT_DECIDES)  # fmt: skip
+    solve = solve_options(fit_bounces, options, rtol=rtol, max_steps=max_steps, refused=FIT_DECIDES)
     solve = dataclasses.replace(solve, adjoint=dfx.ForwardMode(), peaks=False)
     options = bounce_options(law, solve, separation=separation, max_impacts=8)
     problem = BounceProblem(

@@ -149,19 +149,34 @@ class Ranking:
         if self.fit.weighted:
             what = "chi2: the sum of squared normalised residuals"
         else:
-            what = ("sum of squared residuals e_fit - e and (T_fit - T)/T, unweighted (no "
-                    "sigmas: not a chi-square; .chi2 is the same number)")  # fmt: skip
+            what = (
+                "sum of squared residuals e_fit - e and (T_fit - T)/T, unweighted (no "
+                "sigmas: not a chi-square; .chi2 is the same number)"
+            )
         rows = [("sum_sq", f"{format_value(self.sum_sq, '')} ({what})")]
-        rows += [(k, format_value(getattr(self, k), None if k == "k" else ""))
-                 for k in ("k", "aic", "bic")]  # fmt: skip
+        rows += [
+            (k, format_value(getattr(self, k), None if k == "k" else ""))
+            for k in ("k", "aic", "bic")
+        ]
         return format_fields(f"Ranking of {self.name}", rows) + "\n" + self.fit.summary()
 
     def to_dict(self) -> dict:
         """`name`, `sum_sq` (also as `chi2`, its old name), `k`, `dof`, `reduced_chi2`,
         `p_value`, `rms_e`, `rms_T`, `aic`, `bic` and the `fit` (`Fit.to_dict()`), as
         plain numbers (NaN and missing as None)."""
-        names = ("name", "sum_sq", "chi2", "k", "dof", "reduced_chi2", "p_value", "rms_e",
-                 "rms_T", "aic", "bic")  # fmt: skip
+        names = (
+            "name",
+            "sum_sq",
+            "chi2",
+            "k",
+            "dof",
+            "reduced_chi2",
+            "p_value",
+            "rms_e",
+            "rms_T",
+            "aic",
+            "bic",
+        )
         head = {k: jsonable(getattr(self, k)) for k in names}
         return {**head, "fit": self.fit.to_dict()}
 
@@ -291,9 +306,18 @@ def compare_laws(
     def one(job):
         name, start, free = job
         with jax.enable_x64(x64):
-            fit = calibrate(start, m=m, v0=v0_rows, e=e_rows, T=T_rows, sigma_e=sigma_e,
-                            sigma_T=sigma_T, free=free, separation=separation,
-                            **calibrate_options)  # fmt: skip
+            fit = calibrate(
+                start,
+                m=m,
+                v0=v0_rows,
+                e=e_rows,
+                T=T_rows,
+                sigma_e=sigma_e,
+                sigma_T=sigma_T,
+                free=free,
+                separation=separation,
+                **calibrate_options,
+            )
         sum_sq = float(jnp.sum(fit.residuals**2))
         k = len(free)
         aic = sum_sq + 2 * k if has_sigma else None

@@ -15,8 +15,13 @@ from .._status import Status
 from .parts import FLOAT_OUTPUTS
 from .processes import ProcessGroup
 
-_STATUS_NAMES = np.array([Status(i).name if i in set(map(int, Status)) else "" for i in
-                          range(max(map(int, Status)) + 1)], object)  # fmt: skip
+_STATUS_NAMES = np.array(
+    [
+        Status(i).name if i in set(map(int, Status)) else ""
+        for i in range(max(map(int, Status)) + 1)
+    ],
+    object,
+)
 
 
 def compute_chunk(law, cells, fixed: dict, options: dict, group: ProcessGroup | None) -> dict:
@@ -34,8 +39,11 @@ def compute_chunk(law, cells, fixed: dict, options: dict, group: ProcessGroup | 
     that first row again as padding."""
     rows = 0 if cells is None else cells.rows
     values = {} if cells is None else cells.values
-    given = {k: np.broadcast_to(np.asarray(v, float), (rows,)) for k, v in fixed.items()
-             if k != "separation"}  # fmt: skip
+    given = {
+        k: np.broadcast_to(np.asarray(v, float), (rows,))
+        for k, v in fixed.items()
+        if k != "separation"
+    }
     given.update({k: v for k, v in values.items() if k != "separation"})
     given.setdefault("g", np.zeros(rows))
     sep = values.get("separation", np.full(rows, fixed.get("separation", "force"), object))
@@ -52,15 +60,20 @@ def compute_chunk(law, cells, fixed: dict, options: dict, group: ProcessGroup | 
         inputs = {k: np.asarray(given.get(k, np.zeros(0)), float)[idx] for k in columns}
         first, size = plan[key]
         if group is not None:  # the first row, this process's rows, the first row as padding
-            inputs = {k: np.concatenate([[first[j]], inputs[k], np.full(size - idx.size, first[j])])
-                      for j, k in enumerate(columns)}  # fmt: skip
+            inputs = {
+                k: np.concatenate([[first[j]], inputs[k], np.full(size - idx.size, first[j])])
+                for j, k in enumerate(columns)
+            }
         done = run_impacts(
-            law.skeleton, {k: inputs[k] for k in law.parameters},
-            {k: inputs[k] for k in ("m", "v0", "g")}, separation=json.loads(key)[0],
-            fields=(*FLOAT_OUTPUTS, "status"), progress=False,
+            law.skeleton,
+            {k: inputs[k] for k in law.parameters},
+            {k: inputs[k] for k in ("m", "v0", "g")},
+            separation=json.loads(key)[0],
+            fields=(*FLOAT_OUTPUTS, "status"),
+            progress=False,
             **({"devices": GLOBAL} if group is not None else {}),
             **{"rtol": None, **options},  # as `impact`: 1e-11, a user's law 1e-12
-        )  # fmt: skip
+        )
         if not idx.size:
             continue
         out = mark_invalid(done.out, done.lost)  # results float64 cannot hold: invalid
@@ -77,8 +90,9 @@ def _row_groups(law, given: dict, sep, values: dict) -> dict:
     row indices: the rows that share a path and a compiled program."""
     keys = [np.unique(sep, return_inverse=True)[1]] if "separation" in values else []
     keys += [given["g"] == 0.0] if "g" in values else []
-    keys += [np.unique(values[k], return_inverse=True)[1] for k in law.shape_parameters
-             if k in values]  # fmt: skip
+    keys += [
+        np.unique(values[k], return_inverse=True)[1] for k in law.shape_parameters if k in values
+    ]
     group_of = np.zeros(len(sep), int)
     if keys:
         _, group_of = np.unique(np.stack(keys, axis=1), axis=0, return_inverse=True)
@@ -95,8 +109,10 @@ def _shared_plan(group: ProcessGroup, local: dict, given: dict, columns) -> dict
     """Every process's row groups of the round (`local`: this one's), each key -> (the values
     of `columns` in its first row on the first process that has it, the most rows any
     process has of it): the same on every process."""
-    shared = {key: ([float(given[k][idx[0]]) for k in columns], int(idx.size))
-              for key, idx in local.items()}  # fmt: skip
+    shared = {
+        key: ([float(given[k][idx[0]]) for k in columns], int(idx.size))
+        for key, idx in local.items()
+    }
     plan = {}
     for theirs in group.gather(shared):
         for key, (first, size) in theirs.items():

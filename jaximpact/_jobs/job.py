@@ -120,11 +120,22 @@ class Job:
         )
 
 
-def batch_file(source, out, law, *, params: dict | None = None, m: float | None = None,
-               v0: float | None = None, g: float | None = None, separation: str | None = None,
-               chunk_rows: int = 100_000, resume: bool = False,
-               progress: bool | AbstractMeter = True, mesh: str = "local",
-               **impact_options) -> BatchFile:  # fmt: skip
+def batch_file(
+    source,
+    out,
+    law,
+    *,
+    params: dict | None = None,
+    m: float | None = None,
+    v0: float | None = None,
+    g: float | None = None,
+    separation: str | None = None,
+    chunk_rows: int = 100_000,
+    resume: bool = False,
+    progress: bool | AbstractMeter = True,
+    mesh: str = "local",
+    **impact_options,
+) -> BatchFile:
     """Run `impact_batch` over the rows of the file `source` and write `out`.
 
     - `source`, `out`: CSV files, or Parquet (`.parquet`, `.pq`; needs pyarrow). `out`
@@ -173,9 +184,18 @@ def batch_file(source, out, law, *, params: dict | None = None, m: float | None 
     `batch_file("bodies.csv", "impacts.csv", custom_law(f, c=2e6, b1=800.0), m=1.0)`.
     """
     given = {"m": m, "v0": v0, "g": g, "separation": separation}
-    job = plan(source, out, law, params=params, given=given, chunk_rows=chunk_rows,
-               resume=resume, progress=progress, mesh=mesh,
-               impact_options=impact_options)  # fmt: skip
+    job = plan(
+        source,
+        out,
+        law,
+        params=params,
+        given=given,
+        chunk_rows=chunk_rows,
+        resume=resume,
+        progress=progress,
+        mesh=mesh,
+        impact_options=impact_options,
+    )
     with _one_writer(job):
         return join(compute(check(job)))
 
@@ -198,8 +218,9 @@ def _one_writer(job: Job):
         yield
 
 
-def plan(source, out, law, *, params, given, chunk_rows, resume, progress, mesh,
-         impact_options) -> Job:  # fmt: skip
+def plan(
+    source, out, law, *, params, given, chunk_rows, resume, progress, mesh, impact_options
+) -> Job:
     """The job of `batch_file`'s arguments (`given`: its `m`, `v0`, `g`, `separation`), each
     checked, and the table opened: a one-line `ValueError` before any work."""
     law = job_law(law)
@@ -230,17 +251,34 @@ def plan(source, out, law, *, params, given, chunk_rows, resume, progress, mesh,
     fixed = {k: v for k, v in fixed.items() if k not in columns}
     agree = {k: v for k, v in agree.items() if k in columns}  # checked row by row
     settings = json.dumps(
-        [_FORMAT, law.identity, columns, sorted((k, repr(v)) for k, v in fixed.items()),
-         sorted((k, repr(v)) for k, v in impact_options.items()), is_parquet(out)]
-    )  # fmt: skip
+        [
+            _FORMAT,
+            law.identity,
+            columns,
+            sorted((k, repr(v)) for k, v in fixed.items()),
+            sorted((k, repr(v)) for k, v in impact_options.items()),
+            is_parquet(out),
+        ]
+    )
     return Job(
-        law=law, table=table, label=source.name if from_file else "chunks",
-        from_file=from_file, out=out, parts=Parts(out, parquet=is_parquet(out)),
-        columns=columns, fixed=fixed, agree=agree, impact_options=dict(impact_options),
-        settings=settings, group=ProcessGroup.current(), chunk_rows=chunk_rows,
-        resume=resume, progress=progress, mesh=mesh,
+        law=law,
+        table=table,
+        label=source.name if from_file else "chunks",
+        from_file=from_file,
+        out=out,
+        parts=Parts(out, parquet=is_parquet(out)),
+        columns=columns,
+        fixed=fixed,
+        agree=agree,
+        impact_options=dict(impact_options),
+        settings=settings,
+        group=ProcessGroup.current(),
+        chunk_rows=chunk_rows,
+        resume=resume,
+        progress=progress,
+        mesh=mesh,
         one_pass=not getattr(table, "replayable", True),  # a generator: checked as it comes
-    )  # fmt: skip
+    )
 
 
 def _given_for_every_row(law: JobLaw, params: dict, given: dict) -> tuple[dict, dict]:
@@ -261,8 +299,9 @@ def _given_for_every_row(law: JobLaw, params: dict, given: dict) -> tuple[dict, 
             else ""
         )
         takes = ", ".join(law.parameters) or "what its function reads"
-        raise ValueError(f"law {law.label!r} has no parameter {', '.join(unknown)}; it takes "
-                         f"{takes}{hint}")  # fmt: skip
+        raise ValueError(
+            f"law {law.label!r} has no parameter {', '.join(unknown)}; it takes {takes}{hint}"
+        )
     agree = {**params, **{k: v for k, v in given.items() if v is not None}}
     fixed = {**law.defaults, **params, "separation": given["separation"] or "force"}
     fixed.update({k: given[k] for k in KINEMATICS if given[k] is not None})
@@ -347,8 +386,9 @@ def compute(job: Job) -> Job:
                 if problem is not None:
                     raise ValueError(problem)
                 if todo is not None or together:  # `together`: each process takes part
-                    results = compute_chunk(job.law, todo, job.fixed, job.impact_options,
-                                            group if together else None)  # fmt: skip
+                    results = compute_chunk(
+                        job.law, todo, job.fixed, job.impact_options, group if together else None
+                    )
                 if todo is not None:
                     parts.write(mine[0], digests[mine[0]], job.columns, todo, results)
                     computed += 1
@@ -370,8 +410,9 @@ def compute(job: Job) -> Job:
         raise RuntimeError("another process of the batch failed; run again with --resume")
     if job.one_pass and group.count > 1:  # each process counted the chunks it read
         chunks = max(group.gather(chunks))
-    return dataclasses.replace(job, rows=rows, chunks=chunks, digests=digests,
-                               computed=computed, reused=reused)  # fmt: skip
+    return dataclasses.replace(
+        job, rows=rows, chunks=chunks, digests=digests, computed=computed, reused=reused
+    )
 
 
 def join(job: Job) -> BatchFile:
@@ -389,8 +430,16 @@ def join(job: Job) -> BatchFile:
         parts.remove()
     statuses = group.gather(statuses)[0]  # and every process waits for the joined file
     set_note(None)
-    return BatchFile(str(job.out), job.rows, job.chunks, job.computed, job.reused, statuses,
-                     group.index, group.count)  # fmt: skip
+    return BatchFile(
+        str(job.out),
+        job.rows,
+        job.chunks,
+        job.computed,
+        job.reused,
+        statuses,
+        group.index,
+        group.count,
+    )
 
 
 def check_output_file(out, source=None, label: str = "out"):
@@ -408,8 +457,11 @@ def check_output_file(out, source=None, label: str = "out"):
         raise ValueError(f"{label} {out}: is a directory; name the file to write")
     check_outputs(
         [source],
-        {label: out, f"{label} (written first as)": temporary_name(out),
-         f"{label} (its lock)": lock_name(out)},  # fmt: skip
+        {
+            label: out,
+            f"{label} (written first as)": temporary_name(out),
+            f"{label} (its lock)": lock_name(out),
+        },
         {f"{label} (its parts directory)": Parts(out, parquet=is_parquet(out)).dir},
     )
 

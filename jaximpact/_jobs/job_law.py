@@ -61,8 +61,7 @@ def parameters_read(fn: Callable, names) -> tuple[str, ...]:
             return len(self._values)
 
     scalar = jax.ShapeDtypeStruct((), jnp.result_type(float))
-    jax.eval_shape(lambda x, v, p: fn(x, v, Reads(p)), scalar, scalar,
-                   dict.fromkeys(names, scalar))  # fmt: skip
+    jax.eval_shape(lambda x, v, p: fn(x, v, Reads(p)), scalar, scalar, dict.fromkeys(names, scalar))
     return tuple(read)
 
 
@@ -143,8 +142,10 @@ class JobLaw:
                 )
         for key in params:
             if key not in read:
-                raise ValueError(f"{option_name(key)}: {self.label} does not read "
-                                 f"params[{json.dumps(key)}] ({reads})")  # fmt: skip
+                raise ValueError(
+                    f"{option_name(key)}: {self.label} does not read "
+                    f"params[{json.dumps(key)}] ({reads})"
+                )
         carried = [k for k in from_columns if k not in read]  # `readers.carried_columns`
         return dataclasses.replace(self, parameters=tuple(k for k in names if k not in carried))
 
@@ -175,18 +176,26 @@ def job_law(law) -> JobLaw:
         return _table_law(law.spec, values)
     fn = law.fn
     return JobLaw(
-        label=law.name, skeleton=law_skeleton(law), parameters=tuple(values), defaults=values,
-        identity=json.dumps(["user", law.name, *function_identity(fn)]), fn=fn,
-    )  # fmt: skip
+        label=law.name,
+        skeleton=law_skeleton(law),
+        parameters=tuple(values),
+        defaults=values,
+        identity=json.dumps(["user", law.name, *function_identity(fn)]),
+        fn=fn,
+    )
 
 
 def _table_law(spec, values: dict) -> JobLaw:
     """A law of the table's row `spec`, its own parameter `values` over the row's defaults."""
     return JobLaw(
-        label=spec.name, skeleton=("law", spec.name), parameters=tuple(spec.parameters),
-        defaults={**spec.defaults, **values}, positive=tuple(spec.positive),
-        shape_parameters=tuple(spec.shape_parameters), identity=spec.name,
-    )  # fmt: skip
+        label=spec.name,
+        skeleton=("law", spec.name),
+        parameters=tuple(spec.parameters),
+        defaults={**spec.defaults, **values},
+        positive=tuple(spec.positive),
+        shape_parameters=tuple(spec.shape_parameters),
+        identity=spec.name,
+    )
 
 
 def function_identity(fn: Callable) -> list[str]:
@@ -205,8 +214,10 @@ def function_identity(fn: Callable) -> list[str]:
         digest = hashlib.sha256(marshal.dumps(code)).hexdigest()
     else:
         digest = ""
-    held = [*(getattr(fn, "__defaults__", None) or ()),
-            *(cell.cell_contents for cell in (getattr(fn, "__closure__", None) or ()))]  # fmt: skip
+    held = [
+        *(getattr(fn, "__defaults__", None) or ()),
+        *(cell.cell_contents for cell in (getattr(fn, "__closure__", None) or ())),
+    ]
     return [
         str(getattr(fn, "__module__", None) or type(fn).__module__),
         str(getattr(fn, "__qualname__", None) or type(fn).__qualname__),

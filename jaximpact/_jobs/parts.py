@@ -110,11 +110,13 @@ def _write_csv(path: Path, columns, cells, results):
         inputs = cells.lines
     else:
         texts = [
-            list(map(_csv_cell, cells.carried[c].tolist())) if c in cells.carried
-            else cells.values[c].tolist() if cells.values[c].dtype == object
+            list(map(_csv_cell, cells.carried[c].tolist()))
+            if c in cells.carried
+            else cells.values[c].tolist()
+            if cells.values[c].dtype == object
             else list(map(repr, cells.values[c].tolist()))
             for c in columns
-        ]  # fmt: skip
+        ]
         inputs = list(map(",".join, zip(*texts, strict=True)))
     texts = [list(map(repr, np.asarray(results[k], float).tolist())) for k in FLOAT_OUTPUTS]
     rows = map(",".join, zip(inputs, *texts, results["status"], results["path"], strict=True))

@@ -211,8 +211,9 @@ class CsvTable:
         digest = hashlib.sha256("\n".join(lines).encode()).digest()
         columns, ncol = self.columns, len(self.columns)
         carried = self.carried
-        numeric = [j for j, name in enumerate(columns)
-                   if name not in TEXT_COLUMNS and name not in carried]  # fmt: skip
+        numeric = [
+            j for j, name in enumerate(columns) if name not in TEXT_COLUMNS and name not in carried
+        ]
         quoted = any('"' in line for line in lines)
         rows = None
         if quoted:
@@ -226,8 +227,9 @@ class CsvTable:
         table = None
         if not quoted:
             with contextlib.suppress(ValueError):
-                table = np.loadtxt(lines, delimiter=",", dtype=float, usecols=numeric,
-                                   ndmin=2, comments=None)  # fmt: skip
+                table = np.loadtxt(
+                    lines, delimiter=",", dtype=float, usecols=numeric, ndmin=2, comments=None
+                )
         if table is None or table.shape != (len(lines), len(numeric)):
             # quoted cells, or a cell numpy does not read: each cell as `cell_number` reads
             # it (as every reader of tables does), the first that is not a number named

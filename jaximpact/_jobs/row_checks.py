@@ -109,8 +109,11 @@ def check_rows(law, values: dict, fixed: dict, where, options=None):
                     "every row; drop the column or the option"
                 )
                 first, message = i, f"{where(i)}, column {key}: {text}"
-    params = {k: np.broadcast_to(np.asarray(v, float), (rows,)) for k, v in
-              {**fixed, **values}.items() if k in law.parameters}  # fmt: skip
+    params = {
+        k: np.broadcast_to(np.asarray(v, float), (rows,))
+        for k, v in {**fixed, **values}.items()
+        if k in law.parameters
+    }
     bad = law.invalid_rows(params)
     if bad[:first].any():  # a rule of the law table beyond the signs (e_nominal <= 1, p <= n)
         i = int(np.argmax(bad))

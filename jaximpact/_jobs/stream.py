@@ -89,17 +89,34 @@ def impact_batch(
     """
     if options is not None:  # the record whole, each of its fields given once
         given = {k: impact_options.pop(k) for k in IMPACT_OPTIONS if k in impact_options}
-        options = solve_options(impact_batch, options, refused=BATCH_DECIDES, rtol=rtol,
-                                peaks=peaks, **given)  # fmt: skip
+        options = solve_options(
+            impact_batch, options, refused=BATCH_DECIDES, rtol=rtol, peaks=peaks, **given
+        )
     if out is None and (params is None or isinstance(params, Mapping)):
-        settings = dict(m=m, v0=v0, g=g, separation=separation, method=method, fields=fields,
-                        order=order, chunk_size=chunk_size, progress=progress,
-                        devices=devices, exact=exact, invalid=invalid)  # fmt: skip
+        settings = dict(
+            m=m,
+            v0=v0,
+            g=g,
+            separation=separation,
+            method=method,
+            fields=fields,
+            order=order,
+            chunk_size=chunk_size,
+            progress=progress,
+            devices=devices,
+            exact=exact,
+            invalid=invalid,
+        )
         if options is not None:
-            return impacts.impact_batch(law, params, **settings, options=options,
-                                        **impact_options)  # fmt: skip
-        return impacts.impact_batch(law, params, **settings, rtol=1e-11 if rtol is None else rtol,
-                                    peaks=peaks, **impact_options)  # fmt: skip
+            return impacts.impact_batch(law, params, **settings, options=options, **impact_options)
+        return impacts.impact_batch(
+            law,
+            params,
+            **settings,
+            rtol=1e-11 if rtol is None else rtol,
+            peaks=peaks,
+            **impact_options,
+        )
     if options is not None:  # a file's options are keywords (its resume key)
         rtol = options.rtol
         given = {k: getattr(options, k) for k in IMPACT_OPTIONS}
@@ -118,7 +135,16 @@ def impact_batch(
     # disagrees with a value given); the options of arrays (peaks, fields, order, ...)
     # do not apply to a file, whose columns are fixed
     default_g = isinstance(g, (int, float)) and not isinstance(g, bool) and g == 0.0
-    return batch_file(params, out, law, m=m, v0=v0, g=None if default_g else g,
-                      separation=None if separation == "force" else separation,
-                      progress=progress, method=method,
-                      **({} if rtol is None else {"rtol": rtol}), **impact_options)  # fmt: skip
+    return batch_file(
+        params,
+        out,
+        law,
+        m=m,
+        v0=v0,
+        g=None if default_g else g,
+        separation=None if separation == "force" else separation,
+        progress=progress,
+        method=method,
+        **({} if rtol is None else {"rtol": rtol}),
+        **impact_options,
+    )

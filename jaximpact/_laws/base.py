@@ -139,8 +139,9 @@ class AbstractLaw(eqx.Module):
         if self.spec is None:
             name = getattr(getattr(self, "fn", None), "__name__", self.name)
             return call_text("custom_law", name, self.params, {})
-        return call_text("law", repr(self.name), self.params,
-                         concrete_units(self.spec, self.params))  # fmt: skip
+        return call_text(
+            "law", repr(self.name), self.params, concrete_units(self.spec, self.params)
+        )
 
     def _refuse_unknown(self, params: dict, who: str | None = None):
         """A one-line `ValueError` for names in `params` that are not the law's parameters

@@ -23,7 +23,12 @@ from .fast_powers import call_body
 # primitives that pass a zero through unchanged
 _ZERO_PRESERVING = ("convert_element_type", "broadcast_in_dim", "reshape", "copy", "squeeze")
 # call primitives, with the parameter that holds their body
-_CALLS = {"jit": "jaxpr", "pjit": "jaxpr", "closed_call": "call_jaxpr", "custom_jvp_call": "call_jaxpr"}
+_CALLS = {
+    "jit": "jaxpr",
+    "pjit": "jaxpr",
+    "closed_call": "call_jaxpr",
+    "custom_jvp_call": "call_jaxpr",
+}
 
 
 def unclamped(fn: Callable, params: dict) -> Callable | None:

@@ -274,8 +274,12 @@ def exact_batch(law, *, m, v0, separation: str, g=0.0, rest_tol=1e-7) -> dict | 
     params = law.parameters
     shape = np.broadcast_shapes(*(np.shape(v) for v in params.values()))
     # checked when `law` was built; `replace` would take one number per parameter
-    batch = dataclasses.replace(law, params={k: jnp.broadcast_to(jnp.asarray(v, float),
-                                shape or (1,)) for k, v in params.items()})  # fmt: skip
+    batch = dataclasses.replace(
+        law,
+        params={
+            k: jnp.broadcast_to(jnp.asarray(v, float), shape or (1,)) for k, v in params.items()
+        },
+    )
     solve = _batch_solve(law.spec.closed_form, separation, rest_tol, float(g))
     out = solve(batch, jnp.asarray(m, float), jnp.asarray(v0, float))
     return {k: np.asarray(out[k]).reshape(shape) for k in ("e", "T", "status")}
@@ -367,9 +371,17 @@ def _linear_impact(p_in, p_out, damped, dry):
             c, pressure = law.params["c"], law.params["P"]
             b = law.params["b"] if damped else jnp.zeros_like(c)
             fields = linear_impact(
-                c, b, p_in(pressure), p_out(pressure), m, v0, g, separation,
-                dry=dry, rest_tol=rest_tol,
-            )  # fmt: skip
+                c,
+                b,
+                p_in(pressure),
+                p_out(pressure),
+                m,
+                v0,
+                g,
+                separation,
+                dry=dry,
+                rest_tol=rest_tol,
+            )
             return _finish(fields, m, v0, g, with_end)
 
         return impact_fields

@@ -172,8 +172,9 @@ def linear_impact(c, b, p_in, p_out, m, v0, g, separation, *, dry, rest_tol=1e-7
         y, v = _state(s, r, y1, 1.0, t)
         return gamma + y + 2.0 * s * v
 
-    f_max = jnp.maximum(jnp.maximum(compression_force(0.0), compression_force(t_peak)),
-                        compression_force(t_max))  # fmt: skip
+    f_max = jnp.maximum(
+        jnp.maximum(compression_force(0.0), compression_force(t_peak)), compression_force(t_max)
+    )
 
     # restitution from (A, 0) about gamma + d_out
     x_eq = gamma + d_out

@@ -57,6 +57,13 @@ class ObliqueFit(eqx.Module):
       the given sigma; NaN where that kind's sigma was not given); `reduced_chi2`
       (`2 loss / dof`) only where one kind was fitted (NaN where both were: it would add
       e_t and spin residuals; without sigmas it only compares fits).
+    - What the fit was made of, so that `posterior` samples the same model: `problem`,
+      the normal law, the start's tangential law, the sphere (`m` kg, `R` m, `inertia`,
+      `g` m/s^2), the rows (`v_n`, `v_t` m/s, `omega` rad/s), the measured `e_t` and
+      `omega_out` (rad/s; NaN where a row has none, all NaN for a kind not measured), the
+      residuals' scales (`s_e`, `s_w`: the given sigmas or their defaults) and the solve's
+      options; `sigma_e_t`, `sigma_omega`: the sigmas as given (None: not given). None in
+      an `ObliqueFit` built by hand.
     """
 
     tangential: AbstractTangentialLaw
@@ -81,6 +88,9 @@ class ObliqueFit(eqx.Module):
     weighted: bool = eqx.field(static=True, default=False)
     undetermined: tuple[str, ...] = eqx.field(static=True, default=())
     notes: tuple[str, ...] = eqx.field(static=True, default=())
+    problem: eqx.Module | None = None
+    sigma_e_t: Array | None = None
+    sigma_omega: Array | None = None
 
     def summary(self) -> str:
         units = {k: "" if u == "-" else u for k, u in self.tangential.spec.units.items()}
@@ -88,17 +98,27 @@ class ObliqueFit(eqx.Module):
         for k in self.free:
             unit = units.get(k, "")
             if k in self.undetermined:
-                rows.append((k, f"{format_value(self.params[k], unit)} "
-                                f"({_bound_text(self.bounds.get(k), unit)})"))  # fmt: skip
+                rows.append(
+                    (
+                        k,
+                        f"{format_value(self.params[k], unit)} "
+                        f"({_bound_text(self.bounds.get(k), unit)})",
+                    )
+                )
                 continue
-            rows.append((k, f"{format_value(self.params[k], unit)} ± "
-                            f"{format_value(self.stderr[k], unit)}"))  # fmt: skip
+            rows.append(
+                (k, f"{format_value(self.params[k], unit)} ± {format_value(self.stderr[k], unit)}")
+            )
         fixed = [k for k in self.params if k not in self.free]
         rows += [(k, f"{format_value(self.params[k], units.get(k, ''))} (fixed)") for k in fixed]
-        rows += [("rms e_t", format_value(self.rms_e_t)),
-                 ("rms omega", format_value(self.rms_omega, "rad/s"))]  # fmt: skip
-        kinds = (("e_t", self.rms_e_t, self.reduced_chi2_e_t),
-                 ("omega", self.rms_omega, self.reduced_chi2_omega))  # fmt: skip
+        rows += [
+            ("rms e_t", format_value(self.rms_e_t)),
+            ("rms omega", format_value(self.rms_omega, "rad/s")),
+        ]
+        kinds = (
+            ("e_t", self.rms_e_t, self.reduced_chi2_e_t),
+            ("omega", self.rms_omega, self.reduced_chi2_omega),
+        )
         for kind, rms, reduced in kinds:
             if np.isnan(float(rms)):  # not measured
                 continue
@@ -107,10 +127,12 @@ class ObliqueFit(eqx.Module):
                 text = f"- (no sigma_{kind}: its scale is the residuals' own)"
             rows.append((f"reduced chi2 {kind}", text))
         losses = ", ".join(format_value(v) for v in np.atleast_1d(self.start_losses))
-        rows += [("n_data, dof", f"{int(self.n_data)}, {int(self.dof)}"),
-                 ("converged", format_value(self.converged)),
-                 ("iterations", format_value(self.iterations, None)),
-                 ("starts", f"{np.size(self.start_losses)}, losses {losses}")]  # fmt: skip
+        rows += [
+            ("n_data, dof", f"{int(self.n_data)}, {int(self.dof)}"),
+            ("converged", format_value(self.converged)),
+            ("iterations", format_value(self.iterations, None)),
+            ("starts", f"{np.size(self.start_losses)}, losses {losses}"),
+        ]
         text = format_fields(f"ObliqueFit of {self.tangential.name!r} (SI units)", rows)
         return "\n".join([text, *(f"  note: {note}" for note in self.notes)])
 
@@ -119,15 +141,35 @@ class ObliqueFit(eqx.Module):
         and parameters), `params`, `stderr`, `free`, `undetermined`, `bounds`, `notes`,
         the goodness of fit, `start_losses`, per row `e_t`, `omega_out`, and `residuals`.
         Concrete fits only (not inside `jit`)."""
-        names = ("params", "stderr", "e_t", "omega_out", "residuals", "loss", "converged",
-                 "iterations", "n_data", "dof", "rms_e_t", "rms_omega", "reduced_chi2",
-                 "reduced_chi2_e_t", "reduced_chi2_omega", "start_losses")  # fmt: skip
+        names = (
+            "params",
+            "stderr",
+            "e_t",
+            "omega_out",
+            "residuals",
+            "loss",
+            "converged",
+            "iterations",
+            "n_data",
+            "dof",
+            "rms_e_t",
+            "rms_omega",
+            "reduced_chi2",
+            "reduced_chi2_e_t",
+            "reduced_chi2_omega",
+            "start_losses",
+        )
         out = {k: jsonable(getattr(self, k)) for k in names}
         tangential = {"name": self.tangential.name, "parameters": out["params"]}
-        return {"tangential": tangential, **out, "free": list(self.free),
-                "weighted": self.weighted, "undetermined": list(self.undetermined),
-                "bounds": {k: list(v) for k, v in self.bounds.items()},
-                "notes": list(self.notes)}  # fmt: skip
+        return {
+            "tangential": tangential,
+            **out,
+            "free": list(self.free),
+            "weighted": self.weighted,
+            "undetermined": list(self.undetermined),
+            "bounds": {k: list(v) for k, v in self.bounds.items()},
+            "notes": list(self.notes),
+        }
 
     def __repr__(self) -> str:
         return self.summary()
@@ -200,8 +242,9 @@ class _Problem(eqx.Module):
         fitted = _with(self.tangential, self.free, theta)
 
         def one(vn, vt, om):
-            return solve_oblique(self.law, fitted, self.m, self.R, vn, vt, om, self.inertia,
-                                 self.g, self.options)  # fmt: skip
+            return solve_oblique(
+                self.law, fitted, self.m, self.R, vn, vt, om, self.inertia, self.g, self.options
+            )
 
         return jax.vmap(one)(self.v_n, self.v_t, self.omega)
 
@@ -450,9 +493,25 @@ def fit_oblique(
         lever_share=lever_share(contact_point),
     )
     m, R, inertia, g = (jnp.asarray(a, dtype=float) for a in (m, R, inertia, g))
-    problem = _Problem(law=law, tangential=tangential, m=m, R=R, inertia=inertia, g=g,
-                       v_n=v_n, v_t=v_t, omega=omega, e_t=e_t, omega_out=omega_out, s_e=s_e,
-                       s_w=s_w, options=options, free=free, has_e=has_e, has_w=has_w)  # fmt: skip
+    problem = _Problem(
+        law=law,
+        tangential=tangential,
+        m=m,
+        R=R,
+        inertia=inertia,
+        g=g,
+        v_n=v_n,
+        v_t=v_t,
+        omega=omega,
+        e_t=e_t,
+        omega_out=omega_out,
+        s_e=s_e,
+        s_w=s_w,
+        options=options,
+        free=free,
+        has_e=has_e,
+        has_w=has_w,
+    )
     stiffness = stiffness_name(tangential)
     theta0 = np.array([np.log(float(tangential.params[k])) for k in free])
 
@@ -507,9 +566,14 @@ def fit_oblique(
             break
 
     # goodness of fit and standard errors, each kind of residual apart
-    kinds = [(name, given) for name, has, given in
-             (("e_t", has_e, sigma_e_t is not None), ("omega", has_w, sigma_omega is not None))
-             if has]  # fmt: skip
+    kinds = [
+        (name, given)
+        for name, has, given in (
+            ("e_t", has_e, sigma_e_t is not None),
+            ("omega", has_w, sigma_omega is not None),
+        )
+        if has
+    ]
     measured = [values_ for values_, has in ((e_t, has_e), (omega_out, has_w)) if has]
     n_kind = np.array([int(np.sum(np.isfinite(np.asarray(v)))) for v in measured])
     n_data = int(np.sum(n_kind))
@@ -522,8 +586,9 @@ def fit_oblique(
     reduced = {name: (float(own[i]) if given else np.nan) for i, (name, given) in enumerate(kinds)}
     # the scale of each kind: its sigma where given, else its own scatter (floored, so that
     # an exact fit does not divide by zero)
-    variance = np.array([1.0 if given else max(own[i], 1e-24)
-                         for i, (_, given) in enumerate(kinds)])  # fmt: skip
+    variance = np.array(
+        [1.0 if given else max(own[i], 1e-24) for i, (_, given) in enumerate(kinds)]
+    )
     weights = np.repeat(1.0 / np.sqrt(variance), n)
     scaled = jacobian * weights[:, None]
     covariance = np.linalg.pinv(scaled.T @ scaled)
@@ -549,10 +614,12 @@ def fit_oblique(
                 continue
             undetermined.append(k)
             se[i] = np.nan
-            bounds[k] = _profile_bound(problem, theta, free, i, stiffness, variance,
-                                       chi2_at_fit, open_up, open_down)  # fmt: skip
-            said = _undetermined_note(k, bounds[k], open_up, open_down, units, fitted, result,
-                                      problem)  # fmt: skip
+            bounds[k] = _profile_bound(
+                problem, theta, free, i, stiffness, variance, chi2_at_fit, open_up, open_down
+            )
+            said = _undetermined_note(
+                k, bounds[k], open_up, open_down, units, fitted, result, problem
+            )
             notes.append(said)
             warnings.warn(said, stacklevel=2)
 
@@ -582,11 +649,13 @@ def fit_oblique(
         undetermined=tuple(undetermined),
         notes=tuple(notes),
         free=free,
+        problem=problem,
+        sigma_e_t=None if sigma_e_t is None else s_e,
+        sigma_omega=None if sigma_omega is None else s_w,
     )
 
 
-def _profile_bound(problem, theta, free, i, stiffness, variance, chi2_at_fit, open_up,
-                   open_down):  # fmt: skip
+def _profile_bound(problem, theta, free, i, stiffness, variance, chi2_at_fit, open_up, open_down):
     """`(lower, upper)`: the one-sided 95 % bound of free parameter `i` on the side the data
     bound (None on an open side): where the loss, profiled over the stiffness or `mu` (the
     partner, if free; on a grid a factor 3 either way) with the other parameters held,
@@ -627,9 +696,15 @@ def _undetermined_note(name, bound, open_up, open_down, units, fitted, result, p
     side = "larger" if open_up else "smaller"
     why = ""
     if name == "mu" and open_up:
-        rigid = rigid_oblique(mu=fitted.params["mu"], e=result.e, v_n=problem.v_n,
-                              v_t=problem.v_t, R=problem.R, omega=problem.omega,
-                              inertia=problem.inertia)  # fmt: skip
+        rigid = rigid_oblique(
+            mu=fitted.params["mu"],
+            e=result.e,
+            v_n=problem.v_n,
+            v_t=problem.v_t,
+            R=problem.R,
+            omega=problem.omega,
+            inertia=problem.inertia,
+        )
         sliding = int(np.sum(np.asarray(rigid["sliding"])))
         why = (
             " (no impact slides throughout at the fitted mu: each sticks or micro-slips)"

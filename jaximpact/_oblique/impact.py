@@ -166,8 +166,10 @@ def _land(dyn, conditions, masks, term, tau, y, tau_event, args, options, contro
     y_star = solved.ys[-1]
 
     def fired_condition(z):
-        values = [jnp.where(mask, cond(t_star, z, args), 0.0) for mask, cond in
-                  zip(masks, conditions, strict=True)]  # fmt: skip
+        values = [
+            jnp.where(mask, cond(t_star, z, args), 0.0)
+            for mask, cond in zip(masks, conditions, strict=True)
+        ]
         return sum(values[1:], values[0])
 
     rate = dyn.rhs(y_star, *args[:3])
@@ -402,8 +404,20 @@ def _segments(dyn: ObliqueDynamics, y0, options: ObliqueOptions):
     zero = jnp.zeros((), jnp.int32)
     tau0 = jnp.asarray(FIRST_TOUCH)
     no = jnp.asarray(False)
-    carry = (y_in, tau0, mode, sense, compressing, no, tau_max, jnp.asarray(True), zero - 1,
-             zero, zero, (no, -jnp.ones_like(tau0)))  # fmt: skip
+    carry = (
+        y_in,
+        tau0,
+        mode,
+        sense,
+        compressing,
+        no,
+        tau_max,
+        jnp.asarray(True),
+        zero - 1,
+        zero,
+        zero,
+        (no, -jnp.ones_like(tau0)),
+    )
     carry, _ = jax.lax.scan(
         functools.partial(_segment, setup), carry, None, length=options.max_segments
     )
@@ -432,8 +446,9 @@ def solve_oblique(law, tangential, m, R, v_n, v_t, omega, inertia, g, options: O
     spring = tangential.dynamics(m=m, R=R, inertia=inertia, x_star=normal.x_star, v_n=v_n)
     y_n0 = normal.y0()
     loss = options.lever_share * normal.x_star / R if options.lever_share else None
-    dyn = ObliqueDynamics(normal=normal, tangential=spring, size=int(y_n0.shape[0]),
-                          lever_loss=loss)  # fmt: skip
+    dyn = ObliqueDynamics(
+        normal=normal, tangential=spring, size=int(y_n0.shape[0]), lever_loss=loss
+    )
     y0 = jnp.concatenate([y_n0, jnp.stack([jnp.zeros(()), v_t / v_n, R * omega / v_n])])
     y, tau, status, switches, steps = _segments(dyn, y0, options)
     y_n = y[: dyn.size]
@@ -648,9 +663,12 @@ def oblique_impact(
         # jax.grad: the forward-mode Jacobian, transposed (`adjoint.by_forward_jacobian`)
         forward = dataclasses.replace(options, adjoint=dfx.ForwardMode())
         result = through_forward_jacobian(
-            lambda *args: solve_oblique(*args, forward), law, tangential, *values,
+            lambda *args: solve_oblique(*args, forward),
+            law,
+            tangential,
+            *values,
             closes_over=law.spec is None,
-        )  # fmt: skip
+        )
     else:
         result = solve_oblique(law, tangential, *values, options)
     result = checks.refuse(result, status=Status.invalid)

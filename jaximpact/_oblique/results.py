@@ -12,11 +12,23 @@ from .._solve.results import status_names, status_text
 from .._status import Status
 
 # the fields as `summary()` shows them: name, unit ("" a pure number, None a count)
-_SHOWN = (("e", ""), ("e_t", ""), ("e_t_contact", ""), ("v_n_out", "m/s"),
-          ("v_t_out", "m/s"), ("omega_out", "rad/s"), ("u_out", "m/s"),
-          ("angle_out", "rad"), ("angle_out_contact", "rad"), ("T", "s"),
-          ("impulse_n", "N s"), ("impulse_t", "N s"), ("dissipated", "J"),
-          ("num_switches", None), ("num_steps", None))  # fmt: skip
+_SHOWN = (
+    ("e", ""),
+    ("e_t", ""),
+    ("e_t_contact", ""),
+    ("v_n_out", "m/s"),
+    ("v_t_out", "m/s"),
+    ("omega_out", "rad/s"),
+    ("u_out", "m/s"),
+    ("angle_out", "rad"),
+    ("angle_out_contact", "rad"),
+    ("T", "s"),
+    ("impulse_n", "N s"),
+    ("impulse_t", "N s"),
+    ("dissipated", "J"),
+    ("num_switches", None),
+    ("num_steps", None),
+)
 _NOT_RESULTS = ("status", "num_steps", "num_switches")
 
 

@@ -351,8 +351,15 @@ class MindlinLaw(AbstractTangentialLaw):
 
 
 _LINEAR_UNITS = {"kt": "N/m", "mu": "-", "ct": "N s/m"}
-_MINDLIN_UNITS = {"G_star": "Pa", "mu": "-", "beta": "-", "G": "Pa", "nu": "-", "G2": "Pa",
-                  "nu2": "-"}  # fmt: skip
+_MINDLIN_UNITS = {
+    "G_star": "Pa",
+    "mu": "-",
+    "beta": "-",
+    "G": "Pa",
+    "nu": "-",
+    "G2": "Pa",
+    "nu2": "-",
+}
 _MINDLIN_REFERENCE = (
     "R. D. Mindlin, J. Appl. Mech. 16 (1949) 259; k_t = 8 G* a, a = sqrt(R x); "
     "Di Renzo & Di Maio, Chem. Eng. Sci. 59 (2004) 525"
@@ -418,8 +425,10 @@ TANGENTIAL_LAWS: dict[str, TangentialSpec] = {
     for spec in (LINEAR_HISTORY, MINDLIN, MINDLIN_FORCE, MINDLIN_RESCALE, MINDLIN_RESCALE_FORCE)
 }
 TANGENTIAL_LAW_NAMES: tuple[str, ...] = tuple(TANGENTIAL_LAWS)
-_CLASSES = {name: LinearHistoryLaw if name == "linear_history" else MindlinLaw
-            for name in TANGENTIAL_LAW_NAMES}  # fmt: skip
+_CLASSES = {
+    name: LinearHistoryLaw if name == "linear_history" else MindlinLaw
+    for name in TANGENTIAL_LAW_NAMES
+}
 
 
 def shear_modulus_star(G, nu, G2=None, nu2=0.0):
@@ -460,8 +469,11 @@ def _mindlin_parameters(name, given):
         check_positive(f"{name}: shear modulus G2", G2, "Pa")
     if "nu2" in given and G2 is None:
         raise ValueError(f"tangential law {name!r}: nu2 without G2 (the second body's modulus)")
-    assumed = [k for k, modulus in (("nu", "G"), ("nu2", "G2"))
-               if given.get(modulus) is not None and k not in given]  # fmt: skip
+    assumed = [
+        k
+        for k, modulus in (("nu", "G"), ("nu2", "G2"))
+        if given.get(modulus) is not None and k not in given
+    ]
     if assumed:
         import warnings
 

@@ -23,9 +23,19 @@ from .._checks import check_positive
 from .._format import format_fields, format_value, jsonable
 
 # the fields as `summary()` shows them, with units
-_SHOWN = (("t_impact", "s"), ("v_n", "m/s"), ("v_t", "m/s"), ("omega", "rad/s"),
-          ("v_n_out", "m/s"), ("v_t_out", "m/s"), ("omega_out", "rad/s"), ("e", ""),
-          ("e_t", ""), ("sigma_e_t", ""), ("sigma_omega_out", "rad/s"))  # fmt: skip
+_SHOWN = (
+    ("t_impact", "s"),
+    ("v_n", "m/s"),
+    ("v_t", "m/s"),
+    ("omega", "rad/s"),
+    ("v_n_out", "m/s"),
+    ("v_t_out", "m/s"),
+    ("omega_out", "rad/s"),
+    ("e", ""),
+    ("e_t", ""),
+    ("sigma_e_t", ""),
+    ("sigma_omega_out", "rad/s"),
+)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -63,9 +73,15 @@ class TrackRebounds:
                 "the track has no spin (phi): the spin before each impact is unknown; track "
                 "a mark on the ball, or give fit_oblique the spins (omega=) yourself"
             )
-        return dict(v_n=self.v_n, v_t=self.v_t, omega=self.omega, e_t=self.e_t,
-                    omega_out=self.omega_out, sigma_e_t=self.sigma_e_t,
-                    sigma_omega=self.sigma_omega_out)  # fmt: skip
+        return dict(
+            v_n=self.v_n,
+            v_t=self.v_t,
+            omega=self.omega,
+            e_t=self.e_t,
+            omega_out=self.omega_out,
+            sigma_e_t=self.sigma_e_t,
+            sigma_omega=self.sigma_omega_out,
+        )
 
     def to_dict(self) -> dict:
         return {f.name: jsonable(getattr(self, f.name)) for f in dataclasses.fields(self)}
@@ -228,9 +244,20 @@ def _rebounds(fits, g, flights, g_track, *, spin: bool) -> TrackRebounds:
             omega, omega_out, s_omega_out = math.nan, math.nan, math.nan
         e, e_t = v_n_out / v_n, v_t_out / v_t
         rows.append(
-            (t_c, v_n, v_t, omega, v_n_out, v_t_out, omega_out, e, e_t,
-             abs(e) * math.hypot(s_n_out / v_n_out, s_n / v_n),
-             abs(e_t) * math.hypot(s_t_out / v_t_out, s_t / v_t), s_omega_out)
-        )  # fmt: skip
+            (
+                t_c,
+                v_n,
+                v_t,
+                omega,
+                v_n_out,
+                v_t_out,
+                omega_out,
+                e,
+                e_t,
+                abs(e) * math.hypot(s_n_out / v_n_out, s_n / v_n),
+                abs(e_t) * math.hypot(s_t_out / v_t_out, s_t / v_t),
+                s_omega_out,
+            )
+        )
     columns = [np.array(c) for c in zip(*rows, strict=True)]
     return TrackRebounds(*columns, flights=tuple(flights), g_track=g_track)

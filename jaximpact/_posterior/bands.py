@@ -31,12 +31,14 @@ class Bands(eqx.Module):
         pct = f"{100 * self.level:g} %"
         rows = [("v0", format_value(self.v0, "m/s"))]
         for k in range(len(self.v0)):
-            rows.append((
-                f"at {format_value(self.v0[k], 'm/s')}",
-                f"e = {format_value(self.e[k])} [{format_value(self.e_lo[k])}, "
-                f"{format_value(self.e_hi[k])}], T = {format_value(self.T[k], 's')} "
-                f"[{format_value(self.T_lo[k], 's')}, {format_value(self.T_hi[k], 's')}]",
-            ))  # fmt: skip
+            rows.append(
+                (
+                    f"at {format_value(self.v0[k], 'm/s')}",
+                    f"e = {format_value(self.e[k])} [{format_value(self.e_lo[k])}, "
+                    f"{format_value(self.e_hi[k])}], T = {format_value(self.T[k], 's')} "
+                    f"[{format_value(self.T_lo[k], 's')}, {format_value(self.T_hi[k], 's')}]",
+                )
+            )
         what = "a new measurement's" if self.observed else "the law's"
         return format_fields(f"Bands of {what} e and T (median [{pct}], SI units)", rows)
 

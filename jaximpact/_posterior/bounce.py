@@ -44,8 +44,13 @@ from .priors import Prior, default_prior, parse_prior
 
 # nuisance parameters a bounce fit may have, their units, and whether they are moved as
 # logarithms (the others as offsets)
-NUISANCE_UNITS = {"t_impact": "s", "v_impact": "m/s", "drag": "1/m", "floor": "",
-                  "length_scale": ""}  # fmt: skip
+NUISANCE_UNITS = {
+    "t_impact": "s",
+    "v_impact": "m/s",
+    "drag": "1/m",
+    "floor": "",
+    "length_scale": "",
+}
 _LOG = ("v_impact", "drag", "length_scale")
 # the default prior of a sampled `sigma`: loguniform over this range times the first flight's
 # duration `2 v_impact / g` (s, impact times) or the track's span (y units, a trajectory)
@@ -88,9 +93,7 @@ class BounceModel(eqx.Module):
         return {k: p.value(z[..., i]) for i, (k, p) in enumerate(zip(self.names, self.priors))}
 
     def coordinates(self, values: dict) -> np.ndarray:
-        return np.stack(
-            [p.coordinate(values[k]) for k, p in zip(self.names, self.priors)], axis=-1
-        )
+        return np.stack([p.coordinate(values[k]) for k, p in zip(self.names, self.priors)], axis=-1)
 
     def theta(self, values: dict):
         """The fit's own coordinates of `values`: `to_unbounded` of the law's, the
@@ -116,8 +119,9 @@ class BounceModel(eqx.Module):
     def predict(self, values: dict, v0):
         """`(e, T, status)` of single impacts at the speeds `v0` (m/s) with the fit's
         gravity and separation, the contact solve of the chain (`_contact`)."""
-        law = law_with(self.law, self.free, jnp.stack([to_unbounded(k, values[k])
-                                                       for k in self.free]))  # fmt: skip
+        law = law_with(
+            self.law, self.free, jnp.stack([to_unbounded(k, values[k]) for k in self.free])
+        )
         v0 = jnp.asarray(v0, dtype=float)
 
         def one(v):
@@ -228,8 +232,9 @@ def bounce_setup(fit: BounceFit, prior, *, noise: str, nu: float):
     if p is not None and p.bounded:  # inside the range, away from its bounds
         floor = 10.0 * p.a if p.a > 0 else 0.01 * p.b
         starts["sigma"] = min(max(starts["sigma"], floor), 0.5 * p.b)
-    model = _model(fit, names, free, nuisance, priors, None if not given else float(fit.sigma),
-                   noise, nu)  # fmt: skip
+    model = _model(
+        fit, names, free, nuisance, priors, None if not given else float(fit.sigma), noise, nu
+    )
     units = law_units(fit.law)
     units = {k: units.get(k, "") for k in free}
     units.update({k: NUISANCE_UNITS[k] for k in nuisance})
@@ -244,29 +249,52 @@ def _model(fit, names, free, nuisance, priors, sigma, noise, nu) -> BounceModel:
     solve = solve_options(fit_bounces, None, rtol=None, max_steps=4096, refused=FIT_DECIDES)
     solve = dataclasses.replace(solve, adjoint=dfx.ForwardMode(), peaks=False)
     options = bounce_options(fit.law, solve, separation=fit.separation, max_impacts=8)
-    data = dict(sigma=np.asarray(1.0), t1=np.asarray(q["t_impact"]), t_unit=np.asarray(1.0),
-                v1=np.asarray(q["v_impact"]), y_unit=np.asarray(1.0))  # fmt: skip
+    data = dict(
+        sigma=np.asarray(1.0),
+        t1=np.asarray(q["t_impact"]),
+        t_unit=np.asarray(1.0),
+        v1=np.asarray(q["v_impact"]),
+        y_unit=np.asarray(1.0),
+    )
     if "drag" in q:
         data["drag"] = np.asarray(q["drag"])
     if fit.kind == "impacts":
         times = np.asarray(fit.times, float)
         index = np.asarray(fit.index, int)
         options = with_impacts(options, round_up(int(index.max()) + 4, 8))
-        data.update(times=times, floor=np.asarray(0.0), scale=np.asarray(1.0),
-                    t_end=np.asarray(np.inf), min_flight=np.asarray(0.0))  # fmt: skip
+        data.update(
+            times=times,
+            floor=np.asarray(0.0),
+            scale=np.asarray(1.0),
+            t_end=np.asarray(np.inf),
+            min_flight=np.asarray(0.0),
+        )
         data["index"] = np.minimum(index, options.max_impacts - 1)
         n = times.size
     else:
         t, y = np.asarray(fit.t, float), np.asarray(fit.y, float)
         options = with_impacts(options, round_up(fit.num_impacts + 1, 8))
-        data.update(t=t, y=y, floor=np.asarray(q["floor"]), scale=np.asarray(q["length_scale"]),
-                    t_end=np.asarray(float(t.max())),
-                    min_flight=np.asarray(0.5 * float(np.median(np.diff(t)))))  # fmt: skip
+        data.update(
+            t=t,
+            y=y,
+            floor=np.asarray(q["floor"]),
+            scale=np.asarray(q["length_scale"]),
+            t_end=np.asarray(float(t.max())),
+            min_flight=np.asarray(0.5 * float(np.median(np.diff(t)))),
+        )
         n = t.size
     data["mask"] = np.ones(n, dtype=bool)
-    problem = BounceProblem(law=fit.law, free=free, m=float(fit.m), g=float(fit.g),
-                            kind=fit.kind, y_sign=float(fit.y_sign), options=options,
-                            nuisance=nuisance, data=data)  # fmt: skip
+    problem = BounceProblem(
+        law=fit.law,
+        free=free,
+        m=float(fit.m),
+        g=float(fit.g),
+        kind=fit.kind,
+        y_sign=float(fit.y_sign),
+        options=options,
+        nuisance=nuisance,
+        data=data,
+    )
     reference = {k: float(q[k]) for k in nuisance}
     speeds = np.asarray(fit.impact_speeds, float)
     return BounceModel(

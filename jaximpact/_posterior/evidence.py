@@ -38,10 +38,12 @@ class EvidenceRanking(model_choice.Ranking):
     def summary(self) -> str:
         rows = [
             ("log_evidence", f"{format_value(self.log_evidence)} nats (Laplace at the mode)"),
-            ("bayes_factor",
-             f"{format_value(self.bayes_factor)} (the best law's Z over this one's)"),
+            (
+                "bayes_factor",
+                f"{format_value(self.bayes_factor)} (the best law's Z over this one's)",
+            ),
             ("aic_rank", str(self.aic_rank)),
-        ]  # fmt: skip
+        ]
         return format_fields(f"Evidence of {self.name}", rows) + "\n" + super().summary()
 
     def to_dict(self) -> dict:
@@ -66,22 +68,31 @@ class EvidenceRankings(list):
         header = ["rank", "law", "k", "log_evidence", "bayes_factor", by, f"{by} rank"]
         lines = [header]
         for rank, r in enumerate(self, start=1):
-            lines.append([
-                str(rank), r.name, str(r.k), f"{r.log_evidence:.4g}", f"{r.bayes_factor:.4g}",
-                f"{(r.aic if weighted else r.sum_sq):.4g}", str(r.aic_rank),
-            ])  # fmt: skip
+            lines.append(
+                [
+                    str(rank),
+                    r.name,
+                    str(r.k),
+                    f"{r.log_evidence:.4g}",
+                    f"{r.bayes_factor:.4g}",
+                    f"{(r.aic if weighted else r.sum_sq):.4g}",
+                    str(r.aic_rank),
+                ]
+            )
         widths = [max(len(line[i]) for line in lines) for i in range(len(header))]
         text = ["  ".join(c.ljust(w) for c, w in zip(line, widths)).rstrip() for line in lines]
-        text.append("bayes_factor: the best law's evidence over this one's (Laplace, nats in "
-                    "log_evidence)")  # fmt: skip
+        text.append(
+            "bayes_factor: the best law's evidence over this one's (Laplace, nats in log_evidence)"
+        )
         return "\n".join(text)
 
     def summary(self) -> str:
         return self.table()
 
 
-def compare_laws(*, by: str = "aic", prior: dict | None = None,
-                 progress: bool | AbstractMeter = True, **options):  # fmt: skip
+def compare_laws(
+    *, by: str = "aic", prior: dict | None = None, progress: bool | AbstractMeter = True, **options
+):
     """Fit every law of `laws` to the same measurements and rank them, best first.
 
     `by="aic"` (the default): `jaximpact._fit.model_choice.compare_laws`, unchanged: by AIC
@@ -113,30 +124,36 @@ def compare_laws(*, by: str = "aic", prior: dict | None = None,
         return model_choice.compare_laws(progress=progress, **options)
     prior = {} if prior is None else prior
     if not isinstance(prior, dict):
-        raise TypeError(f"prior takes a dict {{law name: {{parameter: (kind, a, b)}}}}, got "
-                        f"{type(prior).__name__}")  # fmt: skip
+        raise TypeError(
+            f"prior takes a dict {{law name: {{parameter: (kind, a, b)}}}}, got "
+            f"{type(prior).__name__}"
+        )
     rankings = model_choice.compare_laws(progress=progress, **options)
     names = [r.name for r in rankings]
     unknown = sorted(set(prior) - set(names))
     if unknown:
-        raise ValueError(f"prior names the law {', '.join(unknown)}, not among the laws "
-                         f"fitted ({', '.join(names)})")  # fmt: skip
+        raise ValueError(
+            f"prior names the law {', '.join(unknown)}, not among the laws "
+            f"fitted ({', '.join(names)})"
+        )
     ranked = []
     with metered(progress, len(rankings), "evidence of each law") as meter:
         for aic_rank, r in enumerate(rankings, start=1):
             with warnings.catch_warnings():  # a poor mode shows as a NaN evidence
                 warnings.simplefilter("ignore")
                 try:
-                    post = posterior(r.fit, prior=prior.get(r.name), method="laplace",
-                                     num_samples=500, chains=1)  # fmt: skip
+                    post = posterior(
+                        r.fit, prior=prior.get(r.name), method="laplace", num_samples=500, chains=1
+                    )
                 except ValueError as error:  # no Gaussian at the mode: no evidence
                     if "Laplace approximation does not exist" not in str(error):
                         raise
                     post = None
             fields = {f.name: getattr(r, f.name) for f in dataclasses.fields(r)}
             evidence = math.nan if post is None else float(post.log_evidence)
-            ranked.append(EvidenceRanking(**fields, log_evidence=evidence, aic_rank=aic_rank,
-                                          posterior=post))  # fmt: skip
+            ranked.append(
+                EvidenceRanking(**fields, log_evidence=evidence, aic_rank=aic_rank, posterior=post)
+            )
             meter.update(1, r.name)
     ranked.sort(key=lambda r: -r.log_evidence if math.isfinite(r.log_evidence) else math.inf)
     best = ranked[0].log_evidence if ranked else math.nan

@@ -57,9 +57,7 @@ class Model(eqx.Module):
 
     def coordinates(self, values: dict) -> np.ndarray:
         """`z` of `{name: value}` (numpy)."""
-        return np.stack(
-            [p.coordinate(values[k]) for k, p in zip(self.names, self.priors)], axis=-1
-        )
+        return np.stack([p.coordinate(values[k]) for k, p in zip(self.names, self.priors)], axis=-1)
 
     # ------------------------------------------------------------------ forward model
 
@@ -116,10 +114,17 @@ def _forward(model: Model, theta, v0):
     `jax.jacfwd` (`with_forward_jacobian`); on the curves directly."""
     setup = model.setup
     raw = _residual_function(
-        model.law, model.free, m=model.m, separation=setup.separation, g=model.g,
-        rtol=setup.rtol, has_e=True, has_T=False, curves=setup.curves,
+        model.law,
+        model.free,
+        m=model.m,
+        separation=setup.separation,
+        g=model.g,
+        rtol=setup.rtol,
+        has_e=True,
+        has_T=False,
+        curves=setup.curves,
         closed_form=setup.closed_form,
-    )  # fmt: skip
+    )
     ones = jnp.ones_like(v0)
     data = (v0, ones, ones, ones, ones)
     if isinstance(setup.curves, CurveKey):

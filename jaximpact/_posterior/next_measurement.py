@@ -30,8 +30,10 @@ class NextMeasurement(eqx.Module):
     measure: tuple = eqx.field(static=True)
 
     def summary(self) -> str:
-        rows = [(f"#{i + 1}: v0", f"{format_value(v, 'm/s')}, gain {g:.4g} nats")
-                for i, (v, g) in enumerate(zip(self.v0, self.gain))]  # fmt: skip
+        rows = [
+            (f"#{i + 1}: v0", f"{format_value(v, 'm/s')}, gain {g:.4g} nats")
+            for i, (v, g) in enumerate(zip(self.v0, self.gain))
+        ]
         what = " and ".join(self.measure)
         return format_fields(f"Next measurement of {what}, best first", rows)
 

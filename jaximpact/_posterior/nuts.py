@@ -21,8 +21,9 @@ class Chains(eqx.Module):
 
 
 @eqx.filter_jit
-def run_chains(model, z0, inverse_mass, key, num_warmup: int, num_samples: int,
-               target_accept: float) -> Chains:  # fmt: skip
+def run_chains(
+    model, z0, inverse_mass, key, num_warmup: int, num_samples: int, target_accept: float
+) -> Chains:
     """Warm up and sample every chain (one row of `z0` each) with NUTS on
     `model.log_posterior`; `inverse_mass` seeds the adaptation (the Laplace covariance)."""
     logdensity = model.log_posterior

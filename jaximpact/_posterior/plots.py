@@ -38,10 +38,12 @@ def plot_posterior(post, path=None, *, v0=None, level=0.9):
         speeds = np.linspace(0.5 * lo, 1.5 * hi, 40) if v0 is None else np.asarray(v0, float)
         b = post.predict(speeds, level=level)
         half = max(d // 2, 1)
-        for row, (what, med, blo, bhi, data, sig) in enumerate((
-            ("e", b.e, b.e_lo, b.e_hi, model.e, model.sigma_e),
-            ("T (s)", b.T, b.T_lo, b.T_hi, model.T, model.sigma_T),
-        )):  # fmt: skip
+        for row, (what, med, blo, bhi, data, sig) in enumerate(
+            (
+                ("e", b.e, b.e_lo, b.e_hi, model.e, model.sigma_e),
+                ("T (s)", b.T, b.T_lo, b.T_hi, model.T, model.sigma_T),
+            )
+        ):
             span = slice(0, half) if row == 0 else slice(half, d)
             if row == 1 and d < 2:
                 break

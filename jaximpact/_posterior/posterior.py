@@ -100,8 +100,11 @@ def posterior(
         raise ValueError(f"noise must be 'normal' or 'student_t', got {noise!r}")
     if not (isinstance(nu, (int, float)) and nu > 0):
         raise ValueError(f"nu (Student-t degrees of freedom) must be > 0, got {nu!r}")
-    for name, value, least in (("num_samples", num_samples, 1), ("chains", chains, 1),
-                               ("num_warmup", num_warmup, 0)):  # fmt: skip
+    for name, value, least in (
+        ("num_samples", num_samples, 1),
+        ("chains", chains, 1),
+        ("num_warmup", num_warmup, 0),
+    ):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
             raise ValueError(f"{name} must be an integer >= {least}, got {value!r}")
     if not 0 < target_accept < 1:
@@ -144,8 +147,13 @@ def posterior(
                 "not negative definite at the mode): use method='nuts' or narrower priors"
             )
         z = gaussian_draws(mode, draw_key, num_samples * chains)
-        diag = {"r_hat": float("nan"), "ess": float(z.shape[0]), "divergences": 0,
-                "chains": 1, "draws_per_chain": int(z.shape[0])}  # fmt: skip
+        diag = {
+            "r_hat": float("nan"),
+            "ess": float(z.shape[0]),
+            "divergences": 0,
+            "chains": 1,
+            "draws_per_chain": int(z.shape[0]),
+        }
     else:
         inverse_mass = jnp.asarray(covariance if usable else np.eye(d))
         if usable:
@@ -153,8 +161,15 @@ def posterior(
         else:
             jitter = np.asarray(jax.random.normal(draw_key, (chains, d)))
             starts_z = np.asarray(mode.z)[None, :] + 0.1 * jitter
-        result = run_chains(model, jnp.asarray(starts_z), inverse_mass, chain_key,
-                            int(num_warmup), int(num_samples), float(target_accept))  # fmt: skip
+        result = run_chains(
+            model,
+            jnp.asarray(starts_z),
+            inverse_mass,
+            chain_key,
+            int(num_warmup),
+            int(num_samples),
+            float(target_accept),
+        )
         diag = diagnostics(result, model.names)
         z = np.asarray(result.z).reshape(-1, d)
         why = poor(diag)
@@ -210,9 +225,13 @@ def _check_fit(fit) -> bool:
         raise TypeError(
             f"posterior takes the result of calibrate (a Fit) or of fit_bounces (a "
             f"BounceFit), got {type(fit).__name__}"
-            + ("; fit_oblique results are not supported: an ObliqueFit does not keep the "
-               "rebounds it was fitted to" if type(fit).__name__ == "ObliqueFit" else "")
-        )  # fmt: skip
+            + (
+                "; fit_oblique results are not supported: an ObliqueFit does not keep the "
+                "rebounds it was fitted to"
+                if type(fit).__name__ == "ObliqueFit"
+                else ""
+            )
+        )
     if is_traced(fit.loss) or np.ndim(fit.loss) != 0:
         raise ValueError("posterior takes one concrete fit, not a traced or vmapped batch")
     return False

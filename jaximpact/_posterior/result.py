@@ -96,9 +96,12 @@ class Posterior(eqx.Module):
         if self.law_parameters is None or self.law_name not in LAWS:
             raise ValueError(
                 f"this Posterior (read from a dict) cannot rebuild its law {self.law_name!r}: "
-                + ("a user's law needs the fit it came from" if self.law_parameters is not None
-                   else "the dict holds no 'law_parameters'")
-            )  # fmt: skip
+                + (
+                    "a user's law needs the fit it came from"
+                    if self.law_parameters is not None
+                    else "the dict holds no 'law_parameters'"
+                )
+            )
         return law(self.law_name, **{**self.law_parameters, **free})
 
     @property
@@ -117,22 +120,25 @@ class Posterior(eqx.Module):
 
     def draw_laws(self, n: int = 200) -> list:
         """The law at each of at most `n` draws, evenly thinned (`draw_indices(n)`)."""
-        return [self.law_at({k: self.samples[k][i] for k in self.free})
-                for i in self.draw_indices(n)]  # fmt: skip
+        return [
+            self.law_at({k: self.samples[k][i] for k in self.free}) for i in self.draw_indices(n)
+        ]
 
     # ------------------------------------------------------------------ predictions
 
     @quietly_compiled
-    def predict(self, v0, *, level: float = 0.9, observed: bool = False,
-                max_draws: int = 1000, key=None) -> Bands:  # fmt: skip
+    def predict(
+        self, v0, *, level: float = 0.9, observed: bool = False, max_draws: int = 1000, key=None
+    ) -> Bands:
         """Bands of `e` and `T` (s) at the speeds `v0` (m/s): median and the `level`
         quantile band over the draws (at most `max_draws` of them, evenly thinned), each
         draw's law solved by the fit's forward model. `observed=True` adds the
         measurement noise (a band for a new measurement) to the law's band.
 
         **Example**: `post.predict(v0=[1.0, 2.0, 4.0]).e_hi`."""
-        return prediction_bands(self, v0, level=level, observed=observed,
-                                max_draws=max_draws, key=key)  # fmt: skip
+        return prediction_bands(
+            self, v0, level=level, observed=observed, max_draws=max_draws, key=key
+        )
 
     def plot(self, path=None, *, v0=None, level: float = 0.9):
         """A pairs plot of the draws (histograms on the diagonal) and, with a forward
@@ -153,18 +159,22 @@ class Posterior(eqx.Module):
             unit = self.units.get(k, "")
             lo, hi = intervals[k]
             kind, a, b = self.priors[k]
-            rows.append((
-                k,
-                f"{format_value(self.median[k], unit)} (90 %: {format_value(lo, unit)} to "
-                f"{format_value(hi, unit)}; prior {kind}({a:.4g}, {b:.4g}))",
-            ))  # fmt: skip
+            rows.append(
+                (
+                    k,
+                    f"{format_value(self.median[k], unit)} (90 %: {format_value(lo, unit)} to "
+                    f"{format_value(hi, unit)}; prior {kind}({a:.4g}, {b:.4g}))",
+                )
+            )
         d = self.diagnostics
         if self.method == "nuts":
-            rows.append((
-                "diagnostics",
-                f"r_hat = {d['r_hat']:.4g}, ess = {d['ess']:.0f}, divergences = "
-                f"{d['divergences']} ({d['chains']} chains x {d['draws_per_chain']} draws)",
-            ))  # fmt: skip
+            rows.append(
+                (
+                    "diagnostics",
+                    f"r_hat = {d['r_hat']:.4g}, ess = {d['ess']:.0f}, divergences = "
+                    f"{d['divergences']} ({d['chains']} chains x {d['draws_per_chain']} draws)",
+                )
+            )
         else:
             laplace = f"Laplace approximation, {self.num_draws} independent draws"
             rows.append(("diagnostics", laplace))

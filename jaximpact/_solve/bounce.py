@@ -97,9 +97,14 @@ def _contact(law, m, v_in, g, ts_local, options: ImpactOptions, active=True):
 
         def exact(v_in):
             fields = closed(
-                law, m=m, v0=v_in, g=g, rest_tol=options.rest_tol, tau_max=options.tau_max,
+                law,
+                m=m,
+                v0=v_in,
+                g=g,
+                rest_tol=options.rest_tol,
+                tau_max=options.tau_max,
                 with_end=True,
-            )  # fmt: skip
+            )
             if not options.peaks:  # as the integrated path under peaks=False
                 fields = {k: v for k, v in fields.items() if k not in ("x_max", "t_max", "F_max")}
             return fields
@@ -290,9 +295,11 @@ class BounceResult(eqx.Module):
         touch, speed in, `e`, `T`; the first and last when there are more than `contacts`).
         A batch of drops by the range of each field and the count of each status; inside
         `jit` the shapes."""
-        rows = [("status", status_text(self.status, BounceStatus)),
-                ("num_impacts", format_value(self.num_impacts, None)),
-                ("t_rest", _at_rest_text(self.t_rest))]  # fmt: skip
+        rows = [
+            ("status", status_text(self.status, BounceStatus)),
+            ("num_impacts", format_value(self.num_impacts, None)),
+            ("t_rest", _at_rest_text(self.t_rest)),
+        ]
         traced = is_traced(self.e)
         if traced or np.ndim(self.num_impacts) > 0:  # the real contacts of all the drops
             for name, unit in (("e", ""), ("T", "s"), ("impact_speeds", "m/s")):
@@ -309,11 +316,15 @@ class BounceResult(eqx.Module):
             if k is None:
                 rows.append(("...", f"{count - contacts} more contacts"))
                 continue
-            rows.append((f"contact {k + 1}",
-                         f"at {format_value(self.impact_times[k], 's')}, "
-                         f"{format_value(self.impact_speeds[k], 'm/s')} in, "
-                         f"e = {format_value(self.e[k])}, T = {format_value(self.T[k], 's')}, "
-                         f"{status_text(self.contact_status[k])}"))  # fmt: skip
+            rows.append(
+                (
+                    f"contact {k + 1}",
+                    f"at {format_value(self.impact_times[k], 's')}, "
+                    f"{format_value(self.impact_speeds[k], 'm/s')} in, "
+                    f"e = {format_value(self.e[k])}, T = {format_value(self.T[k], 's')}, "
+                    f"{status_text(self.contact_status[k])}",
+                )
+            )
         return format_fields("BounceResult (SI units)", rows)
 
     def to_dict(self) -> dict:
@@ -322,15 +333,24 @@ class BounceResult(eqx.Module):
         (padded contacts as None). Concrete results only (not inside `jit`)."""
         single = np.ndim(self.num_impacts) == 0
         count = int(self.num_impacts) if single else self.e.shape[-1]
-        out = {name: jsonable(getattr(self, name)[..., :count]) for name in _PER_CONTACT
-               if getattr(self, name) is not None}  # fmt: skip
+        out = {
+            name: jsonable(getattr(self, name)[..., :count])
+            for name in _PER_CONTACT
+            if getattr(self, name) is not None
+        }
         if not single:
-            out = {k: jsonable(np.where(np.asarray(self.mask), np.asarray(v, dtype=float), np.nan))
-                   for k, v in ((k, getattr(self, k)) for k in out)}  # fmt: skip
+            out = {
+                k: jsonable(np.where(np.asarray(self.mask), np.asarray(v, dtype=float), np.nan))
+                for k, v in ((k, getattr(self, k)) for k in out)
+            }
         out["contact_status"] = status_names(self.contact_status[..., :count])
         out["status"] = status_names(self.status, BounceStatus)
-        out.update({name: jsonable(getattr(self, name)) for name in
-                    ("num_impacts", "t_rest", "drop_apex_time", "drop_apex_height")})  # fmt: skip
+        out.update(
+            {
+                name: jsonable(getattr(self, name))
+                for name in ("num_impacts", "t_rest", "drop_apex_time", "drop_apex_height")
+            }
+        )
         return out
 
     def __repr__(self) -> str:
@@ -375,8 +395,19 @@ def _at_rest_text(t_rest) -> str:
 # the fields of `BounceResult` that the histories re-run the drop from
 _INPUTS = ("law", "m", "g", "drag", "start", "t_end", "min_flight", "options")
 # the per-contact arrays of `BounceResult.to_dict` (`contact_status` apart, as names)
-_PER_CONTACT = ("impact_times", "release_times", "impact_speeds", "rebound_speeds", "e", "T",
-                "release_heights", "apex_times", "apex_heights", "F_max", "x_max")  # fmt: skip
+_PER_CONTACT = (
+    "impact_times",
+    "release_times",
+    "impact_speeds",
+    "rebound_speeds",
+    "e",
+    "T",
+    "release_heights",
+    "apex_times",
+    "apex_heights",
+    "F_max",
+    "x_max",
+)
 
 
 @eqx.filter_jit
@@ -549,8 +580,14 @@ def bounce_options(
     solve = with_tolerances(solve, rtol)
     # Tsit5 given is the default solver here: the gravity table still serves
     default = solver is None or type(solver) is dfx.Tsit5
-    path = choose_path(law, separation=separation, method=method, g=_GRAVITY,
-                       solver=None if default else solver, rtol=solve.rtol)  # fmt: skip
+    path = choose_path(
+        law,
+        separation=separation,
+        method=method,
+        g=_GRAVITY,
+        solver=None if default else solver,
+        rtol=solve.rtol,
+    )
     return BounceOptions(
         impact=ImpactOptions(
             separation=separation,
@@ -648,9 +685,14 @@ def bounce(
             f"got {type(law).__name__}"
         )
     for name, value in (
-        ("m", m), ("h0", h0), ("t_end", t_end), ("g", g), ("v_drop", v_drop),
-        ("min_flight", min_flight), ("drag", drag),
-    ):  # fmt: skip
+        ("m", m),
+        ("h0", h0),
+        ("t_end", t_end),
+        ("g", g),
+        ("v_drop", v_drop),
+        ("min_flight", min_flight),
+        ("drag", drag),
+    ):
         _check_real(name, value)
     # eager: a one-line ValueError; traced: a bad member is NaN and invalid (`MemberChecks`)
     checks = MemberChecks()
@@ -684,9 +726,18 @@ def bounce(
     else:
         h0 = checks.mark(resting, h0, 1.0)
     solve = solve_options(
-        bounce, options, solver=solver, rtol=rtol, atol=atol, max_steps=max_steps,
-        tau_max=tau_max, rest_tol=rest_tol, adjoint=adjoint, peaks=peaks, throw=throw,
-    )  # fmt: skip
+        bounce,
+        options,
+        solver=solver,
+        rtol=rtol,
+        atol=atol,
+        max_steps=max_steps,
+        tau_max=tau_max,
+        rest_tol=rest_tol,
+        adjoint=adjoint,
+        peaks=peaks,
+        throw=throw,
+    )
     # jax.grad alone: the forward-mode Jacobian, transposed (`adjoint.by_forward_jacobian`)
     by_forward = solve.adjoint is None and reverse_only(law, m, h0, v_drop, g, drag, t_end)
     if by_forward:
@@ -699,9 +750,16 @@ def bounce(
     start = (jnp.zeros(()), h0, -v_drop)
     if by_forward:
         result = through_forward_jacobian(
-            lambda *args: solve_bounce(*args, options), law, m, g, drag, start, t_end,
-            min_flight, closes_over=law.spec is None,
-        )  # fmt: skip
+            lambda *args: solve_bounce(*args, options),
+            law,
+            m,
+            g,
+            drag,
+            start,
+            t_end,
+            min_flight,
+            closes_over=law.spec is None,
+        )
     else:
         result = solve_bounce(law, m, g, drag, start, t_end, min_flight, options)
     # the inputs the histories re-run are kept (harmless); `trajectory` gives NaN for them

@@ -287,9 +287,13 @@ def grid_contact(law, m, v0, *, separation: str, steps: int = GRID_STEPS) -> dic
     pair = jnp.stack([zero, zero])
     rate0 = contact.force_rate(y0, True)
     init = (
-        y0, jnp.zeros(3), jnp.asarray(jnp.inf), y0,
-        (y0, zero, pair, false, rate0), (y0, zero, pair, false, zero + 1.0),
-    )  # fmt: skip
+        y0,
+        jnp.zeros(3),
+        jnp.asarray(jnp.inf),
+        y0,
+        (y0, zero, pair, false, rate0),
+        (y0, zero, pair, false, zero + 1.0),
+    )
     carry, _ = jax.lax.scan(body, init, jnp.arange(steps, dtype=float))
     y_last, err, least, y_mid, peak, end = carry
     y_pk, k_pk, rates, found_pk, _ = peak
@@ -302,11 +306,13 @@ def grid_contact(law, m, v0, *, separation: str, steps: int = GRID_STEPS) -> dic
 
     _, y_at, width_pk = _false_position(rate_along, h, rates[0], rates[1], y_pk, _PEAK_ITERS)
     y_peak = jnp.where(found_pk, y_at, y_mid)
-    peaks = jnp.stack([
-        contact.force(y0[0], y0[1], True),
-        contact.force(y_peak[0], y_peak[1], True),
-        contact.force(y_mid[0], zero, True),
-    ])  # fmt: skip
+    peaks = jnp.stack(
+        [
+            contact.force(y0[0], y0[1], True),
+            contact.force(y_peak[0], y_peak[1], True),
+            contact.force(y_mid[0], zero, True),
+        ]
+    )
     converged = ~found_pk | (width_pk <= 1e-4 * h)
 
     y_end = y_last
@@ -318,18 +324,14 @@ def grid_contact(law, m, v0, *, separation: str, steps: int = GRID_STEPS) -> dic
             return (*contact.edge_rate(k_end * h + sigma, y), y)
 
         _, slope0 = contact.edge_rate(k_end * h, y_from)
-        _, y_at, moved_end = _newton_from_left(
-            edge_along, h, edges[0], slope0, y_from, _ROOT_ITERS
-        )
+        _, y_at, moved_end = _newton_from_left(edge_along, h, edges[0], slope0, y_from, _ROOT_ITERS)
         y_end = jnp.where(ended, y_at, y_last)
         converged = converged & (~ended | (moved_end <= 1e-10 * h))
 
     e = -y_end[1]
     tau_end = y_end[2]
     x_max = y_mid[0]
-    estimate = jnp.max(
-        jnp.stack([err[0] / x_max, err[1] / jnp.abs(e), err[2] / jnp.abs(tau_end)])
-    )
+    estimate = jnp.max(jnp.stack([err[0] / x_max, err[1] / jnp.abs(e), err[2] / jnp.abs(tau_end)]))
     stuck = contact.force(x_max, zero, False) <= 0  # nothing pushes the body out at x_max
     values = jnp.stack([e, tau_end, x_max, y_mid[2], *peaks])
     served = (
@@ -368,4 +370,3 @@ def grid_serves(path, law, *, method: str, solver, rtol: float, gravity: bool) -
         and solver is None
         and rtol >= GRID_RTOL
     )
-

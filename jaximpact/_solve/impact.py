@@ -187,9 +187,14 @@ def gravity_impact(dynamics, m, v0, g, options: ImpactOptions):
     from .phases import integrated_contact
 
     fields, x_end, in_range = gravity_fields(
-        dynamics, options.similarity.key, m=m, v0=v0, g=g, peaks=options.peaks,
+        dynamics,
+        options.similarity.key,
+        m=m,
+        v0=v0,
+        g=g,
+        peaks=options.peaks,
         group=options.similarity.group,
-    )  # fmt: skip
+    )
 
     def same_types(values):
         return {
@@ -286,12 +291,26 @@ def impact(
             f"got {type(law).__name__}"
         )
     solve = solve_options(
-        impact, options, solver=solver, rtol=rtol, atol=atol, max_steps=max_steps,
-        tau_max=tau_max, rest_tol=rest_tol, adjoint=adjoint, peaks=peaks, throw=throw,
-    )  # fmt: skip
+        impact,
+        options,
+        solver=solver,
+        rtol=rtol,
+        atol=atol,
+        max_steps=max_steps,
+        tau_max=tau_max,
+        rest_tol=rest_tol,
+        adjoint=adjoint,
+        peaks=peaks,
+        throw=throw,
+    )
     rtol = check_choices(separation, method, solve.rtol, table_law=law.spec is not None)
-    check_options(rtol=rtol, atol=solve.atol, rest_tol=solve.rest_tol,
-                  max_steps=solve.max_steps, tau_max=solve.tau_max)  # fmt: skip
+    check_options(
+        rtol=rtol,
+        atol=solve.atol,
+        rest_tol=solve.rest_tol,
+        max_steps=solve.max_steps,
+        tau_max=solve.tau_max,
+    )
     # eager: a one-line ValueError; traced: a bad member is NaN and invalid (`MemberChecks`)
     checks = MemberChecks()
     # 1e-300 kg is refused as 1e300 kg is: the contact's scales would under- or overflow
@@ -329,9 +348,14 @@ def impact(
             # (`adjoint.by_forward_jacobian`): 10x faster than a reverse solve, compiled sooner
             forward = dataclasses.replace(options, adjoint=dfx.ForwardMode())
             result = through_forward_jacobian(
-                lambda *args: solve_impact(*args, forward), law, m, v0, g, ts,
+                lambda *args: solve_impact(*args, forward),
+                law,
+                m,
+                v0,
+                g,
+                ts,
                 closes_over=law.spec is None,
-            )  # fmt: skip
+            )
     if result is None:
         result = solve_impact(law, m, v0, g, ts, options)
     result = checks.refuse(result, status=Status.invalid)

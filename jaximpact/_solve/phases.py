@@ -92,8 +92,11 @@ def integrate_phases(dynamics, options, *, plan, tau_grid, hold=None):
     (nondimensional), stacked along a leading axis. `hold` (a boolean): skip every phase
     (a contact known in closed form never to return, see `AbstractDynamics.creeping`)."""
     separation, solver, adjoint, max_steps = (
-        options.separation, options.solver, options.adjoint, options.max_steps
-    )  # fmt: skip
+        options.separation,
+        options.solver,
+        options.adjoint,
+        options.max_steps,
+    )
     rtol, atol, tau_max, rest_tol = options.rtol, options.atol, options.tau_max, options.rest_tol
     term = dfx.ODETerm(lambda t, y, args: dynamics.rhs(y, args < _TO_SEPARATION))
     conditions = _event_conditions(dynamics, separation, plan, rest_tol)

@@ -8,8 +8,16 @@ from .._format import format_fields, format_value, jsonable
 from .._status import Status
 
 # the fields of an impact as `summary()` shows them: name, unit (None: a count or a word)
-_SHOWN = (("e", ""), ("T", "s"), ("x_max", "m"), ("t_max", "s"), ("F_max", "N"),
-          ("dissipated", "J"), ("v_out", "m/s"), ("num_steps", None))  # fmt: skip
+_SHOWN = (
+    ("e", ""),
+    ("T", "s"),
+    ("x_max", "m"),
+    ("t_max", "s"),
+    ("F_max", "N"),
+    ("dissipated", "J"),
+    ("v_out", "m/s"),
+    ("num_steps", None),
+)
 _HISTORIES = ("ts", "x", "v", "F")
 
 
@@ -71,8 +79,11 @@ class ImpactResult(eqx.Module):
         """The impact as text, every number with its unit (`T = 7.845 ms`); a batch of
         impacts (arrays) by the range of each field and the count of each status; inside
         `jit` the shapes (`traced f64[]`), as there are no numbers yet."""
-        rows = [(name, format_value(getattr(self, name), unit)) for name, unit in _SHOWN
-                if getattr(self, name) is not None]  # fmt: skip
+        rows = [
+            (name, format_value(getattr(self, name), unit))
+            for name, unit in _SHOWN
+            if getattr(self, name) is not None
+        ]
         rows.append(("status", self._status_text()))
         rows.append(("path", self.path))
         if self.ts is not None:
@@ -86,8 +97,9 @@ class ImpactResult(eqx.Module):
         out = {name: jsonable(getattr(self, name)) for name, _ in _SHOWN}
         out["status"] = status_names(self.status)
         out["path"] = self.path
-        out.update({k: jsonable(getattr(self, k)) for k in _HISTORIES
-                    if getattr(self, k) is not None})  # fmt: skip
+        out.update(
+            {k: jsonable(getattr(self, k)) for k in _HISTORIES if getattr(self, k) is not None}
+        )
         return out
 
     def __repr__(self) -> str:
@@ -107,8 +119,9 @@ def status_text(status, kinds=Status) -> str:
     if np.ndim(status) == 0:
         return names.get(int(codes[0]), str(int(codes[0])))
     found, counts = np.unique(codes, return_counts=True)
-    return ", ".join(f"{names.get(int(c), str(int(c)))} {n}" for c, n in
-                     zip(found, counts, strict=True))  # fmt: skip
+    return ", ".join(
+        f"{names.get(int(c), str(int(c)))} {n}" for c, n in zip(found, counts, strict=True)
+    )
 
 
 def status_names(status, kinds=Status):

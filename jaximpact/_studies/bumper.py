@@ -33,9 +33,19 @@ class BumperDesign(PrintedFields, eqx.Module):
     """
 
     _TITLE = "BumperDesign (SI units; the hertz_rate law that meets the bounds)"
-    _SHOWN = (("c", "N/m^1.5"), ("b1", "N s/m^1.5"), ("feasible", None), ("F_peak", "N"),
-              ("F_ideal", "N"), ("speeds", "m/s"), ("m", "kg"), ("x_max_bound", "m"),
-              ("x_max", "m"), ("e_target", ""), ("e", ""))  # fmt: skip
+    _SHOWN = (
+        ("c", "N/m^1.5"),
+        ("b1", "N s/m^1.5"),
+        ("feasible", None),
+        ("F_peak", "N"),
+        ("F_ideal", "N"),
+        ("speeds", "m/s"),
+        ("m", "kg"),
+        ("x_max_bound", "m"),
+        ("x_max", "m"),
+        ("e_target", ""),
+        ("e", ""),
+    )
 
     c: Array
     b1: Array

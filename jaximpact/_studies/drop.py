@@ -25,8 +25,15 @@ class DropDesign(PrintedFields, eqx.Module):
     """
 
     _TITLE = "DropDesign (SI units)"
-    _SHOWN = (("h0", "m"), ("m", "kg"), ("target", "m"), ("apexes", "m"), ("loss", ""),
-              ("converged", None), ("iterations", None))  # fmt: skip
+    _SHOWN = (
+        ("h0", "m"),
+        ("m", "kg"),
+        ("target", "m"),
+        ("apexes", "m"),
+        ("loss", ""),
+        ("converged", None),
+        ("iterations", None),
+    )
 
     h0: float
     m: float

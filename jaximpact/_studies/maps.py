@@ -34,10 +34,18 @@ class RestitutionMap(PrintedFields, eqx.Module):
     """
 
     _TITLE = "RestitutionMap (SI units; rows follow damping, columns c)"
-    _SHOWN = (("law", None), ("damping_name", None), ("c", lambda r: axis_unit(r, "c")),
-              ("damping", lambda r: axis_unit(r, r.damping_name)),
-              ("e", ""), ("T", "s"), ("m", "kg"), ("v0", "m/s"), ("separation", None),
-              ("path", None))  # fmt: skip
+    _SHOWN = (
+        ("law", None),
+        ("damping_name", None),
+        ("c", lambda r: axis_unit(r, "c")),
+        ("damping", lambda r: axis_unit(r, r.damping_name)),
+        ("e", ""),
+        ("T", "s"),
+        ("m", "kg"),
+        ("v0", "m/s"),
+        ("separation", None),
+        ("path", None),
+    )
 
     law: str = eqx.field(static=True)
     damping_name: str = eqx.field(static=True)

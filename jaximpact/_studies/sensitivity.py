@@ -95,10 +95,20 @@ class SensitivityMap(PrintedFields, eqx.Module):
     """
 
     _TITLE = "SensitivityMap (SI units; rows follow damping, columns c)"
-    _SHOWN = (("law", None), ("damping_name", None), ("c", lambda r: axis_unit(r, "c")),
-              ("damping", lambda r: axis_unit(r, r.damping_name)), ("e", ""),
-              ("T", "s"), ("de_dc", ""), ("de_ddamping", ""), ("dT_dc", ""),
-              ("dT_ddamping", ""), ("m", "kg"), ("v0", "m/s"))  # fmt: skip
+    _SHOWN = (
+        ("law", None),
+        ("damping_name", None),
+        ("c", lambda r: axis_unit(r, "c")),
+        ("damping", lambda r: axis_unit(r, r.damping_name)),
+        ("e", ""),
+        ("T", "s"),
+        ("de_dc", ""),
+        ("de_ddamping", ""),
+        ("dT_dc", ""),
+        ("dT_ddamping", ""),
+        ("m", "kg"),
+        ("v0", "m/s"),
+    )
 
     law: str = eqx.field(static=True)
     damping_name: str = eqx.field(static=True)

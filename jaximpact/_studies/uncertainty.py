@@ -28,9 +28,17 @@ class Uncertainty(PrintedFields, eqx.Module):
     """
 
     _TITLE = "Uncertainty of (e, T in s)"
-    _SHOWN = (("names", None), ("sigma", ""), ("nominal", ""), ("std_linear", ""),
-              ("std_mc", ""), ("std_mc_error", ""), ("z_std", ""), ("n_samples", None),
-              ("separated_fraction", ""))  # fmt: skip
+    _SHOWN = (
+        ("names", None),
+        ("sigma", ""),
+        ("nominal", ""),
+        ("std_linear", ""),
+        ("std_mc", ""),
+        ("std_mc_error", ""),
+        ("z_std", ""),
+        ("n_samples", None),
+        ("separated_fraction", ""),
+    )
 
     names: tuple = eqx.field(static=True)
     nominal: np.ndarray

@@ -148,8 +148,13 @@ def test_a_row_gives_the_same_bits_alone_or_among_others():
     another last bit, so blocks hold at least 2 rows: a file's output must not depend on how
     its rows fall into groups, chunks or processes."""
     env = {k: v for k, v in os.environ.items() if k != "XLA_FLAGS"}
-    done = subprocess.run([sys.executable, "-c", _ONE_ROW_AMONG_OTHERS], env=env,
-                          capture_output=True, text=True, timeout=300)  # fmt: skip
+    done = subprocess.run(
+        [sys.executable, "-c", _ONE_ROW_AMONG_OTHERS],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert done.returncode == 0, done.stdout + done.stderr[-2000:]
 
 

@@ -33,8 +33,7 @@ def _write(path, columns: dict):
     with open(path, "w", encoding="cp1252", newline="") as handle:
         writer = csv.writer(handle, lineterminator="\r\n")
         writer.writerow(columns)
-        writer.writerows([x if isinstance(x, str) else repr(float(x)) for x in row]
-                         for row in rows)  # fmt: skip
+        writer.writerows([x if isinstance(x, str) else repr(float(x)) for x in row] for row in rows)
 
 
 def _read(path):
@@ -45,14 +44,19 @@ def _read(path):
 
 def _table_columns(n=N, carried=True):
     rng = np.random.default_rng(1)
-    numbers = dict(c=rng.uniform(1e6, 3e6, n), b1=rng.uniform(100.0, 2000.0, n),
-                   m=rng.uniform(0.5, 2.0, n), v0=rng.uniform(0.5, 5.0, n))  # fmt: skip
+    numbers = dict(
+        c=rng.uniform(1e6, 3e6, n),
+        b1=rng.uniform(100.0, 2000.0, n),
+        m=rng.uniform(0.5, 2.0, n),
+        v0=rng.uniform(0.5, 5.0, n),
+    )
     if not carried:
         return numbers
     ids = [f"B-{i:04d}" for i in range(n)]
     notes = [NOTES[i % len(NOTES)] for i in range(n)]
-    return dict(id=ids, c=numbers["c"], b1=numbers["b1"], note=notes, m=numbers["m"],
-                v0=numbers["v0"])  # fmt: skip
+    return dict(
+        id=ids, c=numbers["c"], b1=numbers["b1"], note=notes, m=numbers["m"], v0=numbers["v0"]
+    )
 
 
 def test_text_columns_are_carried_through_row_for_row_with_a_table_law(tmp_path):
@@ -71,12 +75,26 @@ def test_text_columns_are_carried_through_row_for_row_with_a_table_law(tmp_path)
 
 
 def test_the_command_line_carries_a_note_column(tmp_path, capsys):
-    _write(tmp_path / "in.csv", {"m": [1.0] * N, "v0": np.linspace(0.5, 5, N),
-                                 "note": [NOTES[i % 5] for i in range(N)]})  # fmt: skip
-    status, _, err = run_cli(capsys, ["batch", str(tmp_path / "in.csv"), "--out",
-                                      str(tmp_path / "out.csv"), "--law", "hertz_rate",
-                                      "--param", "c=2e6", "b1=800", "--chunk-rows",
-                                      str(CHUNK)])  # fmt: skip
+    _write(
+        tmp_path / "in.csv",
+        {"m": [1.0] * N, "v0": np.linspace(0.5, 5, N), "note": [NOTES[i % 5] for i in range(N)]},
+    )
+    status, _, err = run_cli(
+        capsys,
+        [
+            "batch",
+            str(tmp_path / "in.csv"),
+            "--out",
+            str(tmp_path / "out.csv"),
+            "--law",
+            "hertz_rate",
+            "--param",
+            "c=2e6",
+            "b1=800",
+            "--chunk-rows",
+            str(CHUNK),
+        ],
+    )
     assert status == 0, err
     out = _read(tmp_path / "out.csv")
     assert list(out) == ["m", "v0", "note", *RESULTS]
@@ -85,19 +103,25 @@ def test_the_command_line_carries_a_note_column(tmp_path, capsys):
 
 def test_text_columns_are_carried_through_with_a_users_law(tmp_path):
     law = ji.custom_law(hertz_rate, c=2e6, b1=800.0)
-    columns = dict(id=[str(i) for i in range(USER_N)], c=np.linspace(1.5e6, 3e6, USER_N),
-                   m=np.linspace(0.5, 2.0, USER_N), note=NOTES[:USER_N - 1] + ["fin"],
-                   v0=np.linspace(0.5, 4.0, USER_N))  # fmt: skip
+    columns = dict(
+        id=[str(i) for i in range(USER_N)],
+        c=np.linspace(1.5e6, 3e6, USER_N),
+        m=np.linspace(0.5, 2.0, USER_N),
+        note=NOTES[: USER_N - 1] + ["fin"],
+        v0=np.linspace(0.5, 4.0, USER_N),
+    )
     _write(tmp_path / "in.csv", columns)
-    record = ji.batch_file(tmp_path / "in.csv", tmp_path / "out.csv", law,
-                           chunk_rows=USER_CHUNK, progress=False)  # fmt: skip
+    record = ji.batch_file(
+        tmp_path / "in.csv", tmp_path / "out.csv", law, chunk_rows=USER_CHUNK, progress=False
+    )
     assert record.statuses["separated"] == USER_N
     out = _read(tmp_path / "out.csv")
     assert list(out) == ["id", "c", "m", "note", "v0", *RESULTS]
     assert out["id"] == columns["id"] and out["note"] == columns["note"]
     # chunks from a script carry their text columns too (a user's law, the same rows)
-    chunks = [{k: v[i : i + USER_CHUNK] for k, v in columns.items()}
-              for i in range(0, USER_N, USER_CHUNK)]  # fmt: skip
+    chunks = [
+        {k: v[i : i + USER_CHUNK] for k, v in columns.items()} for i in range(0, USER_N, USER_CHUNK)
+    ]
     ji.impact_batch(law, chunks, out=tmp_path / "chunks.csv", progress=False)
     assert _read(tmp_path / "chunks.csv") == out
 
@@ -105,15 +129,18 @@ def test_text_columns_are_carried_through_with_a_users_law(tmp_path):
 @pytest.mark.parametrize(
     "header, law, match",
     [
-        ("c,b1,m,v0,separaton", "hertz_rate",
-         r"unknown column 'separaton' \(did you mean separation\?\)"),
+        (
+            "c,b1,m,v0,separaton",
+            "hertz_rate",
+            r"unknown column 'separaton' \(did you mean separation\?\)",
+        ),
         ("c,b1,m,V0,note", "hertz_rate", r"unknown column 'V0' \(did you mean v0\?\)"),
         ("c,b_1,m,v0", "hertz_rate", r"unknown column 'b_1' \(did you mean b1\?\)"),
         ("c,m,v0,Separation", "user", r"unknown column 'Separation' \(did you mean separation\?\)"),
         ("c,B_1,m,v0", "user", r"unknown column 'B_1' \(did you mean b1\?\)"),
         ("c,b1,m,v0,status", "hertz_rate", r"column 'status' is a result the output writes"),
     ],
-)  # fmt: skip
+)
 def test_a_misspelt_column_is_refused_with_the_nearest_name(tmp_path, header, law, match):
     (tmp_path / "in.csv").write_text(header + "\n" + ",".join(["1"] * len(header.split(","))))
     if law == "user":
@@ -126,9 +153,20 @@ def test_a_misspelt_column_is_refused_with_the_nearest_name(tmp_path, header, la
 
 def test_the_command_line_refuses_a_misspelt_column(tmp_path, capsys):
     (tmp_path / "in.csv").write_text("m,v0,separaton\n1,2,force\n")
-    result = run_cli(capsys, ["batch", str(tmp_path / "in.csv"), "--out",
-                              str(tmp_path / "out.csv"), "--law", "hertz_rate", "--param",
-                              "c=2e6", "b1=800"])  # fmt: skip
+    result = run_cli(
+        capsys,
+        [
+            "batch",
+            str(tmp_path / "in.csv"),
+            "--out",
+            str(tmp_path / "out.csv"),
+            "--law",
+            "hertz_rate",
+            "--param",
+            "c=2e6",
+            "b1=800",
+        ],
+    )
     assert_one_line_error(*result, contains="did you mean separation?")
 
 
@@ -144,10 +182,18 @@ def test_a_resume_checks_the_carried_columns(tmp_path):
 
     def digests(columns):
         _write(tmp_path / "in.csv", columns)
-        planned = job.plan(tmp_path / "in.csv", tmp_path / "out.csv", "hertz_rate", params={},
-                           given=dict.fromkeys(("m", "v0", "g", "separation")),
-                           chunk_rows=CHUNK, resume=True, progress=False, mesh="local",
-                           impact_options={})  # fmt: skip
+        planned = job.plan(
+            tmp_path / "in.csv",
+            tmp_path / "out.csv",
+            "hertz_rate",
+            params={},
+            given=dict.fromkeys(("m", "v0", "g", "separation")),
+            chunk_rows=CHUNK,
+            resume=True,
+            progress=False,
+            mesh="local",
+            impact_options={},
+        )
         return job.check(planned).digests
 
     columns = _table_columns()
@@ -171,8 +217,13 @@ def test_parquet_keeps_the_text_columns(tmp_path):
     assert table.column("note").to_pylist() == columns["note"]
     assert table.column("id").to_pylist() == columns["id"]
     # Parquet in (an integer id, a text note): text columns out, in Parquet and in CSV
-    source = pa.table({**{k: columns[k] for k in ("c", "b1", "m", "v0")},
-                       "id": pa.array(range(N), pa.int64()), "note": columns["note"]})  # fmt: skip
+    source = pa.table(
+        {
+            **{k: columns[k] for k in ("c", "b1", "m", "v0")},
+            "id": pa.array(range(N), pa.int64()),
+            "note": columns["note"],
+        }
+    )
     pq.write_table(source, tmp_path / "in.parquet", row_group_size=37)
     ji.batch_file(tmp_path / "in.parquet", tmp_path / "pq.parquet", "hertz_rate", **kwargs)
     ji.batch_file(tmp_path / "in.parquet", tmp_path / "pq.csv", "hertz_rate", **kwargs)

@@ -166,9 +166,19 @@ def test_a_users_law_takes_parameters_of_any_sign(tmp_path):
     is no error of the file (checked without computing: `plan` and `check` only)."""
     (tmp_path / "in.csv").write_text("c,m,v0\n2e6,1,1\n")
     law = ji.custom_law(lambda x, v, p: p["c"] * x**1.5 + p["s"] * 0.0 * v, c=2e6, s=-1.0)
-    planned = job.check(job.plan(tmp_path / "in.csv", tmp_path / "out.csv", law, params=None,
-                                 given={"m": None, "v0": None, "g": None, "separation": None},
-                                 chunk_rows=CHUNK, resume=False, progress=False,
-                                 mesh="local", impact_options={}))  # fmt: skip
+    planned = job.check(
+        job.plan(
+            tmp_path / "in.csv",
+            tmp_path / "out.csv",
+            law,
+            params=None,
+            given={"m": None, "v0": None, "g": None, "separation": None},
+            chunk_rows=CHUNK,
+            resume=False,
+            progress=False,
+            mesh="local",
+            impact_options={},
+        )
+    )
     assert planned.rows == 1 and planned.law.parameters == ("c", "s")
     assert planned.fixed == {"s": -1.0, "separation": "force", "g": 0.0}

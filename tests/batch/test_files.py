@@ -56,8 +56,19 @@ def test_every_row_equals_the_batch_in_memory(tmp_path):
     assert result.statuses["separated"] == N
     assert not (tmp_path / "out.csv.parts").exists()
     out = _read(tmp_path / "out.csv")
-    assert list(out) == ["c", "b1", "m", "v0", "e", "T", "x_max", "t_max", "F_max", "status",
-                         "path"]  # fmt: skip
+    assert list(out) == [
+        "c",
+        "b1",
+        "m",
+        "v0",
+        "e",
+        "T",
+        "x_max",
+        "t_max",
+        "F_max",
+        "status",
+        "path",
+    ]
     want = ji.impact_batch(
         "hertz_rate",
         {"c": columns["c"], "b1": columns["b1"]},
@@ -83,8 +94,9 @@ def test_any_chunk_size_gives_the_same_rows(tmp_path):
     for key in ("c", "b1", "m", "v0", "status", "path"):
         assert a[key] == b[key]
     for key in ("e", "T", "x_max", "t_max", "F_max"):
-        np.testing.assert_allclose(np.asarray(a[key], float), np.asarray(b[key], float),
-                                   rtol=1e-14, err_msg=key)  # fmt: skip
+        np.testing.assert_allclose(
+            np.asarray(a[key], float), np.asarray(b[key], float), rtol=1e-14, err_msg=key
+        )
 
 
 @pytest.mark.slow  # moved from the fast suite to keep it near 3 minutes
@@ -103,9 +115,15 @@ def test_columns_for_separation_and_failing_rows_kept_with_their_status(tmp_path
     assert out["separation"] == separation.tolist() and result.rows == n
     for word in ("force", "penetration"):
         rows = separation == word
-        want = ji.impact_batch("kelvin_voigt", {"c": 2e6, "b": b[rows]}, m=1.0, v0=2.0,
-                               separation=word, fields=("e", "T", "status"),
-                               progress=False)  # fmt: skip
+        want = ji.impact_batch(
+            "kelvin_voigt",
+            {"c": 2e6, "b": b[rows]},
+            m=1.0,
+            v0=2.0,
+            separation=word,
+            fields=("e", "T", "status"),
+            progress=False,
+        )
         got = {k: np.asarray(out[k])[rows] for k in ("e", "T", "status")}
         np.testing.assert_allclose(got["e"].astype(float), want["e"], rtol=1e-13, atol=1e-17)
         np.testing.assert_allclose(got["T"].astype(float), want["T"], rtol=1e-13)
@@ -156,9 +174,12 @@ def test_resume_recomputes_everything_when_the_settings_changed(tmp_path, monkey
     """A fixed value (here the mass) is part of every chunk's hash."""
     _bodies(tmp_path / "in.csv")
     (tmp_path / "in.csv").write_text(
-        "\n".join(",".join(line.split(",")[:2] + line.split(",")[3:])
-                  for line in (tmp_path / "in.csv").read_text().splitlines()) + "\n"
-    )  # fmt: skip
+        "\n".join(
+            ",".join(line.split(",")[:2] + line.split(",")[3:])
+            for line in (tmp_path / "in.csv").read_text().splitlines()
+        )
+        + "\n"
+    )
     _interrupted(tmp_path, monkeypatch, after=2, m=1.0)
     result = _run(tmp_path, resume=True, m=2.0)
     assert (result.computed, result.reused) == (3, 0)
@@ -224,10 +245,16 @@ def test_parquet_in_and_out(tmp_path):
     columns = _bodies(tmp_path / "in.csv")
     pq.write_table(pa.table(columns), tmp_path / "in.parquet", row_group_size=37)
     _run(tmp_path, "csv.csv")
-    ji.batch_file(tmp_path / "in.parquet", tmp_path / "out.parquet", "hertz_rate",
-                  chunk_rows=CHUNK, progress=False)  # fmt: skip
-    ji.batch_file(tmp_path / "in.parquet", tmp_path / "pq.csv", "hertz_rate",
-                  chunk_rows=CHUNK, progress=False)  # fmt: skip
+    ji.batch_file(
+        tmp_path / "in.parquet",
+        tmp_path / "out.parquet",
+        "hertz_rate",
+        chunk_rows=CHUNK,
+        progress=False,
+    )
+    ji.batch_file(
+        tmp_path / "in.parquet", tmp_path / "pq.csv", "hertz_rate", chunk_rows=CHUNK, progress=False
+    )
     assert (tmp_path / "pq.csv").read_bytes() == (tmp_path / "csv.csv").read_bytes()
     table = pq.read_table(tmp_path / "out.parquet").to_pydict()
     want = _read(tmp_path / "csv.csv")
@@ -281,8 +308,9 @@ def test_a_generator_stops_at_its_first_bad_chunk_and_resume_completes_it(tmp_pa
     with pytest.raises(ValueError, match=r"chunk 1, row 7"):  # a list: before any work
         ji.batch_file(bad, tmp_path / "list.csv", "hertz_rate", progress=False)
     assert not Path(f"{tmp_path / 'list.csv'}.parts").exists()
-    again = ji.batch_file((c for c in good), tmp_path / "out.csv", "hertz_rate", resume=True,
-                          progress=False)  # fmt: skip
+    again = ji.batch_file(
+        (c for c in good), tmp_path / "out.csv", "hertz_rate", resume=True, progress=False
+    )
     assert (again.computed, again.reused) == (2, 1)
     whole = ji.batch_file(good, tmp_path / "whole.csv", "hertz_rate", progress=False)
     assert whole.computed == 3
@@ -292,18 +320,27 @@ def test_a_generator_stops_at_its_first_bad_chunk_and_resume_completes_it(tmp_pa
 @pytest.mark.parametrize(
     "chunks, kwargs, match",
     [
-        ([{"c": [1e6], "b1": [1.0], "v0": [1.0]}, {"c": [1e6], "v0": [1.0]}], {},
-         "chunk 1: columns c, v0, not those of chunk 0"),
+        (
+            [{"c": [1e6], "b1": [1.0], "v0": [1.0]}, {"c": [1e6], "v0": [1.0]}],
+            {},
+            "chunk 1: columns c, v0, not those of chunk 0",
+        ),
         ([[1, 2, 3]], {}, "chunk 0: a mapping column -> array is needed, got list"),
         ([], {}, "holds no chunk"),
-        ([{"c": [1e6, 2e6], "b1": [1.0, 2.0, 3.0], "v0": 1.0}], {},
-         "column c: 2 values for 3 rows"),
+        (
+            [{"c": [1e6, 2e6], "b1": [1.0, 2.0, 3.0], "v0": 1.0}],
+            {},
+            "column c: 2 values for 3 rows",
+        ),
         ([{"c": ["a"], "b1": [1.0], "v0": 1.0}], {}, "column c: not numbers"),
-        ([{"c": [1e6], "b1": [1.0], "v0": [1.0], "V0": [2.0]}], {},
-         r"chunk 0: unknown column 'V0' \(did you mean v0\?\)"),
+        (
+            [{"c": [1e6], "b1": [1.0], "v0": [1.0], "V0": [2.0]}],
+            {},
+            r"chunk 0: unknown column 'V0' \(did you mean v0\?\)",
+        ),
         ([{"c": [1e6], "b1": [1.0]}], {}, "no value for v0"),
     ],
-)  # fmt: skip
+)
 def test_bad_chunks_are_named_in_one_line(tmp_path, chunks, kwargs, match):
     with pytest.raises(ValueError, match=match) as info:
         ji.impact_batch("hertz_rate", chunks, out=tmp_path / "o.csv", m=1.0, progress=False)
@@ -339,14 +376,24 @@ def test_cli_batch(capsys, tmp_path):
         ("c,b1,m\n2e6,800,1\n", "no value for v0"),
     ]:
         (tmp_path / "bad.csv").write_text(bad)
-        result = run_cli(capsys, ["batch", str(tmp_path / "bad.csv"), "--law", "hertz_rate",
-                                  "--out", str(tmp_path / "o.csv")])  # fmt: skip
+        result = run_cli(
+            capsys,
+            [
+                "batch",
+                str(tmp_path / "bad.csv"),
+                "--law",
+                "hertz_rate",
+                "--out",
+                str(tmp_path / "o.csv"),
+            ],
+        )
         assert_one_line_error(*result, contains=message)
         assert not (tmp_path / "o.csv").exists() and not (tmp_path / "o.csv.parts").exists()
     result = run_cli(capsys, [*argv, "--num-processes", "2"])
     assert_one_line_error(*result, contains="--coordinator, --process-id missing")
-    result = run_cli(capsys, [*argv, "--coordinator", "localhost:1", "--num-processes", "2",
-                              "--process-id", "2"])  # fmt: skip
+    result = run_cli(
+        capsys, [*argv, "--coordinator", "localhost:1", "--num-processes", "2", "--process-id", "2"]
+    )
     assert_one_line_error(*result, contains="--process-id must lie in 0 .. 1")
 
 
@@ -383,7 +430,7 @@ def _start(argv, processes: int, **popen):
             ],
             env=_env(),
             **popen,
-        )  # fmt: skip
+        )
         for k in range(processes)
     ]
 
@@ -403,14 +450,17 @@ def test_two_processes_write_the_file_of_one_bit_for_bit(tmp_path, mesh):
     lacks in a round included) or each process on its own (`local`)."""
     rng = np.random.default_rng(7)
     separation = np.where(rng.random(300) < 0.3, "penetration", "force")
-    _bodies(tmp_path / "in.csv", n=300, g=np.where(rng.random(300) < 0.2, 9.81, 0.0),
-            separation=separation)  # fmt: skip
+    _bodies(
+        tmp_path / "in.csv",
+        n=300,
+        g=np.where(rng.random(300) < 0.2, 9.81, 0.0),
+        separation=separation,
+    )
     # 9 chunks: process 1 has none in the last round, and takes part in it all the same
     argv = [str(tmp_path / "in.csv"), "--law", "hertz_rate", "--chunk-rows", "35"]
     pipes = dict(stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     one = _finish(_start([*argv, "--out", str(tmp_path / "one.csv")], 1, **pipes))
-    two = _finish(_start([*argv, "--out", str(tmp_path / "two.csv"), "--mesh", mesh], 2,
-                         **pipes))  # fmt: skip
+    two = _finish(_start([*argv, "--out", str(tmp_path / "two.csv"), "--mesh", mesh], 2, **pipes))
     assert "300 impacts written" in one[0] and "9 chunks computed" in one[0]
     assert "process 0 of 2" in two[0] and "5 chunks computed" in two[0]
     assert "process 1 of 2" in two[1] and "4 chunks computed" in two[1]
@@ -440,8 +490,14 @@ def test_a_killed_run_of_two_processes_is_completed_by_resume(tmp_path, mesh):
     processes finishes the file: equal, bit for bit, to a run never stopped."""
     _bodies(tmp_path / "in.csv", n=4000)
     argv = [str(tmp_path / "in.csv"), "--law", "hertz_rate", "--chunk-rows", "5"]
-    _finish(_start([*argv, "--out", str(tmp_path / "whole.csv")], 1,
-                   stdout=subprocess.PIPE, stderr=subprocess.PIPE))  # fmt: skip
+    _finish(
+        _start(
+            [*argv, "--out", str(tmp_path / "whole.csv")],
+            1,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+        )
+    )
     out = tmp_path / "out.csv"
     parts = Path(f"{out}.parts")
     quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -455,8 +511,7 @@ def test_a_killed_run_of_two_processes_is_completed_by_resume(tmp_path, mesh):
     done = len(list(parts.glob("part-*.json")))
     assert 0 < done < 800 and not out.exists()
     pipes = dict(stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    texts = _finish(_start([*argv, "--out", str(out), "--resume", "--mesh", mesh], 2,
-                           **pipes))  # fmt: skip
+    texts = _finish(_start([*argv, "--out", str(out), "--resume", "--mesh", mesh], 2, **pipes))
     reused = sum(int(t.split(" reused")[0].rsplit(", ", 1)[1]) for t in texts)
     assert reused == done
     assert out.read_bytes() == (tmp_path / "whole.csv").read_bytes()

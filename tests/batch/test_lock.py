@@ -54,9 +54,7 @@ def test_a_second_writer_of_one_output_is_refused_however_spelled(tmp_path, monk
     assert (tmp_path / "out.csv").exists() and not lock_name("out.csv").exists()
 
 
-def test_the_command_line_names_the_other_run_and_a_dead_one_s_lock_is_taken_over(
-    capsys, tmp_path
-):
+def test_the_command_line_names_the_other_run_and_a_dead_one_s_lock_is_taken_over(capsys, tmp_path):
     source, out = tmp_path / "in.csv", tmp_path / "same.csv"
     source.write_text(BODIES)
     argv = ["batch", str(source), "--law", "hertz_rate", "--out", str(out)]

@@ -25,7 +25,17 @@ from jaximpact._cli import common, laws as cli_laws  # noqa: E402
 from jaximpact._plotting import plot_impact  # noqa: E402
 
 LAW = dict(c=2e6, b1=800.0)
-SIMULATE = ["simulate", "--mass", "1", "--law", "hertz_rate", "--param", "c=2e6", "--param", "b1=800"]
+SIMULATE = [
+    "simulate",
+    "--mass",
+    "1",
+    "--law",
+    "hertz_rate",
+    "--param",
+    "c=2e6",
+    "--param",
+    "b1=800",
+]
 SIMULATE += ["--mass", "1", "--v0", "2.5"]
 
 
@@ -65,8 +75,13 @@ def test_laws_by_name(capsys, monkeypatch):
     status, out, err = run_cli(capsys, ["laws", "hertz", "Mindlin-Rescale"])
     assert status == 0 and err == ""
     shown = {line.split()[0] for line in out.splitlines() if line and line[0].isalpha()}
-    wanted = {"hertz_viscous", "hertz_modified", "hertz_rate", "mindlin_rescale",
-              "mindlin_rescale_force"}  # fmt: skip
+    wanted = {
+        "hertz_viscous",
+        "hertz_modified",
+        "hertz_rate",
+        "mindlin_rescale",
+        "mindlin_rescale_force",
+    }
     assert wanted <= shown and not shown & ({*ji.LAW_NAMES, *ji.TANGENTIAL_LAW_NAMES} - wanted)
     status, out, _ = run_cli(capsys, ["laws", "linear_history", "--json"])
     data = json.loads(out)
@@ -119,7 +134,18 @@ def test_simulate_text(capsys):
 def test_simulate_json_and_plot(capsys, tmp_path):
     # Kelvin-Voigt has a closed form (no solve), so only the plot's history costs a solve
     png = tmp_path / "impact.png"
-    argv = ["simulate", "--mass", "1", "--law", "kelvin_voigt", "--param", "c=2e6", "b=400", "--v0", "2.5"]
+    argv = [
+        "simulate",
+        "--mass",
+        "1",
+        "--law",
+        "kelvin_voigt",
+        "--param",
+        "c=2e6",
+        "b=400",
+        "--v0",
+        "2.5",
+    ]
     argv += ["--separation", "penetration", "--json", "--plot", str(png)]
     status, out, err = run_cli(capsys, argv)
     assert status == 0 and err == ""
@@ -141,23 +167,41 @@ def test_simulate_json_and_plot(capsys, tmp_path):
     [
         (["--law", "no_such_law", "--param", "c=1", "--v0", "1"], "unknown law 'no_such_law'"),
         (["--law", "hertz_rate", "--param", "c=-2e6", "b1=800", "--v0", "2.5"], "stiffness c"),
-        (["--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "2.5", "--mass", "-1"],
-         "mass m"),
+        (
+            ["--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "2.5", "--mass", "-1"],
+            "mass m",
+        ),
         (["--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "0"], "impact speed v0"),
         (["--law", "hertz_rate", "--param", "c=abc", "b1=800", "--v0", "2.5"], "not a number"),
         (["--law", "hertz_rate", "--param", "c", "--v0", "2.5"], "NAME=VALUE"),
-        (["--law", "hertz_rate", "--param", "c=2e6", "b1=800", "k=3", "--v0", "2.5"],
-         "no parameter k"),
+        (
+            ["--law", "hertz_rate", "--param", "c=2e6", "b1=800", "k=3", "--v0", "2.5"],
+            "no parameter k",
+        ),
         (["--law", "hertz_rate", "--param", "c=2e6", "--v0", "2.5"], "needs b1"),
         (["--law", "hertz_rate", "--param", "c=2e6", "c=3e6", "b1=800", "--v0", "2.5"], "twice"),
         (["--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "fast"], "--v0"),
         (["--law", "hertz_rate", "--param", "c=2e6", "b1=800"], "--v0"),
-        (["--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "2.5", "--plot", "a.xyz"],
-         "format"),
-        (["--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "2.5", "--plot",
-          "/no/such/dir/a.png"], "does not exist"),
+        (
+            ["--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "2.5", "--plot", "a.xyz"],
+            "format",
+        ),
+        (
+            [
+                "--law",
+                "hertz_rate",
+                "--param",
+                "c=2e6",
+                "b1=800",
+                "--v0",
+                "2.5",
+                "--plot",
+                "/no/such/dir/a.png",
+            ],
+            "does not exist",
+        ),
     ],
-)  # fmt: skip
+)
 def test_simulate_bad_input(capsys, argv, contains):
     assert_one_line_error(*run_cli(capsys, ["simulate", *argv]), contains=contains)
 
@@ -165,19 +209,33 @@ def test_simulate_bad_input(capsys, argv, contains):
 @pytest.mark.parametrize(
     "extra, contains",
     [
-        (["--mass", "10g"], "'10g': numbers are given without a unit, in the units --help gives "
-         "(SI: kg, m, s, N, Pa): 10g is 0.01 (kg)"),
+        (
+            ["--mass", "10g"],
+            "'10g': numbers are given without a unit, in the units --help gives "
+            "(SI: kg, m, s, N, Pa): 10g is 0.01 (kg)",
+        ),
         (["--mass", "250mg"], "250mg is 0.00025 (kg)"),
         (["--v0", "2.5m/s"], "give 2.5 if it is in that unit"),
         (["--mass", "10", "g"], "unrecognized arguments: g: numbers are given without a unit"),
         (["--param", "c=2MPa"], "'2MPa' is not a number: numbers are given without a unit"),
         (["--mass", "abc"], "invalid float value: 'abc' (see"),
     ],
-)  # fmt: skip
+)
 def test_a_number_with_a_unit_is_told_what_to_give(capsys, extra, contains):
     """Found by using the command as a new user: `--radius 5mm` or `--mass 10 g` said only
     `invalid float value` or `unrecognized arguments: g`."""
-    argv = ["simulate", "--mass", "1", "--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "2.5"]
+    argv = [
+        "simulate",
+        "--mass",
+        "1",
+        "--law",
+        "hertz_rate",
+        "--param",
+        "c=2e6",
+        "b1=800",
+        "--v0",
+        "2.5",
+    ]
     assert_one_line_error(*run_cli(capsys, [*argv, *extra]), contains=contains)
 
 

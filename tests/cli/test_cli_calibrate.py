@@ -140,7 +140,9 @@ def test_model_choice(capsys, monkeypatch, law14_csv):
         return compare_laws(laws=laws, **kwargs)
 
     monkeypatch.setattr(_model_choice, "compare_laws", failing_maxwell)
-    status, out, err = run_cli(capsys, ["calibrate", "--mass", "1", "--law", "all", "--data", str(law14_csv)])
+    status, out, err = run_cli(
+        capsys, ["calibrate", "--mass", "1", "--law", "all", "--data", str(law14_csv)]
+    )
     assert status == 0 and err == ""
     lines = out.splitlines()
     header = next(line.split() for line in lines if line.startswith("rank"))
@@ -170,7 +172,9 @@ def test_model_choice_warns_when_the_best_law_fits_badly(capsys, monkeypatch, la
     """Kelvin-Voigt alone on law 14's falling e: its optimiser converges, it is the best
     of one, and it fits badly (RMS of e_fit - e above 0.01, no sigmas): a warning line."""
     monkeypatch.setattr(_cli_calibrate, "MODEL_CHOICE_LAWS", ("kelvin_voigt",))
-    status, out, err = run_cli(capsys, ["calibrate", "--mass", "1", "--law", "all", "--data", str(law14_csv)])
+    status, out, err = run_cli(
+        capsys, ["calibrate", "--mass", "1", "--law", "all", "--data", str(law14_csv)]
+    )
     assert status == 0 and err == ""
     assert "best: kelvin_voigt" in out
     (line,) = [line for line in out.splitlines() if line.startswith("warning:")]
@@ -260,7 +264,15 @@ def test_model_choice_when_every_law_fails(capsys, monkeypatch, tmp_path):
         raise RuntimeError("boom")
 
     monkeypatch.setattr(_model_choice, "compare_laws", failing)
-    argv = ["calibrate", "--mass", "1", "--law", "all", "--data", _csv(tmp_path, "v0,e\n1,0.8\n2,0.7\n")]
+    argv = [
+        "calibrate",
+        "--mass",
+        "1",
+        "--law",
+        "all",
+        "--data",
+        _csv(tmp_path, "v0,e\n1,0.8\n2,0.7\n"),
+    ]
     assert_one_line_error(*run_cli(capsys, argv), contains="no law could be fitted: maxwell")
 
 

@@ -6,8 +6,22 @@ import json
 import pytest
 from helpers import assert_one_line_error, run_cli
 
-BASE = ["--mass", "2.618e-4", "--radius", "2.5e-3", "--law", "tsuji", "--param", "c=4.1968e9",
-        "b=15.134", "--tangential", "linear_history", "--tparam", "kt=1e6", "mu=0.1"]  # fmt: skip
+BASE = [
+    "--mass",
+    "2.618e-4",
+    "--radius",
+    "2.5e-3",
+    "--law",
+    "tsuji",
+    "--param",
+    "c=4.1968e9",
+    "b=15.134",
+    "--tangential",
+    "linear_history",
+    "--tparam",
+    "kt=1e6",
+    "mu=0.1",
+]
 
 
 @pytest.fixture(autouse=True)
@@ -50,8 +64,9 @@ def test_a_missing_file_and_a_plot_that_is_the_input(capsys, tmp_path):
     status, out, err = run_cli(capsys, ["fit-oblique", str(tmp_path / "none.csv"), *BASE])
     assert_one_line_error(status, out, err, contains="cannot read")
     data = _write(tmp_path, "theta_deg,e_t\n20,0.6\n")
-    status, out, err = run_cli(capsys, ["fit-oblique", data, *BASE, "--speed", "3.9",
-                                        "--plot", data])  # fmt: skip
+    status, out, err = run_cli(
+        capsys, ["fit-oblique", data, *BASE, "--speed", "3.9", "--plot", data]
+    )
     assert_one_line_error(status, out, err, contains="input")
 
 
@@ -138,9 +153,22 @@ def _track_csv(tmp_path, scale=1.0, columns=("t", "x", "y", "phi"), solved=False
     return _write(tmp_path, "\n".join(lines) + "\n", "track.csv")
 
 
-TRACK_BASE = ["--mass", "0.05", "--radius", "0.02", "--law", "hertz_rate", "--param",
-              "c=1.32e7", "b1=30", "--tangential", "linear_history", "--tparam", "kt=1e4",
-              "mu=0.2"]  # fmt: skip
+TRACK_BASE = [
+    "--mass",
+    "0.05",
+    "--radius",
+    "0.02",
+    "--law",
+    "hertz_rate",
+    "--param",
+    "c=1.32e7",
+    "b1=30",
+    "--tangential",
+    "linear_history",
+    "--tparam",
+    "kt=1e4",
+    "mu=0.2",
+]
 
 
 @pytest.mark.parametrize(
@@ -178,8 +206,18 @@ def test_fits_a_video_track(capsys, tmp_path):
 
 # ----------------------------------------------------- jaximpact simulate --tangential
 
-SIMULATE = ["simulate", "--law", "hunt_crossley", "--param", "c=4.2e9", "a=0", "--mass",
-            "2.618e-4", "--v0", "3.9"]  # fmt: skip
+SIMULATE = [
+    "simulate",
+    "--law",
+    "hunt_crossley",
+    "--param",
+    "c=4.2e9",
+    "a=0",
+    "--mass",
+    "2.618e-4",
+    "--v0",
+    "3.9",
+]
 MINDLIN = ["--tangential", "mindlin", "--tparam", "G_star=1.35e10", "mu=0.092"]
 
 
@@ -202,14 +240,28 @@ def test_the_command_line_s_tangential_names_are_the_library_s():
         ([*MINDLIN, "--radius", "-1", "--angle", "5"], "--radius must be"),
         ([*MINDLIN, "--radius", "2.5e-3", "--angle", "5", "--v0", "1", "2"], "one --v0"),
         ([*MINDLIN, "--radius", "2.5e-3", "--angle", "5", "--inertia", "0"], "--inertia"),
-        ([*MINDLIN, "--radius", "2.5e-3", "--angle", "5", "--max-segments", "0"],
-         "--max-segments must be at least 1"),
+        (
+            [*MINDLIN, "--radius", "2.5e-3", "--angle", "5", "--max-segments", "0"],
+            "--max-segments must be at least 1",
+        ),
         (["--max-segments", "40"], "--max-segments is for an oblique impact"),
         (["--tangential", "coulomb", "--radius", "2.5e-3", "--angle", "5"], "invalid choice"),
-        (["--tangential", "mindlin", "--tparam", "G_star=1e10", "mu=-0.1", "--radius",
-          "2.5e-3", "--angle", "5"], "mu must be"),
+        (
+            [
+                "--tangential",
+                "mindlin",
+                "--tparam",
+                "G_star=1e10",
+                "mu=-0.1",
+                "--radius",
+                "2.5e-3",
+                "--angle",
+                "5",
+            ],
+            "mu must be",
+        ),
     ],
-)  # fmt: skip
+)
 def test_simulate_oblique_bad_input_is_one_line(capsys, extra, message):
     status, out, err = run_cli(capsys, [*SIMULATE, *extra])
     assert_one_line_error(status, out, err, contains=message)
@@ -226,19 +278,33 @@ def test_simulate_an_oblique_impact_is_the_library_s(capsys, tmp_path):
     want = ji.oblique_impact(
         ji.law("hunt_crossley", c=4.2e9, a=0.0),
         ji.tangential_law("mindlin", G_star=1.35e10, mu=0.092),
-        m=2.618e-4, R=2.5e-3, v_n=3.9 * math.cos(math.radians(20)),
+        m=2.618e-4,
+        R=2.5e-3,
+        v_n=3.9 * math.cos(math.radians(20)),
         v_t=3.9 * math.sin(math.radians(20)),
-    )  # fmt: skip
-    status, out, err = run_cli(capsys, [*SIMULATE, *MINDLIN, "--radius", "2.5e-3", "--angle",
-                                        "20"])  # fmt: skip
+    )
+    status, out, err = run_cli(capsys, [*SIMULATE, *MINDLIN, "--radius", "2.5e-3", "--angle", "20"])
     assert status == 0 and err == ""
     assert "angle             = 20 deg" in out and "status            = separated" in out
     assert f"e_t               = {float(want.e_t):.4g}" in out
     assert f"{math.degrees(float(want.angle_out)):.4g} deg" in out
     assert "e_t_contact = u_out / u (the contact point's slip" in out  # the fields explained
     plot = tmp_path / "sweep.png"
-    status, out, err = run_cli(capsys, [*SIMULATE, *MINDLIN, "--radius", "2.5e-3", "--angle",
-                                        "5", "20", "--json", "--plot", str(plot)])  # fmt: skip
+    status, out, err = run_cli(
+        capsys,
+        [
+            *SIMULATE,
+            *MINDLIN,
+            "--radius",
+            "2.5e-3",
+            "--angle",
+            "5",
+            "20",
+            "--json",
+            "--plot",
+            str(plot),
+        ],
+    )
     runs = json.loads(out)
     assert status == 0 and [r["angle_deg"] for r in runs] == [5.0, 20.0]
     assert runs[1]["e_t"] == pytest.approx(float(want.e_t), rel=1e-12)
@@ -253,9 +319,27 @@ def test_simulate_says_which_angles_ran_out_of_segments(capsys):
     from a wrong unit) switches between stick and slip 16 times: with the default 16
     segments the solve ends out_of_steps. The command prints the status and what to raise,
     exits 1 (it said `internal error, RuntimeError` before), and --max-segments 64 ends it."""
-    argv = ["simulate", "--law", "hertz_rate", "--param", "c=1e9", "b1=0", "--mass", "0.01",
-            "--v0", "1", "--tangential", "mindlin", "--tparam", "G_star=1e10", "mu=0.3",
-            "--radius", "5", "--angle", "30"]  # fmt: skip
+    argv = [
+        "simulate",
+        "--law",
+        "hertz_rate",
+        "--param",
+        "c=1e9",
+        "b1=0",
+        "--mass",
+        "0.01",
+        "--v0",
+        "1",
+        "--tangential",
+        "mindlin",
+        "--tparam",
+        "G_star=1e10",
+        "mu=0.3",
+        "--radius",
+        "5",
+        "--angle",
+        "30",
+    ]
     status, out, err = run_cli(capsys, argv)
     assert status == 1 and "internal error" not in err
     assert "status            = out_of_steps" in out
@@ -280,9 +364,27 @@ def test_a_sphere_of_implausible_density_is_warned(capsys, m, R, warned):
     """A wrong unit in --mass or --radius (found by using the commands as a new user: a
     radius of 2.5 "m" for a 5 mm ball gave a plausible-looking table) is said in one
     warning line before any work; here the tangential law's refusal follows it."""
-    argv = ["simulate", "--law", "hunt_crossley", "--param", "c=4.2e9", "a=0", "--mass",
-            str(m), "--v0", "3.9", "--tangential", "mindlin", "--tparam", "G_star=1.35e10",
-            "mu=-0.1", "--radius", str(R), "--angle", "30"]  # fmt: skip
+    argv = [
+        "simulate",
+        "--law",
+        "hunt_crossley",
+        "--param",
+        "c=4.2e9",
+        "a=0",
+        "--mass",
+        str(m),
+        "--v0",
+        "3.9",
+        "--tangential",
+        "mindlin",
+        "--tparam",
+        "G_star=1.35e10",
+        "mu=-0.1",
+        "--radius",
+        str(R),
+        "--angle",
+        "30",
+    ]
     status, out, err = run_cli(capsys, argv)
     lines = err.strip().splitlines()
     assert status == 2 and out == "" and "mu must be" in lines[-1]
@@ -303,9 +405,16 @@ def test_a_spin_of_a_wrong_unit_is_warned_before_any_work():
 
     def args(omega):
         return argparse.Namespace(
-            tangential="mindlin", radius=2.5e-3, angle=[30.0], v0=[3.9], omega=omega,
-            inertia=0.4, max_segments=16, tparam=[], mass=2.6e-4,
-        )  # fmt: skip
+            tangential="mindlin",
+            radius=2.5e-3,
+            angle=[30.0],
+            v0=[3.9],
+            omega=omega,
+            inertia=0.4,
+            max_segments=16,
+            tparam=[],
+            mass=2.6e-4,
+        )
 
     with pytest.warns(UserWarning, match=r"--omega 1e\+09 rad/s turns the sphere's surface"):
         check_oblique_arguments(args(1e9))

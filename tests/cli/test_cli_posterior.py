@@ -62,21 +62,34 @@ def _posterior_file(tmp_path, samples=True):
     writes it (by hand: the draws are c and b1 about LAW14)."""
     draws = {"c": [1.9e6, 2.0e6, 2.1e6], "b1": [760.0, 800.0, 850.0]}
     posterior = {
-        "method": "laplace", "law": "hertz_rate", "names": ["c", "b1"], "free": ["c", "b1"],
+        "method": "laplace",
+        "law": "hertz_rate",
+        "names": ["c", "b1"],
+        "free": ["c", "b1"],
         "units": {"c": "N/m^1.5", "b1": "N s/m^1.5"},
         "priors": {"c": ["loguniform", 1e5, 1e8], "b1": ["loguniform", 10.0, 1e5]},
-        "median": {"c": 2.0e6, "b1": 800.0}, "map": {"c": 2.0e6, "b1": 800.0},
+        "median": {"c": 2.0e6, "b1": 800.0},
+        "map": {"c": 2.0e6, "b1": 800.0},
         "diagnostics": {"r_hat": None, "ess": 3.0, "divergences": 0},
-        "log_evidence": 1.0, "noise": "normal", "nu": 4.0,
+        "log_evidence": 1.0,
+        "noise": "normal",
+        "nu": 4.0,
         "law_parameters": {"c": 1.5e6, "b1": 500.0},
-    }  # fmt: skip
+    }
     if samples:
         posterior["samples"] = draws
         posterior["z"] = [[0.0, 0.0]] * 3
         posterior["thinned"] = {"draws": 3, "of": 8000}
-    record = {"law": "hertz_rate", "params": {"c": 1.5e6, "b1": 500.0}, "free": ["c", "b1"],
-              "m": 1.0, "rows": [{"v0": 2.0}], "separation": "force", "g": 0.0,
-              "posterior": posterior}  # fmt: skip
+    record = {
+        "law": "hertz_rate",
+        "params": {"c": 1.5e6, "b1": 500.0},
+        "free": ["c", "b1"],
+        "m": 1.0,
+        "rows": [{"v0": 2.0}],
+        "separation": "force",
+        "g": 0.0,
+        "posterior": posterior,
+    }
     path = tmp_path / "post.json"
     path.write_text(json.dumps(record))
     return path, draws
@@ -95,8 +108,16 @@ def test_export_from_a_posterior_gives_the_band(capsys, tmp_path):
     assert data["e"] == pytest.approx(median.e, rel=1e-12)
     es, Ts = [], []
     for c, b1 in zip(draws["c"], draws["b1"], strict=True):
-        one = ji.export(ji.law("hertz_rate", c=c, b1=b1), "lammps", m=1.0, v0=2.0, radius=0.02,
-                        timestep=median.timestep, curves=False, strict=False)  # fmt: skip
+        one = ji.export(
+            ji.law("hertz_rate", c=c, b1=b1),
+            "lammps",
+            m=1.0,
+            v0=2.0,
+            radius=0.02,
+            timestep=median.timestep,
+            curves=False,
+            strict=False,
+        )
         es.append(one.e)
         Ts.append(one.T)
     assert data["e_band"] == pytest.approx(list(np.quantile(es, [0.05, 0.95])), rel=1e-12)
@@ -114,8 +135,9 @@ def test_export_from_a_posterior_without_draws_says_so(capsys, tmp_path):
     assert status == 0, err
     assert "warning: no engine band: the posterior in the file holds no draws" in out
     assert "band     e" not in out
-    assert_one_line_error(*run_cli(capsys, argv + ["--band-draws", "0"]),
-                          contains="--band-draws must be at least 1")  # fmt: skip
+    assert_one_line_error(
+        *run_cli(capsys, argv + ["--band-draws", "0"]), contains="--band-draws must be at least 1"
+    )
 
 
 @pytest.mark.slow
@@ -141,8 +163,19 @@ def test_calibrate_posterior_then_export(capsys, drops, tmp_path):
     assert math.isfinite(post["log_evidence"])
     path = tmp_path / "post.json"
     path.write_text(out)
-    argv = ["export", "lammps", "--from", str(path), "--v0", "2", "--radius", "0.02",
-            "--band-draws", "20", "--json"]  # fmt: skip
+    argv = [
+        "export",
+        "lammps",
+        "--from",
+        str(path),
+        "--v0",
+        "2",
+        "--radius",
+        "0.02",
+        "--band-draws",
+        "20",
+        "--json",
+    ]
     status, out, err = run_cli(capsys, argv)
     assert status == 0, err
     x = json.loads(out)

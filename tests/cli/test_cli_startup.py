@@ -12,8 +12,18 @@ from pathlib import Path
 
 import pytest
 
-SIMULATE = ["simulate", "--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "2.5",
-            "--mass", "1"]  # fmt: skip
+SIMULATE = [
+    "simulate",
+    "--law",
+    "hertz_rate",
+    "--param",
+    "c=2e6",
+    "b1=800",
+    "--v0",
+    "2.5",
+    "--mass",
+    "1",
+]
 
 
 def _script() -> str:
@@ -27,11 +37,15 @@ def _script() -> str:
 def _interrupted(command, after: float, tmp_path) -> subprocess.CompletedProcess:
     """`command` sent SIGINT `after` seconds after its start (its compilation cache empty,
     a figure to draw: seconds of work behind the imports)."""
-    env = {**os.environ, "JAXIMPACT_CACHE_DIR": str(tmp_path / "cache"),
-           "JAXIMPACT_PROGRESS": "off"}  # fmt: skip
+    env = {
+        **os.environ,
+        "JAXIMPACT_CACHE_DIR": str(tmp_path / "cache"),
+        "JAXIMPACT_PROGRESS": "off",
+    }
     argv = [*command, *SIMULATE, "--plot", str(tmp_path / "impact.png")]
-    child = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                             env=env)  # fmt: skip
+    child = subprocess.Popen(
+        argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
+    )
     time.sleep(after)
     assert child.poll() is None, "the command ended before the signal: make it longer"
     child.send_signal(signal.SIGINT)
@@ -79,8 +93,9 @@ def test_ctrl_c_while_a_module_loads_is_one_line(tmp_path, module):
     import) or JAX (`configure_jax`) starts to load."""
     code = f"MODULE = {module!r}\nARGV = {[*SIMULATE, '--plot', str(tmp_path / 'i.png')]!r}\n"
     env = {**os.environ, "JAXIMPACT_CACHE_DIR": str(tmp_path / "cache")}
-    done = subprocess.run([sys.executable, "-c", code + TRIP], capture_output=True, text=True,
-                          timeout=120, env=env)  # fmt: skip
+    done = subprocess.run(
+        [sys.executable, "-c", code + TRIP], capture_output=True, text=True, timeout=120, env=env
+    )
     assert done.returncode == 130, done.stderr
     assert done.stdout == "" and "Traceback" not in done.stderr
     assert done.stderr.splitlines() == ["jaximpact: error: interrupted by SIGINT"]
@@ -90,8 +105,9 @@ def test_ctrl_c_while_a_module_loads_is_one_line(tmp_path, module):
 def test_a_closed_stdout_is_an_error(how):
     command = [_script()] if how == "console script" else [sys.executable, "-m", "jaximpact._cli"]
     closed = ["sh", "-c", 'exec "$@" >&-', "sh"]  # stdout closed, not /dev/null
-    done = subprocess.run([*closed, *command, *SIMULATE], stderr=subprocess.PIPE, text=True,
-                          timeout=120)  # fmt: skip
+    done = subprocess.run(
+        [*closed, *command, *SIMULATE], stderr=subprocess.PIPE, text=True, timeout=120
+    )
     assert done.returncode == 2
     assert done.stderr.splitlines() == [
         "jaximpact: error: cannot write the output: stdout is closed"

@@ -50,8 +50,9 @@ def law_file(tmp_path_factory):
 
 def test_simulate_runs_a_users_law_and_names_it(capsys, law_file):
     _, law = law_file
-    status, out, err = run_cli(capsys, ["simulate", "--mass", "1", "--law", law, *PARAMS, "--v0", "2.5",
-                                        "--json"])  # fmt: skip
+    status, out, err = run_cli(
+        capsys, ["simulate", "--mass", "1", "--law", law, *PARAMS, "--v0", "2.5", "--json"]
+    )
     assert status == 0, err
     data = json.loads(out)
     assert data["law"] == law and data["params"] == {"c": 2e6, "b1": 800.0}
@@ -59,7 +60,9 @@ def test_simulate_runs_a_users_law_and_names_it(capsys, law_file):
     want = ji.impact(ji.law("hertz_rate", c=2e6, b1=800.0), m=1.0, v0=2.5)
     for key in ("e", "T", "x_max", "F_max"):
         assert_rel(data[key], getattr(want, key), 1e-9, key)
-    status, out, err = run_cli(capsys, ["simulate", "--mass", "1", "--law", law, *PARAMS, "--v0", "2.5"])
+    status, out, err = run_cli(
+        capsys, ["simulate", "--mass", "1", "--law", law, *PARAMS, "--v0", "2.5"]
+    )
     assert status == 0, err
     assert out.splitlines()[0] == f"law        {law}"
 
@@ -70,8 +73,18 @@ def test_batch_runs_a_users_law_with_parameters_from_the_columns(capsys, law_fil
     (tmp_path / "in.csv").write_text(
         "c,m,v0\n" + "".join(f"{a},{b},{d}\n" for a, b, d in zip(c, m, v0, strict=True))
     )
-    argv = ["batch", str(tmp_path / "in.csv"), "--law", law, "--param", "b1=800",
-            "--out", str(tmp_path / "out.csv"), "--chunk-rows", "3"]  # fmt: skip
+    argv = [
+        "batch",
+        str(tmp_path / "in.csv"),
+        "--law",
+        law,
+        "--param",
+        "b1=800",
+        "--out",
+        str(tmp_path / "out.csv"),
+        "--chunk-rows",
+        "3",
+    ]
     status, out, err = run_cli(capsys, argv)
     assert status == 0, err
     assert "6 impacts written" in out and "2 chunks computed" in out
@@ -91,23 +104,39 @@ def test_batch_runs_a_users_law_with_parameters_from_the_columns(capsys, law_fil
 @pytest.mark.parametrize(
     "law, params, message",
     [
-        ("{file}:hertz_rate", ["c=2e6"], '{file}:hertz_rate reads params["b1"]: give it with '
-         "--param b1=..."),  # fmt: skip
+        (
+            "{file}:hertz_rate",
+            ["c=2e6"],
+            '{file}:hertz_rate reads params["b1"]: give it with --param b1=...',
+        ),
         ("{file}:hertz_rate", [], 'reads params["c"]: give it with --param c=...'),
-        ("{file}:hertz_rate", ["c=2e6", "b1=800", "k=1"], '--param k: {file}:hertz_rate does '
-         'not read params["k"] (it reads c, b1)'),  # fmt: skip
+        (
+            "{file}:hertz_rate",
+            ["c=2e6", "b1=800", "k=1"],
+            '--param k: {file}:hertz_rate does not read params["k"] (it reads c, b1)',
+        ),
         ("{dir}/none.py:f", ["c=1"], "no such file {dir}/none.py"),
         ("{dir}/law.txt:f", ["c=1"], "{dir}/law.txt is not a .py file"),
         ("{file}", ["c=1"], "--law {file}: a user's law is FILE.py:NAME"),
         ("{file}:", ["c=1"], "a user's law is FILE.py:NAME"),
-        ("{file}:hertz", ["c=1"], "has no 'hertz' (did you mean hertz_rate?); its callables: "
-         "hertz_rate, Kelvin"),  # fmt: skip
+        (
+            "{file}:hertz",
+            ["c=1"],
+            "has no 'hertz' (did you mean hertz_rate?); its callables: hertz_rate, Kelvin",
+        ),
         ("{file}:STIFFNESS", ["c=1"], "STIFFNESS in {file} is a float, not a function"),
-        ("{dir}/raises.py:f", ["c=1"], "importing {dir}/raises.py raised ZeroDivisionError at "
-         "line 3: division by zero"),  # fmt: skip
+        (
+            "{dir}/raises.py:f",
+            ["c=1"],
+            "importing {dir}/raises.py raised ZeroDivisionError at line 3: division by zero",
+        ),
         ("{dir}/syntax.py:f", ["c=1"], "importing {dir}/syntax.py raised SyntaxError at line 2"),
-        ("{dir}/broken.py:f", ["c=1"], "{dir}/broken.py:f failed when called as NAME(x, v, "
-         "params) with numbers (NameError at line 2: name 'undefined' is not defined)"),
+        (
+            "{dir}/broken.py:f",
+            ["c=1"],
+            "{dir}/broken.py:f failed when called as NAME(x, v, "
+            "params) with numbers (NameError at line 2: name 'undefined' is not defined)",
+        ),
     ],
 )
 def test_a_bad_law_file_is_one_line(capsys, law_file, law, params, message):
@@ -118,16 +147,26 @@ def test_a_bad_law_file_is_one_line(capsys, law_file, law, params, message):
     (folder / "broken.py").write_text("def f(x, v, p):\n    return undefined * x\n")
     (folder / "law.txt").write_text("")
     fill = {"file": str(path), "dir": str(folder)}
-    argv = ["simulate", "--mass", "1", "--law", law.format(**fill), *(["--param", *params] if params else []),
-            "--v0", "1"]  # fmt: skip
+    argv = [
+        "simulate",
+        "--mass",
+        "1",
+        "--law",
+        law.format(**fill),
+        *(["--param", *params] if params else []),
+        "--v0",
+        "1",
+    ]
     assert_one_line_error(*run_cli(capsys, argv), contains=message.format(**fill))
 
 
 def test_commands_that_need_the_law_table_refuse_a_users_law(capsys, law_file):
     _, law = law_file
     assert_one_line_error(*run_cli(capsys, ["laws", law]), contains=f"{law} is a user's law")
-    result = run_cli(capsys, ["calibrate", "--mass", "1", "--law", law, "--param", "c=2e6", "--v0", "2",
-                              "--e", "0.8"])  # fmt: skip
+    result = run_cli(
+        capsys,
+        ["calibrate", "--mass", "1", "--law", law, "--param", "c=2e6", "--v0", "2", "--e", "0.8"],
+    )
     assert_one_line_error(*result, contains='reads params["b1"]: give it with --param b1=...')
 
 
@@ -135,19 +174,50 @@ def test_commands_that_need_the_law_table_refuse_a_users_law(capsys, law_file):
 def test_calibrate_fits_a_users_law(capsys, law_file):
     _, law = law_file
     truth = ji.impact(ji.law("hertz_rate", c=2e6, b1=800.0), m=1.0, v0=2.5)
-    status, out, err = run_cli(capsys, [
-        "calibrate", "--mass", "1", "--law", law, "--param", "c=1.5e6", "b1=500", "--v0", "2.5",
-        "--e", repr(float(truth.e)), "--T", repr(float(truth.T)), "--json",
-    ])  # fmt: skip
+    status, out, err = run_cli(
+        capsys,
+        [
+            "calibrate",
+            "--mass",
+            "1",
+            "--law",
+            law,
+            "--param",
+            "c=1.5e6",
+            "b1=500",
+            "--v0",
+            "2.5",
+            "--e",
+            repr(float(truth.e)),
+            "--T",
+            repr(float(truth.T)),
+            "--json",
+        ],
+    )
     assert status == 0, err
     data = json.loads(out)
     assert data["law"] == law and data["free"] == ["c", "b1"] and data["converged"]
     assert data["params"]["c"] == pytest.approx(2e6, rel=1e-6)
     assert data["params"]["b1"] == pytest.approx(800.0, rel=1e-6)
-    status, out, err = run_cli(capsys, [
-        "calibrate", "--mass", "1", "--law", law, "--param", "c=1.5e6", "b1=500", "--v0", "2.5",
-        "--e", repr(float(truth.e)), "--T", repr(float(truth.T)),
-    ])  # fmt: skip
+    status, out, err = run_cli(
+        capsys,
+        [
+            "calibrate",
+            "--mass",
+            "1",
+            "--law",
+            law,
+            "--param",
+            "c=1.5e6",
+            "b1=500",
+            "--v0",
+            "2.5",
+            "--e",
+            repr(float(truth.e)),
+            "--T",
+            repr(float(truth.T)),
+        ],
+    )
     assert status == 0, err
     assert f"law        {law}\n" in out
 
@@ -156,8 +226,9 @@ def test_calibrate_fits_a_users_law(capsys, law_file):
 def test_export_takes_a_users_law(capsys, law_file):
     _, law = law_file
     truth = ji.impact(ji.law("hertz_rate", c=2e6, b1=800.0), m=1.0, v0=2.5)
-    status, out, err = run_cli(capsys, ["export", "mujoco", "--law", law, *PARAMS,
-                                        "--mass", "1", "--v0", "2.5", "--json"])  # fmt: skip
+    status, out, err = run_cli(
+        capsys, ["export", "mujoco", "--law", law, *PARAMS, "--mass", "1", "--v0", "2.5", "--json"]
+    )
     assert status == 0, err
     data = json.loads(out)
     assert data["target_e"] == pytest.approx(float(truth.e), rel=1e-9)
@@ -167,15 +238,28 @@ def test_export_takes_a_users_law(capsys, law_file):
 @pytest.mark.slow  # compiles its own bounce fit
 def test_fit_takes_a_users_law(capsys, law_file, tmp_path):
     _, law = law_file
-    b = ji.bounce(ji.law("hertz_rate", c=5.5e7, b1=700.0), m=0.0415, h0=0.9, t_end=3.0,
-                  max_impacts=8)  # fmt: skip
+    b = ji.bounce(
+        ji.law("hertz_rate", c=5.5e7, b1=700.0), m=0.0415, h0=0.9, t_end=3.0, max_impacts=8
+    )
     times = np.asarray(b.impact_times)
     (tmp_path / "times.csv").write_text(
         "impact_time\n" + "".join(f"{float(t)!r}\n" for t in times[np.isfinite(times)])
     )
-    status, out, err = run_cli(capsys, ["fit", str(tmp_path / "times.csv"), "--law", law,
-                                        "--param", "c=5.5e7", "b1=100", "--mass", "0.0415",
-                                        "--json"])  # fmt: skip
+    status, out, err = run_cli(
+        capsys,
+        [
+            "fit",
+            str(tmp_path / "times.csv"),
+            "--law",
+            law,
+            "--param",
+            "c=5.5e7",
+            "b1=100",
+            "--mass",
+            "0.0415",
+            "--json",
+        ],
+    )
     assert status == 0, err
     fit = json.loads(out)["fits"]["all"]
     assert fit["law"] == law and fit["params"]["b1"] == pytest.approx(700.0, rel=1e-3)

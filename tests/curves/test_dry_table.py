@@ -43,9 +43,12 @@ def scipy_bingham_modified(beta, pi, separation):
         return y[1] + beta * y[1] ** 2 + beta * y[0] * a
 
     one = solve_ivp(
-        compress, (0, 1e3), [0.0, 1.0],
-        events=[event(lambda t, y: y[1], -1), event(force_rate, -1, terminal=False)], **kw,
-    )  # fmt: skip
+        compress,
+        (0, 1e3),
+        [0.0, 1.0],
+        events=[event(lambda t, y: y[1], -1), event(force_rate, -1, terminal=False)],
+        **kw,
+    )
     t_max, x_max = one.t_events[0][0], one.y_events[0][0][0]
     peaks = [pi, x_max + pi] + [y[0] + beta * y[0] * y[1] + pi for y in one.y_events[1]]
     f_max = max(peaks)
@@ -73,8 +76,15 @@ def _law(beta, pi):
 @functools.cache
 def _batched(separation, method="auto", rtol=1e-11):
     def one(beta, pi):
-        r = ji.impact(_law(beta, pi), m=1.0, v0=1.0, separation=separation, method=method,
-                      rtol=rtol, throw=False)  # fmt: skip
+        r = ji.impact(
+            _law(beta, pi),
+            m=1.0,
+            v0=1.0,
+            separation=separation,
+            method=method,
+            rtol=rtol,
+            throw=False,
+        )
         return {k: getattr(r, k) for k in (*OUTPUTS, "status", "num_steps")}
 
     return jax.jit(jax.vmap(one))

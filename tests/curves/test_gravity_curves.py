@@ -41,9 +41,15 @@ def _law(name, beta):
 def _batched(name, separation, method="auto", rtol=1e-11):
     def one(beta, gamma):
         r = ji.impact(
-            _law(name, beta), m=1.0, v0=1.0, g=gamma, separation=separation, method=method,
-            rtol=rtol, throw=False,
-        )  # fmt: skip
+            _law(name, beta),
+            m=1.0,
+            v0=1.0,
+            g=gamma,
+            separation=separation,
+            method=method,
+            rtol=rtol,
+            throw=False,
+        )
         return {k: getattr(r, k) for k in (*OUTPUTS, "status", "num_steps")}
 
     return jax.jit(jax.vmap(one))

@@ -369,7 +369,7 @@ def test_hunt_crossley_built_inside_jit_still_takes_the_curves():
         {"max_steps": 0},
         {"max_steps": 1.5},
         {"tau_max": 0.0},
-    ],  # fmt: skip
+    ],
 )
 def test_options_outside_their_range_are_refused(option):
     with pytest.raises(ValueError, match=next(iter(option))):

@@ -90,8 +90,9 @@ def run_mujoco(
     return np.array(es), np.array(Ts)
 
 
-def run_mujoco_oblique(parameters, *, radius: float, v_n: float, v_t: float, phases=(0.5,),
-                       m: float = 0.05):  # fmt: skip
+def run_mujoco_oblique(
+    parameters, *, radius: float, v_n: float, v_t: float, phases=(0.5,), m: float = 0.05
+):
     """Run MuJoCo on an export with friction (`parameters` with `friction`, `condim`, `cone`,
     `impratio`): a free sphere of mass `m` (kg) and radius `radius` (m) meeting the plane at
     `v_n`, `v_t` (m/s), no spin, gravity off, first touch `phase * timestep` after a step's
@@ -245,9 +246,12 @@ def run_drake_oblique(parameters, *, m, radius, v_n, v_t, accuracy=1e-10):
     )
     plant.RegisterCollisionGeometry(body, RigidTransform(), Sphere(radius), "ball", props)
     plant.RegisterCollisionGeometry(
-        plant.world_body(), HalfSpace.MakePose([0, 0, 1], [0, 0, 0]), HalfSpace(), "ground",
+        plant.world_body(),
+        HalfSpace.MakePose([0, 0, 1], [0, 0, 0]),
+        HalfSpace(),
+        "ground",
         props,
-    )  # fmt: skip
+    )
     plant.mutable_gravity_field().set_gravity_vector([0, 0, 0])
     plant.Finalize()
     simulator = Simulator(builder.Build())
@@ -414,8 +418,11 @@ def _liggghts_rows(script, executable, m, *, mass_column):
             handle.write(script)
         run = subprocess.run(
             [executable, "-in", "in.run", "-log", "none", "-screen", "none"],
-            cwd=folder, capture_output=True, text=True, timeout=600,
-        )  # fmt: skip
+            cwd=folder,
+            capture_output=True,
+            text=True,
+            timeout=600,
+        )
         path = os.path.join(folder, "out.txt")
         if not os.path.exists(path):
             raise RuntimeError(f"LIGGGHTS gave no output: {run.stdout[-400:]}{run.stderr}")
@@ -581,8 +588,16 @@ def run_yade(parameters, *, m, v0, radius, phases=(0.5,), damping=0.0, executabl
     rho = m / (4.0 / 3.0 * math.pi * radius**3)
     es, Ts = [], []
     for phase in map(float, phases):
-        args = (parameters["tc"], parameters["en"], rho, radius, v0, parameters["timestep"],
-                phase, damping)  # fmt: skip
+        args = (
+            parameters["tc"],
+            parameters["en"],
+            rho,
+            radius,
+            v0,
+            parameters["timestep"],
+            phase,
+            damping,
+        )
         with tempfile.TemporaryDirectory() as folder:
             path = os.path.join(folder, "impact.py")
             with open(path, "w") as handle:

@@ -118,7 +118,7 @@ from jaximpact._cli import main
                 "0.01",
             ],
             r"exp\(-2\)",
-        ),  # fmt: skip
+        ),
     ],
 )
 def test_cli_bad_input_is_one_line_with_status_2(argv, match, capsys):
@@ -179,13 +179,41 @@ def test_cli_export_json_and_engine_e_round_trip(capsys):
 def test_cli_yade_export_and_engine_e_round_trip(capsys):
     """export --engine yade, then engine-e on its tc, en and timestep: the stepped e is the
     export's promise, and the continuous law's e is the target."""
-    main(["export", "--engine", "yade", "--e", "0.5", "--T", "1e-3", "--mass", "0.01",
-          "--v0", "1", "--radius", "0.01", "--json"])  # fmt: skip
+    main(
+        [
+            "export",
+            "--engine",
+            "yade",
+            "--e",
+            "0.5",
+            "--T",
+            "1e-3",
+            "--mass",
+            "0.01",
+            "--v0",
+            "1",
+            "--radius",
+            "0.01",
+            "--json",
+        ]
+    )
     out = json.loads(capsys.readouterr().out)
     p = out["parameters"]
     params = json.dumps({"tc": p["tc"], "en": p["en"], "timestep": p["timestep"]})
-    main(["engine-e", "--engine", "yade", "--params", params, "--mass", "0.01", "--speed", "1",
-          "--json"])  # fmt: skip
+    main(
+        [
+            "engine-e",
+            "--engine",
+            "yade",
+            "--params",
+            params,
+            "--mass",
+            "0.01",
+            "--speed",
+            "1",
+            "--json",
+        ]
+    )
     back = json.loads(capsys.readouterr().out)
     assert back["e"][0] == pytest.approx(0.5, rel=1e-6)
     assert back["stepped"]["e"][0] == pytest.approx(out["e"], rel=1e-9)
@@ -193,8 +221,21 @@ def test_cli_yade_export_and_engine_e_round_trip(capsys):
 
 def test_cli_export_wall(capsys):
     """--wall exports the sphere on a wall; without it, the pair (unchanged)."""
-    argv = ["export", "lammps", "--e", "0.5", "--T", "5e-4", "--mass", "0.004", "--v0", "1",
-            "--radius", "0.005", "--json"]  # fmt: skip
+    argv = [
+        "export",
+        "lammps",
+        "--e",
+        "0.5",
+        "--T",
+        "5e-4",
+        "--mass",
+        "0.004",
+        "--v0",
+        "1",
+        "--radius",
+        "0.005",
+        "--json",
+    ]
     main([*argv, "--wall"])
     wall = json.loads(capsys.readouterr().out)
     assert wall["parameters"]["geometry"] == "wall" and "fix wall all wall/gran" in wall["snippet"]
@@ -202,29 +243,68 @@ def test_cli_export_wall(capsys):
     pair = json.loads(capsys.readouterr().out)
     assert "geometry" not in pair["parameters"] and "wall/gran" not in pair["snippet"]
     with pytest.raises(SystemExit):
-        main(["export", "lammps", "--e", "0.5", "--T", "5e-4", "--mass", "0.004", "--v0", "1",
-              "--wall"])  # fmt: skip
+        main(
+            [
+                "export",
+                "lammps",
+                "--e",
+                "0.5",
+                "--T",
+                "5e-4",
+                "--mass",
+                "0.004",
+                "--v0",
+                "1",
+                "--wall",
+            ]
+        )
     assert "radius (m) of the sphere" in capsys.readouterr().err
 
 
-TANGENTIAL_ARGV = ["--law", "tsuji", "--param", "c=4.2e9", "b=15", "--mass", "2.618e-4",
-                   "--v0", "3.9"]  # fmt: skip
+TANGENTIAL_ARGV = [
+    "--law",
+    "tsuji",
+    "--param",
+    "c=4.2e9",
+    "b=15",
+    "--mass",
+    "2.618e-4",
+    "--v0",
+    "3.9",
+]
 
 
 @pytest.mark.parametrize(
     "extra, message",
     [
-        (["chrono", "--radius", "2.5e-3", "--tangential", "mindlin", "--tparam",
-          "G_star=1e10", "mu=0.1"], "Chrono has no tangential export yet"),
-        (["drake", "--tangential", "mindlin", "--tparam", "G_star=1e10", "mu=0.1"],
-         "needs the sphere's radius"),
-        (["mujoco", "--tangential", "mindlin", "--tparam", "G_star=1e10", "mu=0.1"],
-         "needs the sphere's radius"),
+        (
+            [
+                "chrono",
+                "--radius",
+                "2.5e-3",
+                "--tangential",
+                "mindlin",
+                "--tparam",
+                "G_star=1e10",
+                "mu=0.1",
+            ],
+            "Chrono has no tangential export yet",
+        ),
+        (
+            ["drake", "--tangential", "mindlin", "--tparam", "G_star=1e10", "mu=0.1"],
+            "needs the sphere's radius",
+        ),
+        (
+            ["mujoco", "--tangential", "mindlin", "--tparam", "G_star=1e10", "mu=0.1"],
+            "needs the sphere's radius",
+        ),
         (["lammps", "--radius", "2.5e-3", "--tparam", "mu=0.1"], "--tparam needs --tangential"),
-        (["lammps", "--radius", "2.5e-3", "--tangential", "mindlin", "--tparam", "mu"],
-         "--tparam 'mu' must be NAME=VALUE"),
+        (
+            ["lammps", "--radius", "2.5e-3", "--tangential", "mindlin", "--tparam", "mu"],
+            "--tparam 'mu' must be NAME=VALUE",
+        ),
     ],
-)  # fmt: skip
+)
 def test_cli_export_tangential_bad_input(capsys, extra, message):
     with pytest.raises(SystemExit) as stop:
         main(["export", *extra, *TANGENTIAL_ARGV])
@@ -239,8 +319,19 @@ def test_cli_export_tangential_to_lammps(capsys):
     as text and as JSON (the Python export's numbers)."""
     import jaximpact as ji
 
-    argv = ["export", "lammps", *TANGENTIAL_ARGV, "--radius", "2.5e-3", "--wall",
-            "--tangential", "mindlin", "--tparam", "G_star=1.35e10", "mu=0.092"]  # fmt: skip
+    argv = [
+        "export",
+        "lammps",
+        *TANGENTIAL_ARGV,
+        "--radius",
+        "2.5e-3",
+        "--wall",
+        "--tangential",
+        "mindlin",
+        "--tparam",
+        "G_star=1.35e10",
+        "mu=0.092",
+    ]
     assert main(argv) == 0
     out = capsys.readouterr().out
     assert "tangential mindlin 1.35e+11 0 0.092" not in out  # k is 8 G*, not G*
@@ -248,8 +339,16 @@ def test_cli_export_tangential_to_lammps(capsys):
     assert main([*argv, "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     tl = ji.tangential_law("mindlin", G_star=1.35e10, mu=0.092)
-    x = ji.export(ji.law("tsuji", c=4.2e9, b=15.0), "lammps", m=2.618e-4, v0=3.9,
-                  radius=2.5e-3, geometry="wall", tangential=tl, curves=False)  # fmt: skip
+    x = ji.export(
+        ji.law("tsuji", c=4.2e9, b=15.0),
+        "lammps",
+        m=2.618e-4,
+        v0=3.9,
+        radius=2.5e-3,
+        geometry="wall",
+        tangential=tl,
+        curves=False,
+    )
     assert data["e_t_engine"] == pytest.approx(list(x.e_t_engine), rel=1e-12)
     # every parameter of the law, the Mindlin damper beta at its default 0 included
     parameters = {"G_star": 1.35e10, "mu": 0.092, "beta": 0.0}

@@ -30,9 +30,11 @@ def test_drake_realises_the_exports_promise(exported, angle):
     k = exported.angles.index(angle)
     v_n, v_t = V0 * math.cos(math.radians(angle)), V0 * math.sin(math.radians(angle))
     e, e_t, omega = run_drake_oblique(exported.parameters, m=M, radius=R, v_n=v_n, v_t=v_t)
-    print(f"{angle:4.0f} deg: Drake e {e:.9f} e_t {e_t:.9f} omega {omega:.6f} | promise "
-          f"{exported.e_n_engine[k]:.9f} {exported.e_t_engine[k]:.9f} "
-          f"{exported.omega_engine[k]:.6f}")  # fmt: skip
+    print(
+        f"{angle:4.0f} deg: Drake e {e:.9f} e_t {e_t:.9f} omega {omega:.6f} | promise "
+        f"{exported.e_n_engine[k]:.9f} {exported.e_t_engine[k]:.9f} "
+        f"{exported.omega_engine[k]:.6f}"
+    )
     assert e == pytest.approx(exported.e_n_engine[k], abs=1e-8)
     assert e_t == pytest.approx(exported.e_t_engine[k], abs=1e-8)
     assert omega * R / v_t == pytest.approx(exported.omega_engine[k] * R / v_t, abs=1e-8)

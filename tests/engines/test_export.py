@@ -140,8 +140,15 @@ def _documented_hertz_impact(E, nu, restitution, *, m, radius, v0, clamp, ground
         return raw_force(y[0], y[1]) if clamp and t > 1e-3 * t_scale else y[0]
 
     end.terminal, end.direction = True, -1
-    sol = solve_ivp(rhs, (0, 100 * t_scale), [0.0, v0], method="DOP853", rtol=1e-12,
-                    atol=[1e-14 * v0 * t_scale, 1e-14 * v0], events=end)  # fmt: skip
+    sol = solve_ivp(
+        rhs,
+        (0, 100 * t_scale),
+        [0.0, v0],
+        method="DOP853",
+        rtol=1e-12,
+        atol=[1e-14 * v0 * t_scale, 1e-14 * v0],
+        events=end,
+    )
     return -sol.y_events[0][0][1] / v0, sol.t_events[0][0]
 
 
@@ -154,16 +161,26 @@ def test_liggghts_and_chrono_exports_meet_their_documented_laws(e):
     m, radius, v0, T = 0.004, 0.005, 1.0, 1e-3
     x = ji.export(None, "liggghts", m=m, v0=v0, e=e, T=T, radius=radius, curves=False)
     got_e, got_T = _documented_hertz_impact(
-        x.parameters["youngs_modulus"], 0.3, x.parameters["coeff_restitution"],
-        m=m, radius=radius, v0=v0, clamp=False,
-    )  # fmt: skip
+        x.parameters["youngs_modulus"],
+        0.3,
+        x.parameters["coeff_restitution"],
+        m=m,
+        radius=radius,
+        v0=v0,
+        clamp=False,
+    )
     assert abs(got_e - e) < 1e-7 and abs(got_T / T - 1) < 1e-7
     assert abs(x.e / e - 1) < 0.005 and "coefficientRestitution" in x.snippet
     y = ji.export(None, "chrono", m=m, v0=v0, e=e, T=T, radius=radius, curves=False)
     got_e, got_T = _documented_hertz_impact(
-        y.parameters["SetYoungModulus"], 0.3, y.parameters["SetRestitution"],
-        m=m, radius=radius, v0=v0, clamp=True,
-    )  # fmt: skip
+        y.parameters["SetYoungModulus"],
+        0.3,
+        y.parameters["SetRestitution"],
+        m=m,
+        radius=radius,
+        v0=v0,
+        clamp=True,
+    )
     assert abs(got_e - e) < 1e-6 and abs(got_T / T - 1) < 1e-6
     assert y.parameters["SetRestitution"] < e  # the clamp raises e: a lower cr is asked
     assert any("not replicated" in w for w in y.warnings)
@@ -252,8 +269,12 @@ def test_wall_geometry_leaves_the_default_export_unchanged(engine):
         ji.export(None, engine, geometry="plate", **kwargs)
     assert "\n" not in str(info.value)
     mujoco = ji.export(None, "mujoco", m=0.05, v0=1.0, e=0.6, T=1e-2, curves=False)
-    assert ji.export(None, "mujoco", m=0.05, v0=1.0, e=0.6, T=1e-2, curves=False,
-                     geometry="wall").to_dict() == mujoco.to_dict()  # fmt: skip
+    assert (
+        ji.export(
+            None, "mujoco", m=0.05, v0=1.0, e=0.6, T=1e-2, curves=False, geometry="wall"
+        ).to_dict()
+        == mujoco.to_dict()
+    )
     with pytest.raises(ValueError, match="not 'spheres'"):
         ji.export(None, "drake", m=0.05, v0=1.0, e=0.6, T=1e-2, geometry="spheres")
 
@@ -268,8 +289,9 @@ def test_lammps_wall_export_is_the_sphere_on_a_flat(limit_damping):
     kwargs = dict(m=WALL_M, v0=1.0, radius=WALL_R, e=0.5, T=5e-4, limit_damping=limit_damping)
     x = ji.export(None, "lammps", geometry="wall", **kwargs)
     p = x.parameters
-    assert p["k"] == pytest.approx(ji.hertz_stiffness(E=p["youngs_modulus"], nu=0.3, R=WALL_R),
-                                   rel=1e-12)  # fmt: skip
+    assert p["k"] == pytest.approx(
+        ji.hertz_stiffness(E=p["youngs_modulus"], nu=0.3, R=WALL_R), rel=1e-12
+    )
     model = p["pair_coeff"].removeprefix("pair_coeff * * ")
     assert p["fix_wall"] == f"fix wall all wall/gran granular {model} zplane 0.0 NULL"
     assert p["fix_wall"] in x.snippet.splitlines()
@@ -281,12 +303,17 @@ def test_lammps_wall_export_is_the_sphere_on_a_flat(limit_damping):
     assert x.e == pytest.approx(pair.e, rel=1e-9) and x.T == pytest.approx(pair.T, rel=1e-9)
     assert x.timestep == pair.timestep
     # engine-e on the wall parameters: the same law and stepping
-    params = {"E": p["youngs_modulus"], "coeff_restitution": p["coeff_restitution"],
-              "limit_damping": limit_damping, "geometry": "wall"}  # fmt: skip
+    params = {
+        "E": p["youngs_modulus"],
+        "coeff_restitution": p["coeff_restitution"],
+        "limit_damping": limit_damping,
+        "geometry": "wall",
+    }
     _, _, e_back, T_back = engine_response("lammps", params, m=WALL_M, speeds=[1.0], radius=WALL_R)
     assert e_back[0] == pytest.approx(0.5, rel=1e-6) and T_back[0] == pytest.approx(5e-4, rel=1e-6)
-    stepped = stepped_response("lammps", {**params, "timestep": x.timestep}, m=WALL_M,
-                               speeds=[1.0], radius=WALL_R)  # fmt: skip
+    stepped = stepped_response(
+        "lammps", {**params, "timestep": x.timestep}, m=WALL_M, speeds=[1.0], radius=WALL_R
+    )
     assert stepped[1][0] == pytest.approx(x.e, rel=1e-12)
 
 
@@ -314,20 +341,34 @@ def test_liggghts_and_chrono_wall_exports_meet_their_documented_laws(e):
     material (R* = R; Chrono's damping mass m M/(m + M) with its heavy ground): the target
     e and T, LIGGGHTS to 1e-7 and Chrono to 1e-6."""
     m, radius, v0, T = WALL_M, WALL_R, 1.0, 1e-3
-    x = ji.export(None, "liggghts", m=m, v0=v0, e=e, T=T, radius=radius, geometry="wall",
-                  curves=False)  # fmt: skip
+    x = ji.export(
+        None, "liggghts", m=m, v0=v0, e=e, T=T, radius=radius, geometry="wall", curves=False
+    )
     got_e, got_T = _documented_hertz_impact(
-        x.parameters["youngs_modulus"], 0.3, x.parameters["coeff_restitution"],
-        m=m, radius=radius, v0=v0, clamp=False, ground_mass=math.inf,
-    )  # fmt: skip
+        x.parameters["youngs_modulus"],
+        0.3,
+        x.parameters["coeff_restitution"],
+        m=m,
+        radius=radius,
+        v0=v0,
+        clamp=False,
+        ground_mass=math.inf,
+    )
     assert abs(got_e - e) < 1e-7 and abs(got_T / T - 1) < 1e-7
     assert "primitive type 1 zplane 0.0" in x.parameters["fix_wall"]
-    y = ji.export(None, "chrono", m=m, v0=v0, e=e, T=T, radius=radius, geometry="wall",
-                  curves=False)  # fmt: skip
+    y = ji.export(
+        None, "chrono", m=m, v0=v0, e=e, T=T, radius=radius, geometry="wall", curves=False
+    )
     got_e, got_T = _documented_hertz_impact(
-        y.parameters["SetYoungModulus"], 0.3, y.parameters["SetRestitution"],
-        m=m, radius=radius, v0=v0, clamp=True, ground_mass=y.parameters["ground_mass"],
-    )  # fmt: skip
+        y.parameters["SetYoungModulus"],
+        0.3,
+        y.parameters["SetRestitution"],
+        m=m,
+        radius=radius,
+        v0=v0,
+        clamp=True,
+        ground_mass=y.parameters["ground_mass"],
+    )
     assert abs(got_e - e) < 1e-6 and abs(got_T / T - 1) < 1e-6
     assert y.parameters["effective_curvature_radius"] == radius
     assert f"ground.SetMass({y.parameters['ground_mass']:.10g})" in y.snippet
@@ -365,8 +406,9 @@ def test_every_engine_is_a_final_class_declaring_its_facts():
             assert all(hasattr(model, fact) for fact in NORMAL_FACTS)
             names = [key.name for key in model.KEYS]
             assert len(set(names)) == len(names) and all(isinstance(k, Key) for k in model.KEYS)
-            assert names[: sum(k.needed for k in model.KEYS)] == [k.name for k in model.KEYS
-                                                                   if k.needed]  # fmt: skip
+            assert names[: sum(k.needed for k in model.KEYS)] == [
+                k.name for k in model.KEYS if k.needed
+            ]
         assert set(engine.TANGENTIAL) <= set(ji.TANGENTIAL_LAW_NAMES)
         for model in engine.TANGENTIAL.values():
             assert isinstance(model, AbstractTangentialModel)
@@ -478,8 +520,20 @@ def test_a_new_engine_is_one_class_and_one_registry_entry(monkeypatch, capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["parameters"] == x.parameters
     params = json.dumps({"k": out["parameters"]["k"], "c": out["parameters"]["c"]})
-    main(["engine-e", "--engine", "toy", "--params", params, "--mass", "0.1", "--speed", "1",
-          "--json"])  # fmt: skip
+    main(
+        [
+            "engine-e",
+            "--engine",
+            "toy",
+            "--params",
+            params,
+            "--mass",
+            "0.1",
+            "--speed",
+            "1",
+            "--json",
+        ]
+    )
     assert json.loads(capsys.readouterr().out)["e"][0] == pytest.approx(0.6, rel=1e-6)
     with pytest.raises(SystemExit):
         main(["export", "toy", "--e", "0.6", "--T", "1e-3", "--v0", "1"])

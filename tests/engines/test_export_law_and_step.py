@@ -38,27 +38,45 @@ def _export(case):
         "mujoco law": (hertz_rate, "mujoco", dict(m=1.0, v0=2.5, curves=False)),
         "mujoco targets": (None, "mujoco", dict(m=0.05, v0=1.0, e=0.6, T=5e-3, curves=False)),
         "drake": (None, "drake", dict(m=1.0, v0=1.0, e=0.7, T=0.02, curves=False)),
-        "drake discrete": (None, "drake", dict(m=1.0, v0=1.0, e=0.7, T=0.02, timestep=2e-4,
-                                               curves=False)),
+        "drake discrete": (
+            None,
+            "drake",
+            dict(m=1.0, v0=1.0, e=0.7, T=0.02, timestep=2e-4, curves=False),
+        ),
         "lammps spheres": (None, "lammps", dict(e=0.5, T=5e-4, **small)),
         "lammps wall": (None, "lammps", dict(e=0.5, T=5e-4, geometry="wall", **small)),
-        "lammps spheres limit_damping": (None, "lammps", dict(e=0.5, T=5e-4, limit_damping=True,
-                                                      **small)),
+        "lammps spheres limit_damping": (
+            None,
+            "lammps",
+            dict(e=0.5, T=5e-4, limit_damping=True, **small),
+        ),
         "liggghts spheres": (None, "liggghts", dict(e=0.8, T=1e-3, **small)),
         "liggghts wall": (None, "liggghts", dict(e=0.8, T=1e-3, geometry="wall", **small)),
-        "yade spheres": (None, "yade", dict(e=0.5, T=1e-3, m=0.01, v0=1.0, radius=0.01,
-                                            curves=False)),
-        "yade wall": (None, "yade", dict(e=0.5, T=1e-3, m=0.01, v0=1.0, radius=0.01,
-                                         geometry="wall", curves=False)),
+        "yade spheres": (
+            None,
+            "yade",
+            dict(e=0.5, T=1e-3, m=0.01, v0=1.0, radius=0.01, curves=False),
+        ),
+        "yade wall": (
+            None,
+            "yade",
+            dict(e=0.5, T=1e-3, m=0.01, v0=1.0, radius=0.01, geometry="wall", curves=False),
+        ),
         "chrono spheres": (None, "chrono", dict(e=0.6, T=1e-3, **small)),
         "chrono wall": (None, "chrono", dict(e=0.6, T=1e-3, geometry="wall", **small)),
         "lammps jkr spheres": (pair_law(), "lammps", dict(geometry="spheres")),
         "lammps jkr wall": (wall_law(), "lammps", dict(geometry="wall")),
-        "lammps dmt spheres": (_dmt_law(), "lammps", dict(m=RUBBER_M, v0=0.3, radius=RUBBER_R,
-                                                          curves=False)),
-        "lammps dmt wall": (_dmt_law(), "lammps", dict(m=RUBBER_M, v0=0.3, radius=RUBBER_R,
-                                                       geometry="wall", curves=False)),
-    }  # fmt: skip
+        "lammps dmt spheres": (
+            _dmt_law(),
+            "lammps",
+            dict(m=RUBBER_M, v0=0.3, radius=RUBBER_R, curves=False),
+        ),
+        "lammps dmt wall": (
+            _dmt_law(),
+            "lammps",
+            dict(m=RUBBER_M, v0=0.3, radius=RUBBER_R, geometry="wall", curves=False),
+        ),
+    }
     law, engine, kwargs = cases[case]
     if "jkr" in case:  # at four times the law's sticking speed, as the jkr export's test
         v0 = 4.0 * float(law.sticking_speed(RUBBER_M))
@@ -79,9 +97,20 @@ def _law_impact(x, mass):
 
 # the design inverts the engine's continuous law: the law's impact is the target, and what
 # the engine realises (its stepping included) is that within the export's tolerance
-INVERTED = ["drake", "lammps spheres", "lammps wall", "lammps spheres limit_damping",
-            "liggghts spheres", "liggghts wall", "yade spheres", "yade wall",
-            "chrono spheres", "chrono wall", "lammps dmt spheres", "lammps dmt wall"]  # fmt: skip
+INVERTED = [
+    "drake",
+    "lammps spheres",
+    "lammps wall",
+    "lammps spheres limit_damping",
+    "liggghts spheres",
+    "liggghts wall",
+    "yade spheres",
+    "yade wall",
+    "chrono spheres",
+    "chrono wall",
+    "lammps dmt spheres",
+    "lammps dmt wall",
+]
 
 
 @pytest.mark.parametrize(
@@ -141,8 +170,15 @@ def test_lammps_damped_jkr_law_is_within_the_tolerance(geometry):
     """With damping viscoelastic, `law` is the jkr_viscoelastic law whose neck takes
     LAMMPS's energy: its impact at the effective mass gives the target e and T (LAMMPS's
     continuous impact) within 0.5 % (0.3 % here; with w = 2 cohesion, e was 2.7 % below)."""
-    x = ji.export(_damped_law(geometry), "lammps", m=RUBBER_M, v0=0.3, radius=RUBBER_R,
-                  geometry=geometry, curves=False)  # fmt: skip
+    x = ji.export(
+        _damped_law(geometry),
+        "lammps",
+        m=RUBBER_M,
+        v0=0.3,
+        radius=RUBBER_R,
+        geometry=geometry,
+        curves=False,
+    )
     mass = RUBBER_M / 2.0 if geometry == "spheres" else RUBBER_M
     assert x.law_m == mass
     e, T = _law_impact(x, mass)
@@ -172,8 +208,10 @@ def test_recommended_step_for_a_hertz_export_is_ten_times_coarser_than_t_over_40
     assert _within(x) and not any("steps per contact" in w for w in x.warnings)
     coarse = ji.export(None, engine, timestep=2 * x.timestep, **GLASS)
     assert not _within(coarse)
-    assert any(f"use {_stepping.describe_step(x.timestep, GLASS['T'])} or less" in w
-               for w in coarse.warnings), coarse.warnings  # fmt: skip
+    assert any(
+        f"use {_stepping.describe_step(x.timestep, GLASS['T'])} or less" in w
+        for w in coarse.warnings
+    ), coarse.warnings
 
 
 @pytest.mark.parametrize(
@@ -191,8 +229,9 @@ def test_recommended_step_is_the_coarsest_within_the_tolerance(engine, kwargs):
     start phase's e, the mean T), and twice it does not."""
     x = ji.export(None, engine, v0=1.0, curves=False, **kwargs)
     assert _within(x), (x.e_range, x.T, x.target_T)
-    coarse = ji.export(None, engine, v0=1.0, curves=False, timestep=2 * x.timestep,
-                       strict=False, **kwargs)  # fmt: skip
+    coarse = ji.export(
+        None, engine, v0=1.0, curves=False, timestep=2 * x.timestep, strict=False, **kwargs
+    )
     assert not _within(coarse), (coarse.e_range, coarse.T)
 
 
@@ -201,12 +240,14 @@ def test_a_contact_short_of_five_steps_never_reads_as_five():
     rounded down, the step is told as T/n beside its seconds, and the refusal names the
     coarsest step that works, also as T/n."""
     T = 1e-3
-    why = _stepping.unrealised(0.5, T, target_e=0.5, target_T=T, steps_per_contact=4.996,
-                               parameters={})  # fmt: skip
+    why = _stepping.unrealised(
+        0.5, T, target_e=0.5, target_T=T, steps_per_contact=4.996, parameters={}
+    )
     assert "in only 4.99 steps" in why and "at least 5" in why and "fewer than" not in why
     with pytest.raises(UnrealisedExport) as refused:
-        ji.export(None, "yade", m=0.01, v0=1.0, e=0.5, T=T, radius=0.01, timestep=T / 4.996,
-                  curves=False)  # fmt: skip
+        ji.export(
+            None, "yade", m=0.01, v0=1.0, e=0.5, T=T, radius=0.01, timestep=T / 4.996, curves=False
+        )
     text = str(refused.value)
     assert "(T/4.99)" in text and "in only 4.99 steps" in text and " 5 steps" not in text
     working = refused.value.working
@@ -222,8 +263,22 @@ def test_no_strict_warning_speaks_to_who_asked(capsys):
     with pytest.warns(UnrealisedWarning, match=r"exported anyway \(strict=False\)$"):
         x = ji.export(None, "yade", strict=False, **kwargs)
     assert x.warnings[0].endswith("exported anyway (strict=False)")
-    argv = ["export", "yade", "--e", "0.5", "--T", "1e-3", "--v0", "1", "--mass", "0.01",
-            "--radius", "0.01", "--timestep", str(1e-3 / 3)]  # fmt: skip
+    argv = [
+        "export",
+        "yade",
+        "--e",
+        "0.5",
+        "--T",
+        "1e-3",
+        "--v0",
+        "1",
+        "--mass",
+        "0.01",
+        "--radius",
+        "0.01",
+        "--timestep",
+        str(1e-3 / 3),
+    ]
     status, out, err = run_cli(capsys, [*argv, "--no-strict", "--json"])
     assert status == 0 and "strict=False" not in err + out
     assert "exported anyway (--no-strict)" in err
@@ -233,8 +288,23 @@ def test_no_strict_warning_speaks_to_who_asked(capsys):
 
 
 def test_cli_prints_the_recommended_step_with_t_over_n(capsys):
-    status, out, _ = run_cli(capsys, ["export", "lammps", "--e", "0.9", "--T", "5e-5", "--v0",
-                                      "1", "--mass", "4.2e-5", "--radius", "1.5e-3"])  # fmt: skip
+    status, out, _ = run_cli(
+        capsys,
+        [
+            "export",
+            "lammps",
+            "--e",
+            "0.9",
+            "--T",
+            "5e-5",
+            "--v0",
+            "1",
+            "--mass",
+            "4.2e-5",
+            "--radius",
+            "1.5e-3",
+        ],
+    )
     x = ji.export(None, "lammps", **GLASS)
     assert status == 0
     assert f"recommended timestep {x.timestep:.3g} s (T/{5e-5 / x.timestep:.0f})" in out, out
@@ -263,14 +333,23 @@ def test_a_tangential_law_of_another_material_is_warned():
         c = 4 / 3 * E / (2 * (1 - nu**2)) * math.sqrt(R)
         lines = modulus_warnings(c, glass, radius=R, poisson=nu, two_spheres=False)
         assert bool(lines) == warned, lines
-    lines = modulus_warnings(4 / 3 * 345e6 / (2 * (1 - nu**2)) * math.sqrt(R), glass,
-                             radius=R, poisson=nu, two_spheres=False)  # fmt: skip
+    lines = modulus_warnings(
+        4 / 3 * 345e6 / (2 * (1 - nu**2)) * math.sqrt(R),
+        glass,
+        radius=R,
+        poisson=nu,
+        two_spheres=False,
+    )
     assert "G_star = 1.461e+10 Pa is 368 times" in lines[0] and "not of one material" in lines[0]
     alumina = ji.tangential_law("mindlin", G_star=1.35e10, mu=0.092)
     assert modulus_warnings(4.2e9, alumina, radius=2.5e-3, poisson=0.3, two_spheres=False) == []
     # two spheres: the pair's c (the forces halved) on R* = R/2, the same material
-    assert modulus_warnings(4.2e9 / 2, alumina.forces_scaled(0.5), radius=2.5e-3, poisson=0.3,
-                            two_spheres=True) == []  # fmt: skip
+    assert (
+        modulus_warnings(
+            4.2e9 / 2, alumina.forces_scaled(0.5), radius=2.5e-3, poisson=0.3, two_spheres=True
+        )
+        == []
+    )
 
 
 @pytest.mark.slow  # a tangential export compiles its oblique impacts (15 s)
@@ -280,8 +359,17 @@ def test_the_glass_bead_export_warns_of_its_tangential_law():
     c = 4 / 3 * 345e6 / (2 * (1 - nu**2)) * math.sqrt(R)
     law = ji.law("tsuji", c=c, b=0.1 * math.sqrt(m * c))
     glass = ji.tangential_law("mindlin", G=26e9, nu=nu, mu=0.1)
-    x = ji.export(law, "lammps", m=m, v0=1.0, radius=R, geometry="wall", poisson=nu,
-                  tangential=glass, curves=False)  # fmt: skip
+    x = ji.export(
+        law,
+        "lammps",
+        m=m,
+        v0=1.0,
+        radius=R,
+        geometry="wall",
+        poisson=nu,
+        tangential=glass,
+        curves=False,
+    )
     assert x.parameters["youngs_modulus"] == pytest.approx(345e6, rel=0.2)  # T sets E
     assert any("not of one material" in w for w in x.warnings), x.warnings
     assert x.target_T / x.timestep >= 400  # a tangential export keeps T/400 at most

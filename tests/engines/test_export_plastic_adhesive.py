@@ -44,8 +44,9 @@ def test_lammps_jkr_contact_is_jkr_with_w_twice_cohesion_broken_at_the_least_for
     jkr_delta = a**2 / R_eff - np.sqrt(4 * math.pi * cohesion * a / E_mix)
     np.testing.assert_allclose(jkr_delta, deltas, rtol=1e-9, atol=1e-12 * pull)
     force = lammps_jkr.normal_force(deltas, R_eff, cohesion, E_mix)
-    np.testing.assert_allclose(force, np.asarray(law.force(deltas, 0.0)), rtol=1e-8,
-                               atol=1e-10 * abs(force).max())  # fmt: skip
+    np.testing.assert_allclose(
+        force, np.asarray(law.force(deltas, 0.0)), rtol=1e-8, atol=1e-10 * abs(force).max()
+    )
     F_c = 1.5 * math.pi * (2 * cohesion) * R_eff  # = 3 pi cohesion R
     assert lammps_jkr.normal_force(0.0, R_eff, cohesion, E_mix) == pytest.approx(-8 / 9 * F_c)
     assert lammps_jkr.normal_force(-pull, R_eff, cohesion, E_mix) == pytest.approx(-F_c)
@@ -71,8 +72,9 @@ def test_lammps_jkr_replica_tends_to_its_continuous_impact():
         q = float(adhesion_group(law.params["c"], R, W, M, v0))
         e_cont, tau = lammps_jkr.lammps_impact(q)
         T_cont = tau * x_star / v0
-        es, Ts = lammps_jkr.replica({**params, "timestep": T_cont / 4000}, M, v0,
-                                    phases=(0.25, 0.75))  # fmt: skip
+        es, Ts = lammps_jkr.replica(
+            {**params, "timestep": T_cont / 4000}, M, v0, phases=(0.25, 0.75)
+        )
         assert np.all(np.abs(es - e_cont) < 2e-3 * e_cont), (es, e_cont)
         assert np.all(np.abs(Ts / T_cont - 1) < 1e-3), (Ts, T_cont)
         exact = float(ji.impact(law, m=M, v0=v0).e)
@@ -106,15 +108,21 @@ def test_jkr_export_to_lammps_realises_the_laws_e_of_v(geometry, law):
             lammps_jkr.ENERGY_RATIO ** (-0.6), rel=0.02
         )
     # the inverse: LAMMPS's parameters back to e(v), continuous and stepped
-    params = {"E": x.parameters["youngs_modulus"], "cohesion": x.parameters["cohesion"],
-              "poisson": NU, "geometry": geometry}  # fmt: skip
+    params = {
+        "E": x.parameters["youngs_modulus"],
+        "cohesion": x.parameters["cohesion"],
+        "poisson": NU,
+        "geometry": geometry,
+    }
     speeds = [2 * V_s, 4 * V_s]
     _, separation, e_back, _ = engine_response("lammps", params, m=M, speeds=speeds, radius=R)
     assert separation == "force"
-    np.testing.assert_allclose(e_back, [float(ji.impact(law, m=M, v0=v).e) for v in speeds],
-                               rtol=2e-3)  # fmt: skip
-    stepped = stepped_response("lammps", {**params, "timestep": x.timestep}, m=M,
-                               speeds=[4 * V_s], radius=R)  # fmt: skip
+    np.testing.assert_allclose(
+        e_back, [float(ji.impact(law, m=M, v0=v).e) for v in speeds], rtol=2e-3
+    )
+    stepped = stepped_response(
+        "lammps", {**params, "timestep": x.timestep}, m=M, speeds=[4 * V_s], radius=R
+    )
     assert stepped[1][0] == pytest.approx(x.e, rel=1e-12)
 
 
@@ -127,8 +135,9 @@ def test_jkr_export_refusals_are_one_line():
     good = ji.export(law, "lammps", m=M, v0=5 * V_s, radius=R, geometry="wall", curves=False)
     short = r"in only \d\.\d+ steps .*needs at least 5"  # T over the step: 3.63
     with pytest.raises(UnrealisedExport, match=short) as refused:
-        ji.export(law, "lammps", m=M, v0=5 * V_s, radius=R, geometry="wall", timestep=1e-3,
-                  curves=False)  # fmt: skip
+        ji.export(
+            law, "lammps", m=M, v0=5 * V_s, radius=R, geometry="wall", timestep=1e-3, curves=False
+        )
     assert refused.value.working == good.timestep and "\n" not in str(refused.value)
     with pytest.raises(ValueError, match="limit_damping"):
         ji.export(law, "lammps", m=M, v0=5 * V_s, radius=R, limit_damping=True, curves=False)
@@ -143,8 +152,11 @@ def _worst(line: str) -> float:
 def steel():
     """A steel ball of 5 mm on a rigid flat (Thornton 1997; yield speed 0.034 m/s)."""
     m = 4 / 3 * math.pi * R**3 * 7800
-    law = ji.law("thornton", c=ji.hertz_stiffness(E=2.1e11, nu=0.3, R=R, E2=math.inf),
-                 x_y=ji.yield_overlap(E=2.1e11, nu=0.3, R=R, Y=1e9, E2=math.inf))  # fmt: skip
+    law = ji.law(
+        "thornton",
+        c=ji.hertz_stiffness(E=2.1e11, nu=0.3, R=R, E2=math.inf),
+        x_y=ji.yield_overlap(E=2.1e11, nu=0.3, R=R, Y=1e9, E2=math.inf),
+    )
     return law, m
 
 
@@ -172,8 +184,9 @@ def test_thornton_export_names_the_nearest_law_and_its_worst_gap():
     assert worst == pytest.approx(0.5 * (max(e_law) - min(e_law)), abs=2e-3)
     assert worst < _worst(line)
     with pytest.raises(ValueError, match="one speed"):
-        ji.export(ji.law("hertz_rate", c=2e6, b1=800.0), "lammps", m=0.05, v0=[1.0, 2.0],
-                  radius=0.01)  # fmt: skip
+        ji.export(
+            ji.law("hertz_rate", c=2e6, b1=800.0), "lammps", m=0.05, v0=[1.0, 2.0], radius=0.01
+        )
 
 
 def test_jkr_to_an_engine_without_it_names_the_nearest_law():

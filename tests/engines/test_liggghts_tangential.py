@@ -17,19 +17,24 @@ R = 2.5e-3
 M = 4000.0 * 4.0 / 3.0 * math.pi * R**3
 CASES = {
     # e = 0.98, no tangential damper: LIGGGHTS realises the law's own mindlin law
-    "undamped": (ji.law("tsuji", c=4.2e9, b=15.0),
-                 ji.tangential_law("mindlin", G_star=1.35e10, mu=0.092)),
+    "undamped": (
+        ji.law("tsuji", c=4.2e9, b=15.0),
+        ji.tangential_law("mindlin", G_star=1.35e10, mu=0.092),
+    ),
     # e = 0.69, the damper on (with LIGGGHTS's beta, not the law's: the nearest law)
-    "damped": (ji.law("tsuji", c=4.2e9, b=300.0),
-               ji.tangential_law("mindlin", G_star=1.35e10, mu=0.3, beta=0.2)),
-}  # fmt: skip
+    "damped": (
+        ji.law("tsuji", c=4.2e9, b=300.0),
+        ji.tangential_law("mindlin", G_star=1.35e10, mu=0.3, beta=0.2),
+    ),
+}
 
 
 @functools.cache
 def _export(name):
     law, tangential = CASES[name]
-    return ji.export(law, "liggghts", m=M, v0=3.9, radius=R, geometry="wall",
-                     tangential=tangential, curves=False)  # fmt: skip
+    return ji.export(
+        law, "liggghts", m=M, v0=3.9, radius=R, geometry="wall", tangential=tangential, curves=False
+    )
 
 
 @pytest.mark.engines
@@ -44,9 +49,11 @@ def test_liggghts_realises_the_tangential_promise_on_a_wall(name):
         k = x.angles.index(angle)
         v_n, v_t = 3.9 * math.cos(math.radians(angle)), 3.9 * math.sin(math.radians(angle))
         e, e_t, omega = run_liggghts_oblique(x.parameters, m=M, radius=R, v_n=v_n, v_t=v_t)
-        print(f"{name} {angle:4.0f} deg: LIGGGHTS e {e:.5f} e_t {e_t:.5f} omega {omega:8.3f} | "
-              f"promise {x.e_n_engine[k]:.5f} {x.e_t_engine[k]:.5f} "
-              f"{x.omega_engine[k]:8.3f}")  # fmt: skip
+        print(
+            f"{name} {angle:4.0f} deg: LIGGGHTS e {e:.5f} e_t {e_t:.5f} omega {omega:8.3f} | "
+            f"promise {x.e_n_engine[k]:.5f} {x.e_t_engine[k]:.5f} "
+            f"{x.omega_engine[k]:8.3f}"
+        )
         assert e_t == pytest.approx(x.e_t_engine[k], abs=0.005)
         assert abs(omega - x.omega_engine[k]) * R / v_t < 0.01
         assert e == pytest.approx(x.e_n_engine[k], rel=0.005)
@@ -85,8 +92,15 @@ def test_other_tangential_laws_are_refused_in_one_line(name):
     params = {"kt": 1e6} if name == "linear_history" else {"G_star": 1.35e10}
     tangential = ji.tangential_law(name, mu=0.1, **params)
     with pytest.raises(ValueError, match="export a mindlin law"):
-        ji.export(CASES["undamped"][0], "liggghts", m=M, v0=3.9, radius=R, geometry="wall",
-                  tangential=tangential)  # fmt: skip
+        ji.export(
+            CASES["undamped"][0],
+            "liggghts",
+            m=M,
+            v0=3.9,
+            radius=R,
+            geometry="wall",
+            tangential=tangential,
+        )
 
 
 @pytest.mark.engines

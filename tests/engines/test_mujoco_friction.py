@@ -24,8 +24,15 @@ SOFT = {"standard": (0.002, 0.5), "direct": (-4e6, -300.0)}
 
 
 def _soft_parameters(solref, mu=0.3):
-    return dict(solref=list(solref), solimp=list(mj.SOLIMP), timestep=1e-4,
-                friction=[mu, 0.0, 0.0], condim=3, cone="pyramidal", impratio=1.0)  # fmt: skip
+    return dict(
+        solref=list(solref),
+        solimp=list(mj.SOLIMP),
+        timestep=1e-4,
+        friction=[mu, 0.0, 0.0],
+        condim=3,
+        cone="pyramidal",
+        impratio=1.0,
+    )
 
 
 @pytest.mark.engines
@@ -39,8 +46,15 @@ def test_the_replica_is_mujoco(form, angle):
     v_n, v_t = math.cos(math.radians(angle)), math.sin(math.radians(angle))
     phases = (0.1, 0.6, 0.95)
     engine = run_mujoco_oblique(parameters, radius=0.01, v_n=v_n, v_t=v_t, phases=phases)
-    replica = oblique_replica(parameters["solref"], parameters["timestep"], mu=0.3,
-                              radius=0.01, v_n=v_n, v_t=v_t, phases=phases)  # fmt: skip
+    replica = oblique_replica(
+        parameters["solref"],
+        parameters["timestep"],
+        mu=0.3,
+        radius=0.01,
+        v_n=v_n,
+        v_t=v_t,
+        phases=phases,
+    )
     for got, want in zip(replica, engine, strict=True):
         np.testing.assert_allclose(got, want, rtol=1e-10, atol=1e-10)
 
@@ -57,11 +71,14 @@ def test_mujoco_realises_the_exports_promise():
     for angle in (5.0, 45.0, 75.0):
         k = x.angles.index(angle)
         v_n, v_t = 3.9 * math.cos(math.radians(angle)), 3.9 * math.sin(math.radians(angle))
-        e, e_t, omega = run_mujoco_oblique(x.parameters, radius=R, v_n=v_n, v_t=v_t,
-                                           phases=PHASES, m=M)  # fmt: skip
-        print(f"{angle:4.0f} deg: MuJoCo e {e.mean():.6f} e_t {e_t.mean():.6f} omega "
-              f"{omega.mean():.3f} | promise {x.e_n_engine[k]:.6f} {x.e_t_engine[k]:.6f} "
-              f"{x.omega_engine[k]:.3f} | law e_t {x.e_t_target[k]:.5f}")  # fmt: skip
+        e, e_t, omega = run_mujoco_oblique(
+            x.parameters, radius=R, v_n=v_n, v_t=v_t, phases=PHASES, m=M
+        )
+        print(
+            f"{angle:4.0f} deg: MuJoCo e {e.mean():.6f} e_t {e_t.mean():.6f} omega "
+            f"{omega.mean():.3f} | promise {x.e_n_engine[k]:.6f} {x.e_t_engine[k]:.6f} "
+            f"{x.omega_engine[k]:.3f} | law e_t {x.e_t_target[k]:.5f}"
+        )
         assert e.mean() == pytest.approx(x.e_n_engine[k], rel=1e-9)
         assert e_t.mean() == pytest.approx(x.e_t_engine[k], rel=1e-9)
         assert omega.mean() == pytest.approx(x.omega_engine[k], rel=1e-8)
@@ -76,8 +93,9 @@ def test_head_on_the_corrected_cone_is_the_frictionless_contact(mu):
     frictionless row's (MuJoCo's normal replica) to round-off, at every start phase."""
     solref, h = SOFT["standard"], 1e-4
     e_frictionless, _ = mj.replica(solref, h, 1.0)
-    e, _, _ = oblique_replica(frictional_solref(solref, h, mu), h, mu=mu, radius=0.01,
-                              v_n=1.0, v_t=1e-12)  # fmt: skip
+    e, _, _ = oblique_replica(
+        frictional_solref(solref, h, mu), h, mu=mu, radius=0.01, v_n=1.0, v_t=1e-12
+    )
     np.testing.assert_allclose(e, e_frictionless, rtol=1e-9)
     assert head_on_factor(1.0) == pytest.approx(1.0, abs=1e-15)  # mu^2 (1 + mu^2) = 2
 

@@ -123,11 +123,15 @@ def test_drake_discrete_realises_the_promise(e, T, steps):
     for approximation in ("lagged", "similar", "tamsi"):
         runs = [
             run_drake(
-                x.parameters, m=1.0, v0=1.0, time_step=h, approximation=approximation,
+                x.parameters,
+                m=1.0,
+                v0=1.0,
+                time_step=h,
+                approximation=approximation,
                 gap=phase * h,
             )
             for phase in phases
-        ]  # fmt: skip
+        ]
         es, Ts = np.array(runs).T
         np.testing.assert_allclose(es, replica_e, rtol=1e-6)
         assert np.all(np.abs(es / x.e - 1) < 0.005), (approximation, es, x.e)
@@ -143,12 +147,15 @@ def test_drake_discrete_coarse_step_is_warned_and_realised():
     with pytest.raises(ValueError, match="drake cannot realise"):
         ji.export(None, "drake", m=1.0, v0=1.0, e=0.9, T=0.01, timestep=0.001, curves=False)
     with pytest.warns(UserWarning, match="drake cannot realise"):
-        x = ji.export(None, "drake", m=1.0, v0=1.0, e=0.9, T=0.01, timestep=0.001,
-                      curves=False, strict=False)  # fmt: skip
+        x = ji.export(
+            None, "drake", m=1.0, v0=1.0, e=0.9, T=0.01, timestep=0.001, curves=False, strict=False
+        )
     assert any("damps more than e = 0.9" in w for w in x.warnings)
     assert x.parameters["hunt_crossley_dissipation"] == 0.0
-    es = [run_drake(x.parameters, m=1.0, v0=1.0, time_step=0.001,
-                                gap=phase * 0.001)[0] for phase in (0.1, 0.5, 0.9)]  # fmt: skip
+    es = [
+        run_drake(x.parameters, m=1.0, v0=1.0, time_step=0.001, gap=phase * 0.001)[0]
+        for phase in (0.1, 0.5, 0.9)
+    ]
     assert abs(np.mean(es) / x.e - 1) < 0.005 and x.e < 0.7
 
 
@@ -159,8 +166,17 @@ def test_drake_discrete_coarse_step_is_warned_and_realised():
 def test_liggghts_realises_the_promise(e, T, limit_damping):
     require_executable("liggghts")
     m, radius = 0.004, 0.005
-    x = ji.export(None, "liggghts", m=m, v0=1.0, radius=radius, e=e, T=T,
-                  limit_damping=limit_damping, curves=False)  # fmt: skip
+    x = ji.export(
+        None,
+        "liggghts",
+        m=m,
+        v0=1.0,
+        radius=radius,
+        e=e,
+        T=T,
+        limit_damping=limit_damping,
+        curves=False,
+    )
     es, Ts = run_liggghts(x.parameters, m=m, v0=1.0, radius=radius, phases=PHASES)
     assert np.all(np.abs(es / x.e - 1) < 0.005), (es, x.e)
     assert within_a_step(Ts, x.T, x.timestep), (Ts, x.T)
@@ -204,8 +220,7 @@ def test_yade_default_damping_is_the_public_report():
     require_executable("yade")
     m, radius = 0.01, 0.01
     x = ji.export(None, "yade", m=m, v0=1.0, radius=radius, e=0.5, T=1e-3, curves=False)
-    es, _ = run_yade(x.parameters, m=m, v0=1.0, radius=radius, phases=(0.5,),
-                                 damping=0.2)  # fmt: skip
+    es, _ = run_yade(x.parameters, m=m, v0=1.0, radius=radius, phases=(0.5,), damping=0.2)
     stepped = stepped_response("yade", {**x.parameters, "damping": 0.2}, m=m, speeds=[1.0])
     assert 0.40 < es[0] < 0.43 and abs(stepped[1][0] / es[0] - 1) < 0.005
 
@@ -225,25 +240,47 @@ def test_engine_e_stepped_response_is_what_mujoco_realises():
 @pytest.mark.engines
 @pytest.mark.parametrize(
     "e, T, limit_damping",
-    [(0.9, 1e-3, False), (0.5, 5e-4, False), (0.1, 1e-4, False), (0.3, 2e-4, True),
-     (0.8, 5e-4, True)],
-)  # fmt: skip
+    [
+        (0.9, 1e-3, False),
+        (0.5, 5e-4, False),
+        (0.1, 1e-4, False),
+        (0.3, 2e-4, True),
+        (0.8, 5e-4, True),
+    ],
+)
 def test_lammps_wall_realises_the_promise(e, T, limit_damping):
     """A sphere on `fix wall/gran granular` (the exported snippet's wall): LAMMPS realises
     the export's e and T within 0.5 % at five start phases, as for the pair."""
     require("lammps")
-    x = ji.export(None, "lammps", m=WALL_M, v0=1.0, radius=WALL_R, e=e, T=T,
-                  limit_damping=limit_damping, geometry="wall", curves=False)  # fmt: skip
-    es, Ts = run_lammps(x.parameters, m=WALL_M, v0=1.0, radius=WALL_R,
-                                    phases=WALL_PHASES)  # fmt: skip
+    x = ji.export(
+        None,
+        "lammps",
+        m=WALL_M,
+        v0=1.0,
+        radius=WALL_R,
+        e=e,
+        T=T,
+        limit_damping=limit_damping,
+        geometry="wall",
+        curves=False,
+    )
+    es, Ts = run_lammps(x.parameters, m=WALL_M, v0=1.0, radius=WALL_R, phases=WALL_PHASES)
     assert np.all(np.abs(es / x.e - 1) < 0.005), (es, x.e)
     assert within_a_step(Ts, x.T, x.timestep), (Ts, x.T)
     assert abs(x.e / e - 1) < 0.005 and abs(x.T / T - 1) < 0.005
     # the replica is LAMMPS's step on the wall to round-off
     replica_e, _ = lammps_engine.replica(
-        {"k": x.parameters["k"], "b": x.parameters["b"], "limit_damping": limit_damping,
-         "timestep": x.timestep, "geometry": "wall"}, WALL_M, 1.0, WALL_PHASES,
-    )  # fmt: skip
+        {
+            "k": x.parameters["k"],
+            "b": x.parameters["b"],
+            "limit_damping": limit_damping,
+            "timestep": x.timestep,
+            "geometry": "wall",
+        },
+        WALL_M,
+        1.0,
+        WALL_PHASES,
+    )
     np.testing.assert_allclose(es, replica_e, rtol=1e-9)
 
 
@@ -255,10 +292,19 @@ def test_liggghts_wall_realises_the_promise(e, T, limit_damping):
     """A sphere on a primitive `fix wall/gran` (limitForce after the wall): LIGGGHTS
     realises the export's e and T within 0.5 % at five start phases."""
     require_executable("liggghts")
-    x = ji.export(None, "liggghts", m=WALL_M, v0=1.0, radius=WALL_R, e=e, T=T,
-                  limit_damping=limit_damping, geometry="wall", curves=False)  # fmt: skip
-    es, Ts = run_liggghts(x.parameters, m=WALL_M, v0=1.0, radius=WALL_R,
-                                      phases=WALL_PHASES)  # fmt: skip
+    x = ji.export(
+        None,
+        "liggghts",
+        m=WALL_M,
+        v0=1.0,
+        radius=WALL_R,
+        e=e,
+        T=T,
+        limit_damping=limit_damping,
+        geometry="wall",
+        curves=False,
+    )
+    es, Ts = run_liggghts(x.parameters, m=WALL_M, v0=1.0, radius=WALL_R, phases=WALL_PHASES)
     assert np.all(np.abs(es / x.e - 1) < 0.005), (es, x.e)
     assert within_a_step(Ts, x.T, x.timestep), (Ts, x.T)
     assert abs(x.e / e - 1) < 0.005 and abs(x.T / T - 1) < 0.005
@@ -272,8 +318,7 @@ def test_yade_wall_realises_the_promise(e, T):
     (the mass convention included)."""
     require_executable("yade")
     m, radius = 0.01, 0.01
-    x = ji.export(None, "yade", m=m, v0=1.0, radius=radius, e=e, T=T, geometry="wall",
-                  curves=False)  # fmt: skip
+    x = ji.export(None, "yade", m=m, v0=1.0, radius=radius, e=e, T=T, geometry="wall", curves=False)
     phases = (0.1, 0.5, 0.9)
     es, Ts = run_yade(x.parameters, m=m, v0=1.0, radius=radius, phases=phases)
     assert np.all(np.abs(es / x.e - 1) < 0.005), (es, x.e)

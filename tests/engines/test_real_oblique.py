@@ -34,8 +34,16 @@ def test_lammps_realises_the_tangential_promise_on_a_wall(name):
     """e_t within 0.005 and the spin within 1 % of v_t/R of the promise at each angle
     (measured: within 0.002 and 0.5 %; the rest is LAMMPS's step, 400 per contact)."""
     require("lammps")
-    x = ji.export(LAW, "lammps", m=M, v0=3.9, radius=R, geometry="wall",
-                  tangential=TANGENTIAL[name], curves=False)  # fmt: skip
+    x = ji.export(
+        LAW,
+        "lammps",
+        m=M,
+        v0=3.9,
+        radius=R,
+        geometry="wall",
+        tangential=TANGENTIAL[name],
+        curves=False,
+    )
     assert x.angles[: len(x.e_t_engine)] == x.angles and len(x.e_t_engine) == len(x.angles)
     rows = []
     for angle in ANGLES:
@@ -43,8 +51,10 @@ def test_lammps_realises_the_tangential_promise_on_a_wall(name):
         v_n, v_t = 3.9 * math.cos(math.radians(angle)), 3.9 * math.sin(math.radians(angle))
         e_t, omega = run_lammps_oblique(x.parameters, m=M, radius=R, v_n=v_n, v_t=v_t)
         rows.append((angle, e_t, x.e_t_engine[k], omega, x.omega_engine[k]))
-        print(f"{name} {angle:4.0f} deg: LAMMPS e_t {e_t:.5f} omega {omega:8.2f} | "
-              f"promise e_t {x.e_t_engine[k]:.5f} omega {x.omega_engine[k]:8.2f}")  # fmt: skip
+        print(
+            f"{name} {angle:4.0f} deg: LAMMPS e_t {e_t:.5f} omega {omega:8.2f} | "
+            f"promise e_t {x.e_t_engine[k]:.5f} omega {x.omega_engine[k]:8.2f}"
+        )
         assert e_t == pytest.approx(x.e_t_engine[k], abs=0.005)
         assert abs(omega - x.omega_engine[k]) * R / v_t < 0.01
     # the regimes differ across the angles (stick and slip, then gross sliding): e_t varies
@@ -61,8 +71,9 @@ def test_lammps_realises_the_tangential_promise_between_two_spheres():
     v_t T / (2 R) = 0.7 % of a radian during this contact: our reading of the difference,
     not checked further here; a pair's e_t is promised to about 1 %."""
     require("lammps")
-    x = ji.export(LAW, "lammps", m=M, v0=3.9, radius=R, tangential=TANGENTIAL["mindlin"],
-                  curves=False)  # fmt: skip
+    x = ji.export(
+        LAW, "lammps", m=M, v0=3.9, radius=R, tangential=TANGENTIAL["mindlin"], curves=False
+    )
     for angle in (20.0, 45.0):
         k = x.angles.index(angle)
         v_n, v_t = 3.9 * math.cos(math.radians(angle)), 3.9 * math.sin(math.radians(angle))
@@ -99,8 +110,16 @@ def test_the_clause_is_lammps_own():
         tangential_clause(TANGENTIAL["mindlin_force"])
         == "tangential mindlin/force 1.08e+11 0 0.092"
     )
-    x = ji.export(LAW, "lammps", m=M, v0=3.9, radius=R, geometry="wall",
-                  tangential=TANGENTIAL["mindlin"], curves=False)  # fmt: skip
+    x = ji.export(
+        LAW,
+        "lammps",
+        m=M,
+        v0=3.9,
+        radius=R,
+        geometry="wall",
+        tangential=TANGENTIAL["mindlin"],
+        curves=False,
+    )
     for key in ("pair_coeff", "fix_wall"):
         assert "tangential mindlin 1.08e+11 0 0.092" in x.parameters[key]
     assert x.to_dict()["tangential"]["name"] == "mindlin"
@@ -115,9 +134,19 @@ def test_two_spheres_get_the_law_at_the_pair_s_mass_tangential_forces_halved():
     then departs from the law's e_t as the wall's does (0.0167 and 0.0154 at 5 degrees:
     Tsuji's force under LAMMPS's end at x = 0 against the law's force criterion), where
     before this stop, the spring not halved, the pair's departed by 0.24."""
-    wall, pair = (ji.export(LAW, "lammps", m=M, v0=3.9, radius=R, geometry=geometry,
-                            tangential=TANGENTIAL["mindlin"], curves=False)
-                  for geometry in ("wall", "spheres"))  # fmt: skip
+    wall, pair = (
+        ji.export(
+            LAW,
+            "lammps",
+            m=M,
+            v0=3.9,
+            radius=R,
+            geometry=geometry,
+            tangential=TANGENTIAL["mindlin"],
+            curves=False,
+        )
+        for geometry in ("wall", "spheres")
+    )
     assert "tangential mindlin 5.4e+10 0 0.092" in pair.parameters["pair_coeff"]
     assert "tangential mindlin 1.08e+11 0 0.092" in wall.parameters["pair_coeff"]
     assert pair.tangential.params["G_star"] == pytest.approx(6.75e9)  # the engine's, as `law`

@@ -70,10 +70,13 @@ def test_lammps_jkr_with_the_laws_own_surface_energy_takes_half_the_energy():
     h = 2e-6
     model = f"{lammps_jkr.model(E, W / 2, NU)} {FRICTIONLESS}"  # the normal and tangential clauses
     literal = {
-        "pair_style": "pair_style granular", "pair_coeff": f"pair_coeff * * {model}",
+        "pair_style": "pair_style granular",
+        "pair_coeff": f"pair_coeff * * {model}",
         "fix_wall": f"fix wall all wall/gran granular {model} zplane 0.0 NULL",
-        "geometry": "wall", "timestep": f"timestep {h}", "timestep_s": h,
-    }  # fmt: skip
+        "geometry": "wall",
+        "timestep": f"timestep {h}",
+        "timestep_s": h,
+    }
     for factor in (0.8, 1.5):
         es, _ = run_lammps_jkr(literal, m=M, v0=factor * V_s, radius=R, phases=(0.5,))
         said = math.sqrt(1 - lammps_jkr.ENERGY_RATIO / factor**2)
@@ -88,8 +91,11 @@ def test_lammps_nearest_to_thornton_falls_by_the_reported_gap():
     measured worst |de| from the law is the one the export's first warning reports."""
     require("lammps")
     m = 4 / 3 * math.pi * R**3 * 7800
-    law = ji.law("thornton", c=ji.hertz_stiffness(E=2.1e11, nu=0.3, R=R, E2=math.inf),
-                 x_y=ji.yield_overlap(E=2.1e11, nu=0.3, R=R, Y=1e9, E2=math.inf))  # fmt: skip
+    law = ji.law(
+        "thornton",
+        c=ji.hertz_stiffness(E=2.1e11, nu=0.3, R=R, E2=math.inf),
+        x_y=ji.yield_overlap(E=2.1e11, nu=0.3, R=R, Y=1e9, E2=math.inf),
+    )
     speeds = [0.1, 0.3, 1.0, 3.0]
     x = ji.export(law, "lammps", m=m, v0=speeds, radius=R, geometry="wall")
     gaps = []

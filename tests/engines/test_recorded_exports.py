@@ -52,8 +52,11 @@ def _dmt():
 
 def _thornton():
     m = 4 / 3 * math.pi * RUBBER_R**3 * 7800
-    law = ji.law("thornton", c=ji.hertz_stiffness(E=2.1e11, nu=0.3, R=RUBBER_R, E2=math.inf),
-                 x_y=ji.yield_overlap(E=2.1e11, nu=0.3, R=RUBBER_R, Y=1e9, E2=math.inf))  # fmt: skip
+    law = ji.law(
+        "thornton",
+        c=ji.hertz_stiffness(E=2.1e11, nu=0.3, R=RUBBER_R, E2=math.inf),
+        x_y=ji.yield_overlap(E=2.1e11, nu=0.3, R=RUBBER_R, Y=1e9, E2=math.inf),
+    )
     return law, m
 
 
@@ -75,94 +78,195 @@ def _cases():
         # targets, each engine and scene
         "mujoco targets": (None, "mujoco", dict(m=0.05, v0=1.0, e=0.6, T=5e-3)),
         "mujoco targets per kg": (None, "mujoco", dict(v0=1.0, e=0.6, curves=False)),
-        "mujoco coarse step": (None, "mujoco", dict(m=1.0, v0=1.0, e=0.5, T=2e-3,
-                                                    timestep=2e-4, curves=False)),
+        "mujoco coarse step": (
+            None,
+            "mujoco",
+            dict(m=1.0, v0=1.0, e=0.5, T=2e-3, timestep=2e-4, curves=False),
+        ),
         "drake": (None, "drake", dict(m=1.0, v0=1.0, e=0.7, T=0.02)),
         "drake discrete": (None, "drake", dict(m=1.0, v0=1.0, e=0.7, T=0.02, timestep=2e-4)),
         "lammps spheres": (None, "lammps", dict(e=0.5, T=5e-4, **SMALL)),
-        "lammps wall": (None, "lammps", dict(e=0.5, T=5e-4, geometry="wall", curves=False,
-                                             **SMALL)),
-        "lammps limit_damping": (None, "lammps", dict(e=0.5, T=5e-4, limit_damping=True,
-                                                      curves=False, **SMALL)),
-        "lammps unrealised": (None, "lammps", dict(e=0.5, T=5e-4, timestep=2e-4, strict=False,
-                                                   curves=False, **SMALL)),
+        "lammps wall": (
+            None,
+            "lammps",
+            dict(e=0.5, T=5e-4, geometry="wall", curves=False, **SMALL),
+        ),
+        "lammps limit_damping": (
+            None,
+            "lammps",
+            dict(e=0.5, T=5e-4, limit_damping=True, curves=False, **SMALL),
+        ),
+        "lammps unrealised": (
+            None,
+            "lammps",
+            dict(e=0.5, T=5e-4, timestep=2e-4, strict=False, curves=False, **SMALL),
+        ),
         "liggghts spheres": (None, "liggghts", dict(e=0.8, T=1e-3, **SMALL)),
-        "liggghts wall": (None, "liggghts", dict(e=0.8, T=1e-3, geometry="wall", curves=False,
-                                                 **SMALL)),
-        "liggghts limit_damping": (None, "liggghts", dict(e=0.5, T=1e-3, limit_damping=True,
-                                                          poisson=0.25, curves=False, **SMALL)),
+        "liggghts wall": (
+            None,
+            "liggghts",
+            dict(e=0.8, T=1e-3, geometry="wall", curves=False, **SMALL),
+        ),
+        "liggghts limit_damping": (
+            None,
+            "liggghts",
+            dict(e=0.5, T=1e-3, limit_damping=True, poisson=0.25, curves=False, **SMALL),
+        ),
         "yade spheres": (None, "yade", dict(e=0.5, T=1e-3, m=0.01, v0=1.0, radius=0.01)),
-        "yade wall": (None, "yade", dict(e=0.5, T=1e-3, m=0.01, v0=1.0, radius=0.01,
-                                         geometry="wall", curves=False)),
+        "yade wall": (
+            None,
+            "yade",
+            dict(e=0.5, T=1e-3, m=0.01, v0=1.0, radius=0.01, geometry="wall", curves=False),
+        ),
         "chrono spheres": (None, "chrono", dict(e=0.6, T=1e-3, **SMALL)),
-        "chrono wall": (None, "chrono", dict(e=0.6, T=1e-3, geometry="wall", curves=False,
-                                             **SMALL)),
+        "chrono wall": (
+            None,
+            "chrono",
+            dict(e=0.6, T=1e-3, geometry="wall", curves=False, **SMALL),
+        ),
         # laws: each engine's own family and the laws it lacks
         "mujoco law": (hertz_rate, "mujoco", dict(m=1.0, v0=2.5)),
         "drake law": (ji.law("point_contact", c=2e5, d=0.5), "drake", dict(m=0.05, v0=1.0)),
         "lammps law": (tsuji, "lammps", dict(curves=False, **KHARAZ)),
         "liggghts law": (tsuji, "liggghts", dict(geometry="wall", curves=False, **KHARAZ)),
-        "yade law": (ji.law("kelvin_voigt", c=2e5, b=3.0), "yade",
-                     dict(m=0.05, v0=1.0, radius=0.01, geometry="wall", curves=False)),
+        "yade law": (
+            ji.law("kelvin_voigt", c=2e5, b=3.0),
+            "yade",
+            dict(m=0.05, v0=1.0, radius=0.01, geometry="wall", curves=False),
+        ),
         "chrono law": (hertz_rate, "chrono", dict(m=0.05, v0=1.0, radius=0.01, curves=False)),
         "lammps jkr spheres": (_jkr("spheres"), "lammps", dict(geometry="spheres")),
         "lammps jkr wall": (_jkr("wall"), "lammps", dict(geometry="wall")),
-        "lammps jkr_viscoelastic spheres": (_jkr_viscoelastic("spheres"), "lammps",
-                                            dict(m=RUBBER_M, v0=0.3, radius=RUBBER_R)),
-        "lammps jkr_viscoelastic wall": (_jkr_viscoelastic("wall"), "lammps",
-                                         dict(m=RUBBER_M, v0=0.3, radius=RUBBER_R,
-                                              geometry="wall", curves=False)),
+        "lammps jkr_viscoelastic spheres": (
+            _jkr_viscoelastic("spheres"),
+            "lammps",
+            dict(m=RUBBER_M, v0=0.3, radius=RUBBER_R),
+        ),
+        "lammps jkr_viscoelastic wall": (
+            _jkr_viscoelastic("wall"),
+            "lammps",
+            dict(m=RUBBER_M, v0=0.3, radius=RUBBER_R, geometry="wall", curves=False),
+        ),
         "lammps dmt spheres": (_dmt(), "lammps", dict(m=RUBBER_M, v0=0.3, radius=RUBBER_R)),
-        "lammps dmt wall": (_dmt(), "lammps", dict(m=RUBBER_M, v0=0.3, radius=RUBBER_R,
-                                                   geometry="wall", curves=False)),
-        "lammps thornton": (steel, "lammps", dict(m=steel_m, v0=1.0, radius=RUBBER_R,
-                                                  geometry="wall", curves=False)),
-        "lammps thornton speeds": (steel, "lammps", dict(m=steel_m, v0=[0.1, 0.3, 1.0, 3.0],
-                                                         radius=RUBBER_R, geometry="wall")),
+        "lammps dmt wall": (
+            _dmt(),
+            "lammps",
+            dict(m=RUBBER_M, v0=0.3, radius=RUBBER_R, geometry="wall", curves=False),
+        ),
+        "lammps thornton": (
+            steel,
+            "lammps",
+            dict(m=steel_m, v0=1.0, radius=RUBBER_R, geometry="wall", curves=False),
+        ),
+        "lammps thornton speeds": (
+            steel,
+            "lammps",
+            dict(m=steel_m, v0=[0.1, 0.3, 1.0, 3.0], radius=RUBBER_R, geometry="wall"),
+        ),
         "mujoco jkr speeds": (_jkr("wall"), "mujoco", dict(m=RUBBER_M, v0="jkr speeds")),
         # tangential laws: every row of every engine's table
-        **{f"lammps wall {name}": (tsuji, "lammps", dict(geometry="wall", curves=False,
-                                                         tangential=tangential, **KHARAZ))
-           for name, tangential in {
-               "linear_history": _tl("linear_history", kt=1e6, mu=0.092),
-               "mindlin": _tl("mindlin", **G),
-               "mindlin_force": _tl("mindlin_force", **G),
-               "mindlin_rescale": _tl("mindlin_rescale", **G),
-               "mindlin_rescale_force": _tl("mindlin_rescale_force", **G)}.items()},
-        "lammps spheres mindlin": (tsuji, "lammps", dict(curves=False,
-                                                         tangential=_tl("mindlin", **G), **KHARAZ)),
-        "lammps jkr mindlin": (_jkr("wall"), "lammps", dict(geometry="wall", curves=False,
-                                                            tangential=_tl("mindlin", G_star=1e8,
-                                                                           mu=0.3))),
-        "liggghts wall mindlin": (tsuji, "liggghts", dict(geometry="wall", curves=False,
-                                                          tangential=_tl("mindlin", **G),
-                                                          **KHARAZ)),
-        "liggghts wall mindlin damped": (ji.law("tsuji", c=4.2e9, b=300.0), "liggghts",
-                                         dict(geometry="wall", curves=False, **KHARAZ,
-                                              tangential=_tl("mindlin", G_star=1.35e10, mu=0.3,
-                                                             beta=0.2))),
-        "liggghts spheres mindlin": (tsuji, "liggghts", dict(curves=False, **KHARAZ,
-                                                             tangential=_tl("mindlin", **G))),
-        "yade wall linear_history": (ji.law("kelvin_voigt", c=2e5, b=3.0), "yade",
-                                     dict(m=0.05, v0=1.0, radius=0.01, geometry="wall",
-                                          curves=False,
-                                          tangential=_tl("linear_history", kt=1e5, mu=0.3))),
-        "yade spheres linear_history": (ji.law("kelvin_voigt", c=2e5, b=3.0), "yade",
-                                        dict(m=0.05, v0=1.0, radius=0.01, curves=False,
-                                             tangential=_tl("linear_history", kt=1e5, mu=0.3))),
-        "mujoco mindlin": (tsuji, "mujoco", dict(curves=False, tangential=_tl("mindlin", **G),
-                                                 **KHARAZ)),
-        "mujoco frictionless": (tsuji, "mujoco", dict(curves=False, **KHARAZ,
-                                                      tangential=_tl("mindlin", G_star=1.35e10,
-                                                                     mu=0.0))),
-        "drake linear_history": (ji.law("point_contact", c=2e5, d=0.5), "drake",
-                                 dict(m=0.05, v0=1.0, radius=0.01, curves=False,
-                                      tangential=_tl("linear_history", kt=1e5, mu=0.3))),
-        "mujoco targets mindlin": (None, "mujoco", dict(m=0.05, v0=1.0, e=0.6, T=5e-3,
-                                                        radius=0.01, curves=False,
-                                                        tangential=_tl("mindlin", G_star=1e9,
-                                                                       mu=0.3))),
-    }  # fmt: skip
+        **{
+            f"lammps wall {name}": (
+                tsuji,
+                "lammps",
+                dict(geometry="wall", curves=False, tangential=tangential, **KHARAZ),
+            )
+            for name, tangential in {
+                "linear_history": _tl("linear_history", kt=1e6, mu=0.092),
+                "mindlin": _tl("mindlin", **G),
+                "mindlin_force": _tl("mindlin_force", **G),
+                "mindlin_rescale": _tl("mindlin_rescale", **G),
+                "mindlin_rescale_force": _tl("mindlin_rescale_force", **G),
+            }.items()
+        },
+        "lammps spheres mindlin": (
+            tsuji,
+            "lammps",
+            dict(curves=False, tangential=_tl("mindlin", **G), **KHARAZ),
+        ),
+        "lammps jkr mindlin": (
+            _jkr("wall"),
+            "lammps",
+            dict(geometry="wall", curves=False, tangential=_tl("mindlin", G_star=1e8, mu=0.3)),
+        ),
+        "liggghts wall mindlin": (
+            tsuji,
+            "liggghts",
+            dict(geometry="wall", curves=False, tangential=_tl("mindlin", **G), **KHARAZ),
+        ),
+        "liggghts wall mindlin damped": (
+            ji.law("tsuji", c=4.2e9, b=300.0),
+            "liggghts",
+            dict(
+                geometry="wall",
+                curves=False,
+                **KHARAZ,
+                tangential=_tl("mindlin", G_star=1.35e10, mu=0.3, beta=0.2),
+            ),
+        ),
+        "liggghts spheres mindlin": (
+            tsuji,
+            "liggghts",
+            dict(curves=False, **KHARAZ, tangential=_tl("mindlin", **G)),
+        ),
+        "yade wall linear_history": (
+            ji.law("kelvin_voigt", c=2e5, b=3.0),
+            "yade",
+            dict(
+                m=0.05,
+                v0=1.0,
+                radius=0.01,
+                geometry="wall",
+                curves=False,
+                tangential=_tl("linear_history", kt=1e5, mu=0.3),
+            ),
+        ),
+        "yade spheres linear_history": (
+            ji.law("kelvin_voigt", c=2e5, b=3.0),
+            "yade",
+            dict(
+                m=0.05,
+                v0=1.0,
+                radius=0.01,
+                curves=False,
+                tangential=_tl("linear_history", kt=1e5, mu=0.3),
+            ),
+        ),
+        "mujoco mindlin": (
+            tsuji,
+            "mujoco",
+            dict(curves=False, tangential=_tl("mindlin", **G), **KHARAZ),
+        ),
+        "mujoco frictionless": (
+            tsuji,
+            "mujoco",
+            dict(curves=False, **KHARAZ, tangential=_tl("mindlin", G_star=1.35e10, mu=0.0)),
+        ),
+        "drake linear_history": (
+            ji.law("point_contact", c=2e5, d=0.5),
+            "drake",
+            dict(
+                m=0.05,
+                v0=1.0,
+                radius=0.01,
+                curves=False,
+                tangential=_tl("linear_history", kt=1e5, mu=0.3),
+            ),
+        ),
+        "mujoco targets mindlin": (
+            None,
+            "mujoco",
+            dict(
+                m=0.05,
+                v0=1.0,
+                e=0.6,
+                T=5e-3,
+                radius=0.01,
+                curves=False,
+                tangential=_tl("mindlin", G_star=1e9, mu=0.3),
+            ),
+        ),
+    }
     return cases
 
 
@@ -198,12 +302,16 @@ def _compare(got, want, where=""):
     """A list of the places where `got` differs from `want` (floats to `REL`)."""
     if isinstance(want, dict):
         if not isinstance(got, dict) or list(got) != list(want):
-            return [f"{where}: keys {list(got) if isinstance(got, dict) else got!r} != {list(want)}"]
+            return [
+                f"{where}: keys {list(got) if isinstance(got, dict) else got!r} != {list(want)}"
+            ]
         return [d for k in want for d in _compare(got[k], want[k], f"{where}.{k}")]
     if isinstance(want, list):
         if not isinstance(got, list) or len(got) != len(want):
             return [f"{where}: {got!r} != {want!r}"]
-        return [d for i, (a, b) in enumerate(zip(got, want)) for d in _compare(a, b, f"{where}[{i}]")]
+        return [
+            d for i, (a, b) in enumerate(zip(got, want)) for d in _compare(a, b, f"{where}[{i}]")
+        ]
     if isinstance(want, float) and isinstance(got, float) and not isinstance(want, bool):
         if got == want or abs(got - want) <= REL * max(abs(got), abs(want)):
             return []

@@ -21,8 +21,9 @@ SPRINGS = {
 
 @functools.cache
 def _export(name):
-    return ji.export(LAW, "yade", m=M, v0=V0, radius=R, geometry="wall",
-                     tangential=SPRINGS[name], curves=False)  # fmt: skip
+    return ji.export(
+        LAW, "yade", m=M, v0=V0, radius=R, geometry="wall", tangential=SPRINGS[name], curves=False
+    )
 
 
 @pytest.mark.engines
@@ -38,9 +39,11 @@ def test_yade_realises_the_tangential_promise_on_a_wall(name):
         k = x.angles.index(angle)
         v_n, v_t = V0 * math.cos(math.radians(angle)), V0 * math.sin(math.radians(angle))
         e, e_t, omega = run_yade_oblique(x.parameters, m=M, radius=R, v_n=v_n, v_t=v_t)
-        print(f"{name} {angle:4.0f} deg: Yade e {e:.5f} e_t {e_t:.5f} omega {omega:8.3f} | "
-              f"promise {x.e_n_engine[k]:.5f} {x.e_t_engine[k]:.5f} {x.omega_engine[k]:8.3f}"
-              f" | law e_t {x.e_t_target[k]:.5f}")  # fmt: skip
+        print(
+            f"{name} {angle:4.0f} deg: Yade e {e:.5f} e_t {e_t:.5f} omega {omega:8.3f} | "
+            f"promise {x.e_n_engine[k]:.5f} {x.e_t_engine[k]:.5f} {x.omega_engine[k]:8.3f}"
+            f" | law e_t {x.e_t_target[k]:.5f}"
+        )
         assert e_t == pytest.approx(x.e_t_engine[k], abs=0.002)
         assert abs(omega - x.omega_engine[k]) * R / v_t < 0.01
         assert e == pytest.approx(x.e_n_engine[k], rel=1e-3)
@@ -77,8 +80,9 @@ PAIR_SPRINGS = {
 
 @functools.cache
 def _pair_export(name):
-    return ji.export(PAIR_LAW, "yade", m=M, v0=V0, radius=R, tangential=PAIR_SPRINGS[name],
-                     curves=False)  # fmt: skip
+    return ji.export(
+        PAIR_LAW, "yade", m=M, v0=V0, radius=R, tangential=PAIR_SPRINGS[name], curves=False
+    )
 
 
 @pytest.mark.engines
@@ -97,8 +101,10 @@ def test_yade_realises_the_tangential_promise_between_two_spheres(name):
         v_n, v_t = V0 * math.cos(math.radians(angle)), V0 * math.sin(math.radians(angle))
         e, e_t, omega = run_yade_oblique(x.parameters, m=M, radius=R, v_n=v_n, v_t=v_t)
         promise = (x.e_n_engine[k], x.e_t_engine[k], x.omega_engine[k])
-        print(f"{name} {angle:4.0f} deg: Yade {e:.5f} {e_t:.5f} {omega:8.3f} | promise "
-              "{:.5f} {:.5f} {:8.3f}".format(*promise))  # fmt: skip
+        print(
+            f"{name} {angle:4.0f} deg: Yade {e:.5f} {e_t:.5f} {omega:8.3f} | promise "
+            "{:.5f} {:.5f} {:8.3f}".format(*promise)
+        )
         assert e_t == pytest.approx(promise[1], abs=0.005)
         assert abs(omega - promise[2]) * R / v_t < 0.01
         assert e == pytest.approx(promise[0], abs=0.01)

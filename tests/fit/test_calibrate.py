@@ -666,8 +666,13 @@ def test_calibrate_takes_the_closed_form(name, truth, start):
 def test_compare_laws_in_threads_ranks_as_one_after_another():
     """The fits side by side (threads, `workers=2`) give the rankings one after another
     gives, to the bit."""
-    data = dict(m=0.0027, v0=[1.0, 1.4, 1.9, 2.4], e=[0.95, 0.94, 0.936, 0.912], progress=False,
-                laws=("kelvin_voigt", "hertz_rate"))  # fmt: skip
+    data = dict(
+        m=0.0027,
+        v0=[1.0, 1.4, 1.9, 2.4],
+        e=[0.95, 0.94, 0.936, 0.912],
+        progress=False,
+        laws=("kelvin_voigt", "hertz_rate"),
+    )
     one = ji.compare_laws(workers=1, **data)
     two = ji.compare_laws(workers=2, **data)
     assert [r.name for r in one] == [r.name for r in two]
@@ -704,8 +709,9 @@ def test_a_fit_prints_no_compiler_notes(tmp_path):
     )
     env = {k: v for k, v in os.environ.items() if k != "TF_CPP_MIN_LOG_LEVEL"}
     env["JAX_COMPILATION_CACHE_DIR"] = str(tmp_path)  # compiled here, not read back
-    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
-                          env=env, timeout=900)  # fmt: skip
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, env=env, timeout=900
+    )
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "True"
     assert "Algebraic simplifier" not in done.stderr, done.stderr[:500]

@@ -99,9 +99,13 @@ def reference(law, params, *, m, v0, g, separation, atol=1e-15):
     y1 = np.array(y_top, dtype=float)
     y1[1] = 0.0
     two = solve_ivp(
-        rhs, (tau_top, tau_top + 1e5), y1, events=[leave, back, at_rest(False)], args=(False,),
+        rhs,
+        (tau_top, tau_top + 1e5),
+        y1,
+        events=[leave, back, at_rest(False)],
+        args=(False,),
         **kw,
-    )  # fmt: skip
+    )
     T = two.t[-1] * t_s
     if two.t_events[0].size:
         return dict(out, T=T, e=-two.y[1, -1], status=int(ji.Status.separated), ending="separated")
@@ -189,13 +193,12 @@ def closed(law, cases, separation):
         cols = [[k["params"]["c"], k["params"]["b"], k["m"], k["v0"]] for k in cases]
         out = maxwell_batch(separation)(*zip(*cols, strict=True))
     else:
-        cols = [
-            [*linear_arguments(law, k["params"]), k["m"], k["v0"], k["g"]] for k in cases
-        ]  # fmt: skip
+        cols = [[*linear_arguments(law, k["params"]), k["m"], k["v0"], k["g"]] for k in cases]
         out = linear_batch(separation)(*zip(*cols, strict=True))
     if law != "bingham":  # held without a dry force is a capture
-        out["status"] = np.where(np.isin(out["status"], HELD), int(ji.Status.captured),
-                                 out["status"])  # fmt: skip
+        out["status"] = np.where(
+            np.isin(out["status"], HELD), int(ji.Status.captured), out["status"]
+        )
     return out
 
 
@@ -273,8 +276,12 @@ def check_grid(law, separation, full):
 
 
 # the fast suite: each law under one criterion; the slow group: the other criterion too
-FAST_GRID = {("kelvin_voigt", "force"), ("bingham", "penetration"),
-             ("bingham_compression", "force"), ("maxwell", "penetration")}  # fmt: skip
+FAST_GRID = {
+    ("kelvin_voigt", "force"),
+    ("bingham", "penetration"),
+    ("bingham_compression", "force"),
+    ("maxwell", "penetration"),
+}
 
 
 @pytest.mark.parametrize(
@@ -364,13 +371,16 @@ def test_impact_fields_dissipated_energy_and_vmap():
     def one(c, P):
         r = ji.impact(ji.law("bingham", c=c, b=200.0, P=P), m=1.0, v0=2.5, g=9.81)
         assert r.path == "closed_form"
-        return {k: getattr(r, k) for k in ("e", "T", "t_max", "x_max", "dissipated", "v_out",
-                                           "status", "num_steps")}  # fmt: skip
+        return {
+            k: getattr(r, k)
+            for k in ("e", "T", "t_max", "x_max", "dissipated", "v_out", "status", "num_steps")
+        }
 
     got = {k: np.asarray(v) for k, v in jax.jit(jax.vmap(one))(cs, Ps).items()}
     n = len(cs)
-    want = linear_batch("force")(cs, np.full(n, 200.0), Ps, Ps, np.ones(n), np.full(n, 2.5),
-                                 np.full(n, 9.81))  # fmt: skip
+    want = linear_batch("force")(
+        cs, np.full(n, 200.0), Ps, Ps, np.ones(n), np.full(n, 2.5), np.full(n, 9.81)
+    )
     assert list(got["status"]) == [0, 1, 0, 0] and np.all(got["num_steps"] == 0)
     for key in ("e", "T", "t_max", "x_max"):
         np.testing.assert_allclose(got[key], want[key], rtol=1e-13, err_msg=key)

@@ -50,8 +50,12 @@ def _walk(rhs, t0, y0, events, pieces, kw):
         if end <= t0:
             continue
         sol = solve_ivp(rhs, (t0, end), y0, events=events, max_step=max_step, **kw)
-        peaks += [y for k, ev in enumerate(events) if not getattr(ev, "terminal", False)
-                  for y in sol.y_events[k]]  # fmt: skip
+        peaks += [
+            y
+            for k, ev in enumerate(events)
+            if not getattr(ev, "terminal", False)
+            for y in sol.y_events[k]
+        ]
         t0, y0 = sol.t[-1], sol.y[:, -1]
         for k, ev in enumerate(events):
             if getattr(ev, "terminal", False) and sol.t_events[k].size:
@@ -82,8 +86,13 @@ def reference(c, b, m, v0, g, separation, *, tau_max=TAU_MAX, atol=1e-15, refine
     if refine:  # V's first minimum: the force falls back through m g
         falls = _terminal(lambda tau, y: y[2] - gamma, -1)
         t2 = _walk(rhs, 0.0, y0, [falls], pieces, kw)[0]
-        pieces = [(t2 - 1e-2, np.inf), (t2 - 1e-5, 1e-4), (t2 + 1e-5, 1e-8), (t2 + 1e-2, 1e-4),
-                  (tau_max, np.inf)]  # fmt: skip
+        pieces = [
+            (t2 - 1e-2, np.inf),
+            (t2 - 1e-5, 1e-4),
+            (t2 + 1e-5, 1e-8),
+            (t2 + 1e-2, 1e-4),
+            (tau_max, np.inf),
+        ]
     rest = _terminal(lambda tau, y: abs(y[1]) + abs(y[2] - gamma) - REST_TOL, -1)
     top = _terminal(lambda tau, y: y[1], -1)
 
@@ -94,9 +103,14 @@ def reference(c, b, m, v0, g, separation, *, tau_max=TAU_MAX, atol=1e-15, refine
     tau_top, y_top, fired, peaks = _walk(rhs, 0.0, y0, [top, rest, peak], pieces, kw)
     forces = [0.0, y_top[2]] + [y[2] for y in peaks[:1]]
     out = dict(
-        x_max=y_top[0] * x_s, t_max=tau_top * t_s, F_max=max(forces) * f_s, e=0.0,
-        status=CAPTURED, T=tau_top * t_s, x_end=y_top[0] * x_s,
-    )  # fmt: skip
+        x_max=y_top[0] * x_s,
+        t_max=tau_top * t_s,
+        F_max=max(forces) * f_s,
+        e=0.0,
+        status=CAPTURED,
+        T=tau_top * t_s,
+        x_end=y_top[0] * x_s,
+    )
     if fired == 1:
         return dict(out, ending="rest")
     if fired is None:
@@ -240,8 +254,10 @@ def check(cases, separation, refine=False):
             errors[key] = max(errors[key], abs(got[key][i] / want[key] - 1.0))
         errors["x_end"] = max(errors["x_end"], abs(got["x_end"][i] - want["x_end"]) / want["x_max"])
     ERRORS[(separation, len(cases))] = errors
-    print(f"{separation}, {len(cases)} cases ({', '.join(sorted(endings))}): " +
-          ", ".join(f"{k} {v:.1e}" for k, v in errors.items()))  # fmt: skip
+    print(
+        f"{separation}, {len(cases)} cases ({', '.join(sorted(endings))}): "
+        + ", ".join(f"{k} {v:.1e}" for k, v in errors.items())
+    )
     limits = dict(e=1e-9, T=1e-9, x_max=1e-9, t_max=1e-9, F_max=1e-9, x_end=1e-9, T_rest=1e-7)
     for key, limit in limits.items():
         assert errors[key] <= limit, f"{separation}: {key} off by {errors[key]:.2e}"
@@ -280,8 +296,13 @@ def test_matches_scipy_near_the_capture_threshold(separation):
 def _fd_rows(points, h):
     rows = []
     for c, b, m, v0, g in points:
-        rows += [(c, b, m, v0, g), (c * (1 + h), b, m, v0, g), (c * (1 - h), b, m, v0, g),
-                 (c, b * (1 + h), m, v0, g), (c, b * (1 - h), m, v0, g)]  # fmt: skip
+        rows += [
+            (c, b, m, v0, g),
+            (c * (1 + h), b, m, v0, g),
+            (c * (1 - h), b, m, v0, g),
+            (c, b * (1 + h), m, v0, g),
+            (c, b * (1 - h), m, v0, g),
+        ]
     return rows
 
 
@@ -436,9 +457,15 @@ FIELDS = ("impact_times", "release_times", "e", "T", "release_heights", "x_max",
 
 def _drop(name, params, separation, method, **options):
     return ji.bounce(
-        ji.law(name, **params), m=1.0, h0=0.6, t_end=3.0, separation=separation,
-        max_impacts=16, method=method, **options,
-    )  # fmt: skip
+        ji.law(name, **params),
+        m=1.0,
+        h0=0.6,
+        t_end=3.0,
+        separation=separation,
+        max_impacts=16,
+        method=method,
+        **options,
+    )
 
 
 def check_drop(name, params, separation):
@@ -512,18 +539,33 @@ def test_no_gravity_compiles_without_gravitys_formulas(where, monkeypatch):
     monkeypatch.setattr(calibrate, "solve_impact", solve_impact.__wrapped__)
     law = ji.law("maxwell", c=2.7e4, b=200.0)
     options = dict(
-        separation="force", closed_form=True, solver=None, rtol=1e-11, atol=1e-11,
-        max_steps=4096, tau_max=1e4, rest_tol=1e-7, adjoint=None, peaks=True,
-    )  # fmt: skip
+        separation="force",
+        closed_form=True,
+        solver=None,
+        rtol=1e-11,
+        atol=1e-11,
+        max_steps=4096,
+        tau_max=1e4,
+        rest_tol=1e-7,
+        adjoint=None,
+        peaks=True,
+    )
     solve = solve_impact.__wrapped__
     if where == "impact":
         no_gravity = ji.ImpactOptions(**options, gravity=False)
         jax.eval_shape(lambda v, g: solve(law, 0.0027, v, g, None, no_gravity).e, 1.0, 0.0)
     else:
         raw = calibrate._residual_function(
-            law, ("b", "c"), m=0.0027, separation="force", g=0.0, rtol=1e-10, has_e=True,
-            has_T=False, closed_form=True,
-        )  # fmt: skip
+            law,
+            ("b", "c"),
+            m=0.0027,
+            separation="force",
+            g=0.0,
+            rtol=1e-10,
+            has_e=True,
+            has_T=False,
+            closed_form=True,
+        )
         data = (jnp.ones(2), jnp.ones(2), jnp.full(2, jnp.nan), jnp.ones(2), jnp.ones(2))
         jax.eval_shape(lambda t: value_and_jacobian(raw, t, data), jnp.zeros(2))
     # with gravity the formulas are traced (the check above can fail)

@@ -94,15 +94,17 @@ def test_a_microsphere_in_SI_units_and_the_integrated_path():
 def test_without_adhesion_it_is_law_14_and_with_it_law_14_under_gravity():
     base = dict(c=2e6, b=800.0)
     plain = ji.impact(ji.law("dmt", **base, R=0.01, w=0.0), m=1.0, v0=2.5)
-    law14 = ji.impact(ji.law("hertz_rate", c=2e6, b1=800.0), m=1.0, v0=2.5,
-                      separation="penetration")  # fmt: skip
+    law14 = ji.impact(
+        ji.law("hertz_rate", c=2e6, b1=800.0), m=1.0, v0=2.5, separation="penetration"
+    )
     for field in (*FIELDS, "t_max"):
         assert float(getattr(plain, field)) == pytest.approx(float(getattr(law14, field)), rel=TOL)
     # an adhesion of 2 pi w R = 2000 N on 1 kg is a gravity of 2000 m/s^2 inside the contact
     w = 2000.0 / (2 * math.pi * 0.01)
     dmt = ji.impact(ji.law("dmt", **base, R=0.01, w=w), m=1.0, v0=2.5)
-    pulled = ji.impact(ji.law("hertz_rate", c=2e6, b1=800.0), m=1.0, v0=2.5, g=2000.0,
-                       separation="penetration")  # fmt: skip
+    pulled = ji.impact(
+        ji.law("hertz_rate", c=2e6, b1=800.0), m=1.0, v0=2.5, g=2000.0, separation="penetration"
+    )
     for field in ("e", "T", "x_max", "t_max"):
         assert float(getattr(dmt, field)) == pytest.approx(float(getattr(pulled, field)), rel=TOL)
     assert float(dmt.F_max) == pytest.approx(float(pulled.F_max) - 2000.0, rel=TOL)
@@ -140,8 +142,13 @@ def test_gradients_match_central_differences():
     fd = []
     for i in range(4):
         h = float(x[i]) * 1e-4
-        fd.append((outputs(x.at[i].add(h), "integrate", 1e-12)
-                   - outputs(x.at[i].add(-h), "integrate", 1e-12)) / (2 * h))  # fmt: skip
+        fd.append(
+            (
+                outputs(x.at[i].add(h), "integrate", 1e-12)
+                - outputs(x.at[i].add(-h), "integrate", 1e-12)
+            )
+            / (2 * h)
+        )
     fd = np.stack(fd, axis=1)
     scale = np.abs(fd).max(axis=1, keepdims=True)
     assert np.max(np.abs(np.asarray(jac) - fd) / scale) < 1e-6

@@ -63,8 +63,16 @@ def scipy_jkr(c, R, w, m, v0, g=0.0, rtol=1e-13, b=0.0):
         return y[1]
 
     turn.terminal, turn.direction = True, -1
-    first = solve_ivp(rhs, (0, 100), [0, 1], method="DOP853", rtol=rtol, atol=1e-15, events=turn,
-                      dense_output=True)  # fmt: skip
+    first = solve_ivp(
+        rhs,
+        (0, 100),
+        [0, 1],
+        method="DOP853",
+        rtol=rtol,
+        atol=1e-15,
+        events=turn,
+        dense_output=True,
+    )
     t_m, (X_m, _) = first.t_events[0][0], first.y_events[0][0]
 
     def pull_off(t, y):
@@ -75,8 +83,15 @@ def scipy_jkr(c, R, w, m, v0, g=0.0, rtol=1e-13, b=0.0):
 
     pull_off.terminal, pull_off.direction = True, -1
     back.terminal, back.direction = True, 1
-    second = solve_ivp(rhs, (t_m, t_m + 100), [X_m, 0.0], method="DOP853", rtol=rtol,
-                       atol=1e-15, events=[pull_off, back])  # fmt: skip
+    second = solve_ivp(
+        rhs,
+        (t_m, t_m + 100),
+        [X_m, 0.0],
+        method="DOP853",
+        rtol=rtol,
+        atol=1e-15,
+        events=[pull_off, back],
+    )
     if second.t_events[0].size:
         t_end, e = second.t_events[0][0], -second.y_events[0][0][1]
     else:
@@ -87,8 +102,12 @@ def scipy_jkr(c, R, w, m, v0, g=0.0, rtol=1e-13, b=0.0):
     k = int(np.argmax(forces))
     F_max = forces[-1]
     if 0 < k < grid.size - 1:
-        peak = minimize_scalar(lambda t: -force(*first.sol(t)), bounds=(grid[k - 1], grid[k + 1]),
-                               method="bounded", options=dict(xatol=1e-14))  # fmt: skip
+        peak = minimize_scalar(
+            lambda t: -force(*first.sol(t)),
+            bounds=(grid[k - 1], grid[k + 1]),
+            method="bounded",
+            options=dict(xatol=1e-14),
+        )
         F_max = max(-peak.fun, F_max)
     return dict(e=e, T=t_end * ts, x_max=X_m * xs, F_max=F_max * fs, t_max=t_m * ts)
 
@@ -227,8 +246,12 @@ def test_without_damping_it_is_jkr():
     law = damped()
     x_f = -0.75 * (math.pi**2 * W**2 * R / E_STAR**2) ** (1 / 3)
     for x, v in ((1e-9, 0.3), (0.999 * x_f, -0.2), (0.0, 1.0)):  # damping b a / R^0.5 v
-        a = brentq(lambda a, x=x: a * a / R - math.sqrt(2 * math.pi * W * a / E_STAR) - x,
-                   (math.pi * W * R**2 / (8 * E_STAR)) ** (1 / 3), 1e-5, xtol=1e-300)  # fmt: skip
+        a = brentq(
+            lambda a, x=x: a * a / R - math.sqrt(2 * math.pi * W * a / E_STAR) - x,
+            (math.pi * W * R**2 / (8 * E_STAR)) ** (1 / 3),
+            1e-5,
+            xtol=1e-300,
+        )
         extra = float(law.force(x, v)) - float(LAW.force(x, v))
         assert extra == pytest.approx(B * a / math.sqrt(R) * v, rel=1e-9)
 

@@ -183,8 +183,7 @@ def test_many_values_through_vmap_and_the_batches():
     `impact_batch` takes the arrays as rows."""
     cs = jnp.array([1e6, 2e6])
     law_e = jax.vmap(lambda c: ji.impact(ji.law("hertz_rate", c=c, b1=800.0), m=1.0, v0=2.5).e)
-    batch = ji.impact_batch("hertz_rate", {"c": cs, "b1": 800.0}, m=1.0, v0=2.5,
-                            progress=False)  # fmt: skip
+    batch = ji.impact_batch("hertz_rate", {"c": cs, "b1": 800.0}, m=1.0, v0=2.5, progress=False)
     assert_rel(law_e(cs), batch["e"], 1e-12, "vmap vs impact_batch")
 
 

@@ -49,8 +49,9 @@ def test_a_batch_equals_the_impacts_one_by_one(name):
 
 def test_cli_simulates_and_calibrates_thornton(capsys):
     params = ["--param", f"c={C!r}", f"x_y={X_Y!r}", "--mass", f"{M!r}"]
-    status, out, err = run_cli(capsys, ["simulate", "--law", "thornton", *params,
-                                        "--v0", "0.5", "1", "2", "--json"])  # fmt: skip
+    status, out, err = run_cli(
+        capsys, ["simulate", "--law", "thornton", *params, "--v0", "0.5", "1", "2", "--json"]
+    )
     assert status == 0, err
     import json
 
@@ -60,8 +61,9 @@ def test_cli_simulates_and_calibrates_thornton(capsys):
     # x_y from e at one speed, c held: the yield overlap back
     e = want[1]
     start = ["--param", f"c={C!r}", f"x_y={2 * X_Y!r}", "--mass", f"{M!r}"]
-    status, out, err = run_cli(capsys, ["calibrate", "--law", "thornton", *start,
-                                        "--v0", "1", "--e", f"{e!r}", "--json"])  # fmt: skip
+    status, out, err = run_cli(
+        capsys, ["calibrate", "--law", "thornton", *start, "--v0", "1", "--e", f"{e!r}", "--json"]
+    )
     assert status == 0, err
     fit = json.loads(out)
     assert fit["params"]["x_y"] == pytest.approx(X_Y, rel=1e-6)

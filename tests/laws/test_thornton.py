@@ -39,8 +39,15 @@ def scipy_thornton(c, x_y, m, v0, g=0.0, separation="force", rtol=1e-13):
         return y[1]
 
     stop.terminal, stop.direction = True, -1
-    first = solve_ivp(lambda t, y: [y[1], -loading(max(y[0], 0.0)) + gam], (0, 100), [0, 1],
-                      method="DOP853", rtol=rtol, atol=1e-15, events=stop)  # fmt: skip
+    first = solve_ivp(
+        lambda t, y: [y[1], -loading(max(y[0], 0.0)) + gam],
+        (0, 100),
+        [0, 1],
+        method="DOP853",
+        rtol=rtol,
+        atol=1e-15,
+        events=stop,
+    )
     t_m, (X_m, _) = first.t_events[0][0], first.y_events[0][0]
     F_m = loading(X_m)
     c_p = math.sqrt(X_m**1.5 / F_m)
@@ -53,17 +60,32 @@ def scipy_thornton(c, x_y, m, v0, g=0.0, separation="force", rtol=1e-13):
         return y[0] - (X_p if separation == "force" else 0.0)
 
     leave.terminal, leave.direction = True, -1
-    second = solve_ivp(unloading, (t_m, t_m + 100), [X_m, 0.0], method="DOP853", rtol=rtol,
-                       atol=1e-15, events=leave)  # fmt: skip
+    second = solve_ivp(
+        unloading,
+        (t_m, t_m + 100),
+        [X_m, 0.0],
+        method="DOP853",
+        rtol=rtol,
+        atol=1e-15,
+        events=leave,
+    )
     t_end, (_, V_end) = second.t_events[0][0], second.y_events[0][0]
     return dict(e=-V_end, T=t_end * ts, x_max=X_m * xs, F_max=F_m * fs, t_max=t_m * ts)
 
 
 @pytest.mark.parametrize(
     "ratio, e",
-    [(1.5, 0.971239), (2, 0.930626), (3, 0.862740), (5, 0.773337), (10, 0.658558),
-     (30, 0.504389), (100, 0.374299), (1000, 0.210701)],
-)  # fmt: skip
+    [
+        (1.5, 0.971239),
+        (2, 0.930626),
+        (3, 0.862740),
+        (5, 0.773337),
+        (10, 0.658558),
+        (30, 0.504389),
+        (100, 0.374299),
+        (1000, 0.210701),
+    ],
+)
 def test_restitution_is_thorntons_formula_and_the_published_table(ratio, e):
     """The table of shared/notes/contact-physics.md, 2.1 (formula = model, 6 digits), from
     the impact itself (its closed form) and from the formula."""
@@ -120,8 +142,9 @@ def test_gradients_match_central_differences(method, ratio):
     v0 = ratio * V_Y
 
     def outputs(params):
-        r = ji.impact(ji.law("thornton", c=params[0], x_y=params[1]), m=M, v0=v0,
-                      method=method, peaks=False)  # fmt: skip
+        r = ji.impact(
+            ji.law("thornton", c=params[0], x_y=params[1]), m=M, v0=v0, method=method, peaks=False
+        )
         return jnp.stack([r.e, r.T])
 
     p = jnp.array([C, X_Y])
@@ -169,8 +192,9 @@ def test_bridges_ice_e_of_v_picks_the_plastic_law():
     R_ice = 0.0275
     m = 917.0 * 4.0 / 3.0 * math.pi * R_ice**3
     c = ji.hertz_stiffness(E=9e9, nu=0.33, R=R_ice, E2=math.inf)
-    fit = ji.calibrate(ji.law("thornton", c=c, x_y=1e-7), m=m, v0=BRIDGES_V, e=BRIDGES_E,
-                       free=("x_y",))  # fmt: skip
+    fit = ji.calibrate(
+        ji.law("thornton", c=c, x_y=1e-7), m=m, v0=BRIDGES_V, e=BRIDGES_E, free=("x_y",)
+    )
     rms = float(np.sqrt(np.mean((np.asarray(fit.e) - BRIDGES_E) ** 2)))
     v_y = float(fit.law.yield_speed(m))
     print(f"thornton RMS {rms:.5f}, v_y = {v_y * 1e3:.4f} mm/s")

@@ -24,10 +24,29 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 
-def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_star=None,
-                   history="displacement", beta=0.0, rtol=1e-12, max_switches=40,
-                   share=0.0, b_tsuji=0.0, kelvin_voigt=None, end="penetration",
-                   rescale=False):  # fmt: skip
+def oblique_oracle(
+    *,
+    c,
+    a=0.0,
+    m,
+    R,
+    inertia,
+    v_n,
+    v_t,
+    omega,
+    mu,
+    kt=None,
+    G_star=None,
+    history="displacement",
+    beta=0.0,
+    rtol=1e-12,
+    max_switches=40,
+    share=0.0,
+    b_tsuji=0.0,
+    kelvin_voigt=None,
+    end="penetration",
+    rescale=False,
+):
     """Returns dict(e, v_t_out, omega_out, T, switches). `beta` (Mindlin only): the damper
     `2 (5/6)^0.5 beta (m k_t)^0.5` on the slip while sticking, left out of Coulomb's test
     (LIGGGHTS' convention), so the switches are the undamped ones' formulas. `share` f: the
@@ -173,9 +192,17 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
                 return slide_rate(y, s)
 
         ev_switch.terminal, ev_switch.direction = True, -1
-        sol = solve_ivp(rhs, (t, 1e3 * T_scale), state, method="DOP853", rtol=rtol,
-                        atol=1e-14 * np.maximum(1.0, np.abs(state)), args=(mode, s),
-                        events=(ev_sep, ev_switch), dense_output=False)  # fmt: skip
+        sol = solve_ivp(
+            rhs,
+            (t, 1e3 * T_scale),
+            state,
+            method="DOP853",
+            rtol=rtol,
+            atol=1e-14 * np.maximum(1.0, np.abs(state)),
+            args=(mode, s),
+            events=(ev_sep, ev_switch),
+            dense_output=False,
+        )
         if sol.t_events[0].size:
             t_end, y_end = sol.t_events[0][0], sol.y_events[0][0]
             return dict(
@@ -191,8 +218,9 @@ def oblique_oracle(*, c, a=0.0, m, R, inertia, v_n, v_t, omega, mu, kt=None, G_s
             # within 1e-12 of the overlap's scale, where the spring's force, `(R x)^0.5`
             # small, gives no impulse that counts; the last x travels at the speed reached
             t_end, y_end = sol.t[-1] + x_last / abs(sol.y[1, -1]), sol.y[:, -1]
-            return dict(e=-y_end[1] / v_n, v_t_out=y_end[3], omega_out=y_end[4], T=t_end,
-                        switches=switches)  # fmt: skip
+            return dict(
+                e=-y_end[1] / v_n, v_t_out=y_end[3], omega_out=y_end[4], T=t_end, switches=switches
+            )
         assert sol.t_events[1].size, (
             f"oracle: the contact neither ended nor switched ({sol.message} at x = "
             f"{x_last:.3e}, mode {mode})"

@@ -126,9 +126,16 @@ def sweep_4(name="mindlin", anvil=None, thetas=None):
         v_n, v_t = (float(v) for v in incidence(3.9, np.deg2rad(theta)))
         r = oblique_impact(law, tl, m=m, R=R, v_n=v_n, v_t=v_t)
         assert r.status_name == "separated"
-        rows.append((float(r.e), float(r.e_t), -float(r.omega_out),
-                     np.rad2deg(float(r.angle_out_contact)), np.rad2deg(float(r.angle_out)),
-                     int(r.num_switches)))  # fmt: skip
+        rows.append(
+            (
+                float(r.e),
+                float(r.e_t),
+                -float(r.omega_out),
+                np.rad2deg(float(r.angle_out_contact)),
+                np.rad2deg(float(r.angle_out)),
+                int(r.num_switches),
+            )
+        )
     return np.array(rows)
 
 
@@ -200,8 +207,10 @@ def test5_gross_sliding_plateau():
     the rigid -2.5 (1 + e) = -5 (the reference's sign) to 1e-9; the digitised curves
     (-5.004, -4.991 steel; -4.963, -4.942 polyethylene at psi = 10, 20) within 0.06."""
     R, v_n, mu = 1e-5, 5.0, 0.3
-    for material, digitised in (((208e9, 0.30, 7850.0), (-5.004, -4.991)),
-                                ((1e9, 0.40, 1400.0), (-4.963, -4.942))):  # fmt: skip
+    for material, digitised in (
+        ((208e9, 0.30, 7850.0), (-5.004, -4.991)),
+        ((1e9, 0.40, 1400.0), (-4.963, -4.942)),
+    ):
         m, c, G = sphere(*material, R)
         tl = tangential_law("mindlin", G=G, nu=material[1], mu=mu)
         law = ji.law("hunt_crossley", c=c, a=0.0)
@@ -215,10 +224,20 @@ def test5_gross_sliding_plateau():
 
 # Test 6 (Al alloy, R = 0.1 m, V_n = 0.2 m/s, mu = 0.4, e = 0.5, spin only): beta against
 # x = 3.5 mu (1 + e) V_n / V_st, the first points of Kratos' benchmark8_graph1 "Test 6"
-X_6 = [0.18716577540106982, 0.35828877005347604, 0.550802139037434, 0.764705882352942,
-       0.97860962566845]  # fmt: skip
-BETA_6 = [-0.8152230971128611, -0.6262467191601051, -0.43937007874015754,
-          -0.23779527559055114, -0.017322834645669194]  # fmt: skip
+X_6 = [
+    0.18716577540106982,
+    0.35828877005347604,
+    0.550802139037434,
+    0.764705882352942,
+    0.97860962566845,
+]
+BETA_6 = [
+    -0.8152230971128611,
+    -0.6262467191601051,
+    -0.43937007874015754,
+    -0.23779527559055114,
+    -0.017322834645669194,
+]
 
 
 def test6_gross_sliding_branch():
@@ -295,8 +314,9 @@ def hunt_crossley_a(e, v):
     `-alpha e - ln(1 - alpha e) = alpha - ln(1 + alpha)`, `alpha = 1.5 a v`."""
     from scipy.optimize import brentq
 
-    alpha = brentq(lambda a: -a * e - np.log1p(-a * e) - a + np.log1p(a), 1e-6, 1.0 / e - 1e-9,
-                   xtol=1e-15)  # fmt: skip
+    alpha = brentq(
+        lambda a: -a * e - np.log1p(-a * e) - a + np.log1p(a), 1e-6, 1.0 / e - 1e-9, xtol=1e-15
+    )
     return alpha / (1.5 * v)
 
 
@@ -342,8 +362,7 @@ def test7_two_identical_spheres_spinning(material):
 
     slid = 0
     for omega0 in OMEGA_7:
-        p1, p2 = contact_velocities(V_7 * X_HAT, omega0 * Y_HAT, -V_7 * X_HAT, -omega0 * Y_HAT,
-                                    R_7)  # fmt: skip
+        p1, p2 = contact_velocities(V_7 * X_HAT, omega0 * Y_HAT, -V_7 * X_HAT, -omega0 * Y_HAT, R_7)
         assert np.allclose(p1[1:], [0.0, -omega0 * R_7]) and np.allclose(p2[1:], p1[1:])
         spheres, slip_out, r, inputs = two_spinning_spheres(MATERIALS_7[material], omega0, -omega0)
         assert inputs["v_t"] == 0.0 and inputs["omega"] == 0.0
@@ -362,17 +381,34 @@ def test7_two_identical_spheres_spinning(material):
         assert spheres[3] == pytest.approx(spheres[1], rel=1e-15)
         assert slip_out == pytest.approx(float(r.u_out), rel=1e-12, abs=1e-15)
         assert abs(float(r.impulse_t)) <= MU_7 * float(r.impulse_n) * (1 + 1e-9)
-        o = oblique_oracle(c=inputs["c"], a=float(hunt_crossley_a(E_7, 2 * V_7)),
-                           m=inputs["m"], R=inputs["R"], inertia=inputs["inertia"],
-                           v_n=inputs["v_n"], v_t=0.0, omega=inputs["omega"], mu=MU_7,
-                           G_star=inputs["G_star"])  # fmt: skip
+        o = oblique_oracle(
+            c=inputs["c"],
+            a=float(hunt_crossley_a(E_7, 2 * V_7)),
+            m=inputs["m"],
+            R=inputs["R"],
+            inertia=inputs["inertia"],
+            v_n=inputs["v_n"],
+            v_t=0.0,
+            omega=inputs["omega"],
+            mu=MU_7,
+            G_star=inputs["G_star"],
+        )
         assert int(r.num_switches) == o["switches"], omega0
         # in units of the slip in, 2 omega0 R (omega_out nearly vanishes at small omega0)
-        errors = (abs(float(r.v_t_out) - o["v_t_out"]),
-                  inputs["R"] * abs(float(r.omega_out) - o["omega_out"]))  # fmt: skip
+        errors = (
+            abs(float(r.v_t_out) - o["v_t_out"]),
+            inputs["R"] * abs(float(r.omega_out) - o["omega_out"]),
+        )
         assert max(errors) <= 1e-8 * 2 * omega0 * R_7, omega0
-        rigid = rigid_oblique(mu=MU_7, e=float(r.e), v_n=inputs["v_n"], v_t=0.0, R=inputs["R"],
-                              omega=inputs["omega"], inertia=inputs["inertia"])  # fmt: skip
+        rigid = rigid_oblique(
+            mu=MU_7,
+            e=float(r.e),
+            v_n=inputs["v_n"],
+            v_t=0.0,
+            R=inputs["R"],
+            omega=inputs["omega"],
+            inertia=inputs["inertia"],
+        )
         if omega0 > 4.2:
             assert bool(rigid["sliding"]) and int(r.num_switches) == 0
             slid += 1
@@ -395,9 +431,11 @@ def test_coulomb_bound_everywhere():
     R = 2.5e-3
     m, c, G = sphere(*ALUMINA, R)
     law = ji.law("tsuji", c=c, b=tsuji_damping(0.98, c, m, 3.9))
-    for tl in (tangential_law("mindlin", G=G, nu=ALUMINA[1], mu=0.092),
-               tangential_law("mindlin_force", G=G, nu=ALUMINA[1], mu=0.092),
-               tangential_law("linear_history", kt=1e9, mu=0.092)):  # fmt: skip
+    for tl in (
+        tangential_law("mindlin", G=G, nu=ALUMINA[1], mu=0.092),
+        tangential_law("mindlin_force", G=G, nu=ALUMINA[1], mu=0.092),
+        tangential_law("linear_history", kt=1e9, mu=0.092),
+    ):
         for theta in np.linspace(1.0, 89.0, 23):
             v_n, v_t = (float(v) for v in incidence(3.9, np.deg2rad(theta)))
             r = oblique_impact(law, tl, m=m, R=R, v_n=v_n, v_t=v_t)

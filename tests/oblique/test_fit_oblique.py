@@ -31,8 +31,7 @@ def test_fit_input_checks():
     with pytest.raises(ValueError, match="e_t has 3 values where v_n has 6"):
         fit_oblique(LAW, tl, **base, e_t=np.ones(3))
     with pytest.raises(ValueError, match="start value of mu must be a finite number > 0"):
-        fit_oblique(LAW, tangential_law("linear_history", kt=1e7, mu=0.0), **base,
-                    e_t=np.ones(6))  # fmt: skip
+        fit_oblique(LAW, tangential_law("linear_history", kt=1e7, mu=0.0), **base, e_t=np.ones(6))
     with pytest.raises(ValueError, match="takes the normal law first"):
         fit_oblique(tl, tl, **base, e_t=np.ones(6))
 
@@ -61,11 +60,13 @@ def test_recovers_linear_history_from_e_t_alone_with_both_starts_off():
     law = ji.law("hertz_rate", c=4.2e9, b1=1e4)
     truth = tangential_law("linear_history", kt=1e7, mu=0.092)
     v_t = np.linspace(0.3, 3.0, 5)
-    e_t = np.array([float(oblique_impact(law, truth, m=2.6e-4, R=2.5e-3, v_n=3.0, v_t=v).e_t)
-                    for v in v_t])  # fmt: skip
+    e_t = np.array(
+        [float(oblique_impact(law, truth, m=2.6e-4, R=2.5e-3, v_n=3.0, v_t=v).e_t) for v in v_t]
+    )
     start = tangential_law("linear_history", kt=3e6, mu=0.2)
-    fit = fit_oblique(law, start, m=2.6e-4, R=2.5e-3, v_n=np.full(5, 3.0), v_t=v_t, e_t=e_t,
-                      free=("kt", "mu"))  # fmt: skip
+    fit = fit_oblique(
+        law, start, m=2.6e-4, R=2.5e-3, v_n=np.full(5, 3.0), v_t=v_t, e_t=e_t, free=("kt", "mu")
+    )
     assert bool(fit.converged) and float(fit.rms_e_t) < 1e-8
     assert float(fit.params["kt"]) == pytest.approx(1e7, rel=1e-7)
     assert float(fit.params["mu"]) == pytest.approx(0.092, rel=1e-7)
@@ -79,8 +80,9 @@ def test_recovers_mindlin_with_noise():
     e_t, _ = rebounds(tangential_law("mindlin", G_star=g_star, mu=0.092))
     noisy = e_t + 0.003 * np.random.default_rng(7).standard_normal(e_t.shape)
     start = tangential_law("mindlin", G_star=0.5 * g_star, mu=0.12)
-    fit = fit_oblique(LAW, start, m=M, R=R, v_n=V_N, v_t=V_T, e_t=noisy, sigma_e_t=0.003,
-                      free=("G_star", "mu"))  # fmt: skip
+    fit = fit_oblique(
+        LAW, start, m=M, R=R, v_n=V_N, v_t=V_T, e_t=noisy, sigma_e_t=0.003, free=("G_star", "mu")
+    )
     assert bool(fit.converged)
     for name, truth in (("G_star", g_star), ("mu", 0.092)):
         value, se = float(fit.params[name]), float(fit.stderr[name])
@@ -91,10 +93,25 @@ def test_recovers_mindlin_with_noise():
 # Kharaz, Gorham & Salman (2001), Powder Technol. 120:281, doi:10.1016/S0032-5910(01)00283-2:
 # 5 mm alumina spheres on soda-lime glass at 3.9 m/s, as Lethe digitised them (notes 4.2):
 # incidence (deg) and e_t; incidence and the spin after impact (rad/s)
-KHARAZ_E_T = [(1.84, 0.793), (3.70, 0.745), (9.50, 0.673), (20.01, 0.597), (30.13, 0.688),
-              (39.38, 0.771), (49.69, 0.848), (60.02, 0.901)]  # fmt: skip
-KHARAZ_SPIN = [(6.14, 136.0), (10.99, 266.0), (21.25, 578.0), (31.16, 613.0), (39.14, 595.0),
-               (50.35, 453.0), (60.33, 382.0)]  # fmt: skip
+KHARAZ_E_T = [
+    (1.84, 0.793),
+    (3.70, 0.745),
+    (9.50, 0.673),
+    (20.01, 0.597),
+    (30.13, 0.688),
+    (39.38, 0.771),
+    (49.69, 0.848),
+    (60.02, 0.901),
+]
+KHARAZ_SPIN = [
+    (6.14, 136.0),
+    (10.99, 266.0),
+    (21.25, 578.0),
+    (31.16, 613.0),
+    (39.14, 595.0),
+    (50.35, 453.0),
+    (60.33, 382.0),
+]
 GLASS = (70e9, 0.25)
 
 
@@ -128,8 +145,9 @@ def test_fits_kharaz_measurements():
     law, theta, e_t, spin, g_star = kharaz_problem()
     v_n, v_t = (np.asarray(v) for v in incidence(3.9, np.deg2rad(theta)))
     start = tangential_law("mindlin", G_star=g_star, mu=0.092)
-    fit = fit_oblique(law, start, m=M, R=R, v_n=v_n, v_t=v_t, e_t=e_t, omega_out=spin,
-                      free=("G_star", "mu"))  # fmt: skip
+    fit = fit_oblique(
+        law, start, m=M, R=R, v_n=v_n, v_t=v_t, e_t=e_t, omega_out=spin, free=("G_star", "mu")
+    )
     print(fit)
     assert bool(fit.converged)
     assert abs(float(fit.params["mu"]) - 0.092) < 0.01
@@ -161,8 +179,17 @@ def test_fit_oblique_finds_the_mindlin_damper():
     ]
     e_t = np.array([float(r.e_t) for r in made])
     omega_out = np.array([float(r.omega_out) for r in made])
-    fit = ji.fit_oblique(law, truth.replace(beta=0.1, mu=0.08), m=m, R=R, v_n=v_n, v_t=v_t,
-                         e_t=e_t, omega_out=omega_out, free=("mu", "beta"))  # fmt: skip
+    fit = ji.fit_oblique(
+        law,
+        truth.replace(beta=0.1, mu=0.08),
+        m=m,
+        R=R,
+        v_n=v_n,
+        v_t=v_t,
+        e_t=e_t,
+        omega_out=omega_out,
+        free=("mu", "beta"),
+    )
     assert bool(fit.converged)
     assert float(fit.params["mu"]) == pytest.approx(0.092, rel=1e-8)
     assert float(fit.params["beta"]) == pytest.approx(0.3, rel=1e-8)
@@ -177,8 +204,10 @@ def test_a_fit_with_the_engine_s_contact_point():
     soft = ji.law("hunt_crossley", c=C / 300.0, a=0.01)
     truth = tangential_law("linear_history", kt=5e5, mu=0.15)
     pairs = list(zip(V_N, V_T, strict=True))
-    made = [oblique_impact(soft, truth, m=M, R=R, v_n=a, v_t=b, contact_point="midpoint")
-            for a, b in pairs]  # fmt: skip
+    made = [
+        oblique_impact(soft, truth, m=M, R=R, v_n=a, v_t=b, contact_point="midpoint")
+        for a, b in pairs
+    ]
     e_t = np.array([float(r.e_t) for r in made])
     start = tangential_law("linear_history", kt=3e5, mu=0.1)
     base = dict(m=M, R=R, v_n=V_N, v_t=V_T, e_t=e_t)
@@ -234,8 +263,12 @@ class _LinearStandIn:
         def refine(problem, start, max_steps, tol):
             end = self.theta_fit if refine_to is None else np.asarray(start)
             r = self.r0 + (end - self.theta_fit) @ self.jacobian.T
-            return (jnp.asarray(end), jnp.asarray(True), jnp.asarray(3),
-                    (jnp.asarray(r), jnp.asarray(self.jacobian), result))  # fmt: skip
+            return (
+                jnp.asarray(end),
+                jnp.asarray(True),
+                jnp.asarray(3),
+                (jnp.asarray(r), jnp.asarray(self.jacobian), result),
+            )
 
         monkeypatch.setattr(module, "_evaluate", evaluate)
         monkeypatch.setattr(module, "_refine", refine)
@@ -249,8 +282,18 @@ def test_goodness_of_fit_keeps_e_t_and_spin_apart(monkeypatch):
     e_t = np.array([0.6, 0.7, 0.8, 0.9])
     spin = np.array([-300.0, -200.0, -100.0, -50.0])
     r0 = np.array([1.0, -1.0, 1.0, -1.0, 2.0, -2.0, 2.0, -2.0])  # in units of the sigmas
-    jacobian = np.array([[1.0, 0.5], [0.2, 1.0], [0.3, -0.4], [1.0, 1.0],
-                         [0.5, 2.0], [1.0, 0.0], [0.0, 1.0], [2.0, 1.0]])  # fmt: skip
+    jacobian = np.array(
+        [
+            [1.0, 0.5],
+            [0.2, 1.0],
+            [0.3, -0.4],
+            [1.0, 1.0],
+            [0.5, 2.0],
+            [1.0, 0.0],
+            [0.0, 1.0],
+            [2.0, 1.0],
+        ]
+    )
     theta = np.log([2e7, 0.2])
     sigma_e, sigma_w = 0.01, 20.0
     predicted = {"e_t": e_t + r0[:4] * sigma_e, "omega": spin + r0[4:] * sigma_w}
@@ -286,8 +329,9 @@ def test_a_grid_point_below_the_fit_is_not_converged(monkeypatch):
     e_t = np.full(6, 0.7)
     theta = np.log([5e7, 0.15])
     jacobian = np.column_stack([np.linspace(1.0, 2.0, 6), np.linspace(-1.0, 1.0, 6)])
-    _LinearStandIn(monkeypatch, np.zeros(6), jacobian, theta, {"e_t": e_t, "omega": e_t},
-                   refine_to="start")  # fmt: skip
+    _LinearStandIn(
+        monkeypatch, np.zeros(6), jacobian, theta, {"e_t": e_t, "omega": e_t}, refine_to="start"
+    )
     start = tangential_law("linear_history", kt=5e6, mu=0.15)
     with pytest.warns(UserWarning) as given:  # (the stand-in's flat loss bounds neither)
         fit = fit_oblique(LAW, start, m=M, R=R, v_n=V_N, v_t=V_T, e_t=e_t, max_starts=1)
@@ -316,14 +360,33 @@ def test_fit_oblique_takes_the_normal_law_from_a_calibrate_json(capsys, tmp_path
         raise ValueError("the stand-in fit")
 
     monkeypatch.setattr(oblique, "fit_oblique", stand_in)
-    fit = {"law": "tsuji", "params": {"c": 4.2e9, "b": 15.0}, "m": 2.618e-4,
-           "separation": "force", "converged": True, "rows": [{"v0": 3.9}]}  # fmt: skip
+    fit = {
+        "law": "tsuji",
+        "params": {"c": 4.2e9, "b": 15.0},
+        "m": 2.618e-4,
+        "separation": "force",
+        "converged": True,
+        "rows": [{"v0": 3.9}],
+    }
     path = tmp_path / "fit.json"
     path.write_text(json.dumps(fit))
     rebounds = tmp_path / "rebounds.csv"
     rebounds.write_text("theta_deg,e_t\n10,0.6\n20,0.55\n30,0.6\n")
-    argv = ["fit-oblique", str(rebounds), "--speed", "3.9", "--mass", "2.618e-4", "--radius",
-            "2.5e-3", "--tangential", "mindlin", "--tparam", "G_star=1e10", "mu=0.1"]  # fmt: skip
+    argv = [
+        "fit-oblique",
+        str(rebounds),
+        "--speed",
+        "3.9",
+        "--mass",
+        "2.618e-4",
+        "--radius",
+        "2.5e-3",
+        "--tangential",
+        "mindlin",
+        "--tparam",
+        "G_star=1e10",
+        "mu=0.1",
+    ]
     status, out, err = run_cli(capsys, [*argv, "--from", str(path)])
     assert status == 2 and "the stand-in fit" in err
     assert seen["law"].name == "tsuji" and float(seen["law"].parameters["b"]) == 15.0
@@ -384,13 +447,15 @@ def test_mu_of_sticking_impacts_is_a_lower_bound():
     g_star = E / (2 * (1 + NU)) / (2 - NU)
     truth = tangential_law("mindlin", G_star=g_star, mu=0.55)
     v_n, v_t = (np.asarray(v) for v in incidence(3.9, np.deg2rad(np.linspace(2.0, 16.0, 8))))
-    made = [oblique_impact(LAW, truth, m=M, R=R, v_n=a, v_t=b)
-            for a, b in zip(v_n, v_t, strict=True)]  # fmt: skip
+    made = [
+        oblique_impact(LAW, truth, m=M, R=R, v_n=a, v_t=b) for a, b in zip(v_n, v_t, strict=True)
+    ]
     e_t = np.array([float(r.e_t) for r in made])
     start = truth.replace(G_star=0.8 * g_star, mu=0.4)
     with pytest.warns(UserWarning, match="mu is bounded on one side only"):
-        fit = fit_oblique(LAW, start, m=M, R=R, v_n=v_n, v_t=v_t, e_t=e_t, sigma_e_t=0.01,
-                          start_scan=0)  # fmt: skip
+        fit = fit_oblique(
+            LAW, start, m=M, R=R, v_n=v_n, v_t=v_t, e_t=e_t, sigma_e_t=0.01, start_scan=0
+        )
     assert fit.free == ("G_star", "mu") and fit.undetermined == ("mu",)
     assert np.isnan(float(fit.stderr["mu"])) and float(fit.stderr["G_star"]) > 0
     lower, upper = fit.bounds["mu"]
@@ -412,16 +477,18 @@ def test_standard_errors_cover_the_truth():
     (docs/oblique.md)."""
     truth = tangential_law("linear_history", kt=5e7, mu=0.15)
     v_n, v_t = (np.asarray(v) for v in incidence(3.9, np.deg2rad(COVERAGE_ANGLES)))
-    made = [oblique_impact(LAW, truth, m=M, R=R, v_n=a, v_t=b)
-            for a, b in zip(v_n, v_t, strict=True)]  # fmt: skip
+    made = [
+        oblique_impact(LAW, truth, m=M, R=R, v_n=a, v_t=b) for a, b in zip(v_n, v_t, strict=True)
+    ]
     e_t = np.array([float(r.e_t) for r in made])
     rng = np.random.default_rng(20)
     start = tangential_law("linear_history", kt=3e7, mu=0.2)
     inside = {"kt": 0, "mu": 0}
     for _ in range(20):
         noisy = e_t + 0.01 * rng.standard_normal(e_t.shape)
-        fit = fit_oblique(LAW, start, m=M, R=R, v_n=v_n, v_t=v_t, e_t=noisy, sigma_e_t=0.01,
-                          start_scan=0)  # fmt: skip
+        fit = fit_oblique(
+            LAW, start, m=M, R=R, v_n=v_n, v_t=v_t, e_t=noisy, sigma_e_t=0.01, start_scan=0
+        )
         for k in inside:
             error = float(fit.stderr[k])
             inside[k] += abs(float(fit.params[k]) - float(truth.params[k])) <= 1.645 * error

@@ -160,8 +160,9 @@ LINEAR = dict(m=0.1, c=1e6, v_n=1.0, R=0.01)
 def _linear_impact(kt, mu, v_t, land_events=None):
     law = ji.law("kelvin_voigt", c=LINEAR["c"], b=0.0)
     tl = tangential_law("linear_history", kt=kt, mu=mu)
-    return oblique_impact(law, tl, m=LINEAR["m"], R=LINEAR["R"], v_n=LINEAR["v_n"], v_t=v_t,
-                          land_events=land_events)  # fmt: skip
+    return oblique_impact(
+        law, tl, m=LINEAR["m"], R=LINEAR["R"], v_n=LINEAR["v_n"], v_t=v_t, land_events=land_events
+    )
 
 
 @pytest.mark.slow
@@ -190,17 +191,21 @@ def test_gradient_through_a_transition():
     kt = K * c
     grad = jax.grad(lambda kt, mu: _linear_impact(kt, mu, U0).u_out, argnums=(0, 1))(kt, mu)
     h = 1e-5
-    fd_kt = (_linear_closed_form(K * (1 + h), mu, U0)[0]
-             - _linear_closed_form(K * (1 - h), mu, U0)[0]) / (2 * h * kt)  # fmt: skip
-    fd_mu = (_linear_closed_form(K, mu * (1 + h), U0)[0]
-             - _linear_closed_form(K, mu * (1 - h), U0)[0]) / (2 * h * mu)  # fmt: skip
+    fd_kt = (
+        _linear_closed_form(K * (1 + h), mu, U0)[0] - _linear_closed_form(K * (1 - h), mu, U0)[0]
+    ) / (2 * h * kt)
+    fd_mu = (
+        _linear_closed_form(K, mu * (1 + h), U0)[0] - _linear_closed_form(K, mu * (1 - h), U0)[0]
+    ) / (2 * h * mu)
     assert float(grad[0]) == pytest.approx(fd_kt, rel=1e-7)
     assert float(grad[1]) == pytest.approx(fd_mu, rel=1e-7)
     # the solve's own values carry 1e-10 of noise: a wider step (the error of the
     # difference quotient itself is 4e-6 here)
     h = 1e-3
-    solve_fd = (float(_linear_impact(kt, mu * (1 + h), U0).u_out)
-                - float(_linear_impact(kt, mu * (1 - h), U0).u_out)) / (2 * h * mu)  # fmt: skip
+    solve_fd = (
+        float(_linear_impact(kt, mu * (1 + h), U0).u_out)
+        - float(_linear_impact(kt, mu * (1 - h), U0).u_out)
+    ) / (2 * h * mu)
     assert float(grad[1]) == pytest.approx(solve_fd, rel=2e-5)
     # without landing the events (diffrax's interpolant), the same gradient is 1e-4 off
     plain = jax.grad(lambda mu: _linear_impact(kt, mu, U0, land_events=False).u_out)(mu)
@@ -244,8 +249,9 @@ def test_against_scipy(name, params, oracle_params, a):
         v_n, v_t = incidence(3.9, np.deg2rad(degrees))
         v_n, v_t = float(v_n), float(v_t)
         r = oblique_impact(hertz(a), tl, m=M, R=R, v_n=v_n, v_t=v_t, rtol=1e-12)
-        o = oblique_oracle(c=C, a=a, m=M, R=R, inertia=0.4, v_n=v_n, v_t=v_t, omega=0.0,
-                           mu=0.092, **oracle_params)  # fmt: skip
+        o = oblique_oracle(
+            c=C, a=a, m=M, R=R, inertia=0.4, v_n=v_n, v_t=v_t, omega=0.0, mu=0.092, **oracle_params
+        )
         what = f"{name}, a = {a}, {degrees} degrees"
         assert int(r.num_switches) == o["switches"], what
         assert float(r.e) == pytest.approx(o["e"], rel=1e-8), what
@@ -265,8 +271,19 @@ def test_gradient_mindlin_against_central_differences():
 
     x = (G_STAR, 0.092, 1.3)
     grads = jax.grad(e_t, argnums=(0, 1, 2))(*x)
-    assert int(oblique_impact(hertz(0.01), tangential_law("mindlin", G_star=G_STAR, mu=0.092),
-                              m=M, R=R, v_n=3.6, v_t=1.3).num_switches) == 2  # fmt: skip
+    assert (
+        int(
+            oblique_impact(
+                hertz(0.01),
+                tangential_law("mindlin", G_star=G_STAR, mu=0.092),
+                m=M,
+                R=R,
+                v_n=3.6,
+                v_t=1.3,
+            ).num_switches
+        )
+        == 2
+    )
     for k in range(3):
         h = 1e-5 * x[k]
         up = list(x)
@@ -330,8 +347,9 @@ def test_soft_spring_restick_in_the_first_step():
     v_n, v_t = (float(v) for v in incidence(3.9, np.deg2rad(5.0)))
     r = oblique_impact(hertz(0.01), tl, m=M, R=R, v_n=v_n, v_t=v_t, rtol=1e-12)
     assert r.status_name == "separated" and int(r.num_switches) == 2
-    o = oblique_oracle(c=C, a=0.01, m=M, R=R, inertia=0.4, v_n=v_n, v_t=v_t, omega=0.0,
-                       mu=0.15, kt=5e6)  # fmt: skip
+    o = oblique_oracle(
+        c=C, a=0.01, m=M, R=R, inertia=0.4, v_n=v_n, v_t=v_t, omega=0.0, mu=0.15, kt=5e6
+    )
     assert o["switches"] == 2
     assert float(r.v_t_out) == pytest.approx(o["v_t_out"], rel=1e-8)
     assert float(r.omega_out) == pytest.approx(o["omega_out"], rel=1e-8)
@@ -348,8 +366,19 @@ def test_the_mindlin_damper_against_scipy_and_its_limits():
     for name, history in (("mindlin", "displacement"), ("mindlin_force", "force")):
         tl = tangential_law(name, G_star=G_STAR, mu=0.092, beta=0.2)
         r = oblique_impact(hertz(), tl, m=M, R=R, v_n=v_n, v_t=v_t, rtol=1e-12)
-        o = oblique_oracle(c=C, m=M, R=R, inertia=0.4, v_n=v_n, v_t=v_t, omega=0.0, mu=0.092,
-                           G_star=G_STAR, history=history, beta=0.2)  # fmt: skip
+        o = oblique_oracle(
+            c=C,
+            m=M,
+            R=R,
+            inertia=0.4,
+            v_n=v_n,
+            v_t=v_t,
+            omega=0.0,
+            mu=0.092,
+            G_star=G_STAR,
+            history=history,
+            beta=0.2,
+        )
         assert int(r.num_switches) == o["switches"], name
         for key in ("v_t_out", "omega_out", "T"):
             assert float(getattr(r, key)) == pytest.approx(o[key], rel=1e-8), (name, key)
@@ -384,9 +413,12 @@ def test_gradient_of_the_mindlin_damper_against_central_differences():
 @pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")  # scipy's probes
 @pytest.mark.parametrize(
     "name, history, contact_point, share",
-    [("mindlin", "displacement", "midpoint", 0.5), ("mindlin_force", "force", "midpoint", 0.5),
-     ("mindlin", "displacement", "plane", 1.0)],
-)  # fmt: skip
+    [
+        ("mindlin", "displacement", "midpoint", 0.5),
+        ("mindlin_force", "force", "midpoint", 0.5),
+        ("mindlin", "displacement", "plane", 1.0),
+    ],
+)
 def test_the_contact_point_inside_the_overlap_against_scipy(name, history, contact_point, share):
     """`contact_point="midpoint"` (lever arm `R - x/2`, as LIGGGHTS, MuJoCo and Drake) and
     `"plane"` (`R - x`, Yade's wall) on a contact 300 times softer than Kharaz's (x_max / R
@@ -399,10 +431,22 @@ def test_the_contact_point_inside_the_overlap_against_scipy(name, history, conta
     moved = 0.0
     for degrees in (5.0, 20.0, 45.0):
         v_n, v_t = (float(v) for v in incidence(3.9, np.deg2rad(degrees)))
-        r = oblique_impact(law, tl, m=M, R=R, v_n=v_n, v_t=v_t, rtol=1e-12,
-                           contact_point=contact_point)  # fmt: skip
-        o = oblique_oracle(c=c, m=M, R=R, inertia=0.4, v_n=v_n, v_t=v_t, omega=0.0, mu=0.092,
-                           G_star=G_STAR / 300.0, history=history, share=share)  # fmt: skip
+        r = oblique_impact(
+            law, tl, m=M, R=R, v_n=v_n, v_t=v_t, rtol=1e-12, contact_point=contact_point
+        )
+        o = oblique_oracle(
+            c=c,
+            m=M,
+            R=R,
+            inertia=0.4,
+            v_n=v_n,
+            v_t=v_t,
+            omega=0.0,
+            mu=0.092,
+            G_star=G_STAR / 300.0,
+            history=history,
+            share=share,
+        )
         what = f"{name}, {degrees} degrees"
         assert int(r.num_switches) == o["switches"], what
         assert float(r.e) == pytest.approx(o["e"], rel=1e-8), what
@@ -417,8 +461,15 @@ def test_the_contact_point_inside_the_overlap_against_scipy(name, history, conta
 def test_a_contact_point_not_known_is_refused_in_one_line():
     for bad in ("centre", 1.5, -0.1, None):
         with pytest.raises(ValueError, match="contact_point must be one of"):
-            oblique_impact(hertz(), tangential_law("mindlin", G_star=G_STAR, mu=0.1), m=M, R=R,
-                           v_n=1.0, v_t=1.0, contact_point=bad)  # fmt: skip
+            oblique_impact(
+                hertz(),
+                tangential_law("mindlin", G_star=G_STAR, mu=0.1),
+                m=M,
+                R=R,
+                v_n=1.0,
+                v_t=1.0,
+                contact_point=bad,
+            )
 
 
 FLOAT32_OBLIQUE = """
@@ -452,8 +503,13 @@ def test_float32_without_x64():
     import sys
 
     env = dict(os.environ, JAX_ENABLE_X64="0", JAX_PLATFORMS="cpu")
-    proc = subprocess.run([sys.executable, "-c", FLOAT32_OBLIQUE], capture_output=True,
-                          text=True, env=env, timeout=300)  # fmt: skip
+    proc = subprocess.run(
+        [sys.executable, "-c", FLOAT32_OBLIQUE],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
+    )
     assert proc.returncode == 0, proc.stderr[-3000:]
     rows = json.loads(proc.stdout.strip().splitlines()[-1])
     tl = tangential_law("mindlin", G_star=G_STAR, mu=0.092)
@@ -474,8 +530,9 @@ def _rows_without_xla_flags(script: str):
     import sys
 
     env = {k: v for k, v in os.environ.items() if k != "XLA_FLAGS"}
-    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
-                          env=env, timeout=600)  # fmt: skip
+    proc = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, env=env, timeout=600
+    )
     assert proc.returncode == 0, proc.stderr[-3000:]
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
@@ -518,8 +575,18 @@ def test_the_penetration_criterion_where_the_normal_force_pulls_before_the_end()
     law = ji.law("tsuji", c=4.2e9, b=15.0)
     for degrees, row in zip((20.0, 40.0, 45.0), rows, strict=True):
         v_n, v_t = (float(v) for v in incidence(3.9, np.deg2rad(degrees)))
-        o = oblique_oracle(c=4.2e9, b_tsuji=15.0, m=M, R=R, inertia=0.4, v_n=v_n, v_t=v_t,
-                           omega=0.0, mu=0.092, kt=1e6)  # fmt: skip
+        o = oblique_oracle(
+            c=4.2e9,
+            b_tsuji=15.0,
+            m=M,
+            R=R,
+            inertia=0.4,
+            v_n=v_n,
+            v_t=v_t,
+            omega=0.0,
+            mu=0.092,
+            kt=1e6,
+        )
         head_on = ji.impact(law, m=M, v0=v_n, separation="penetration")
         assert row["status"] == ji.Status.separated, (degrees, row)
         assert row["switches"] == o["switches"], degrees
@@ -540,10 +607,20 @@ def test_a_rescaled_history_that_sticks_to_the_end_separates():
     law = ji.law("tsuji", c=4.2e9, b=15.0)
     tl = tangential_law("mindlin_rescale", G_star=1.35e10, mu=0.092)
     v_n, v_t = (float(v) for v in incidence(3.9, np.deg2rad(75.0)))
-    r = oblique_impact(law, tl, m=M, R=R, v_n=v_n, v_t=v_t, separation="penetration",
-                       rtol=1e-12)  # fmt: skip
-    o = oblique_oracle(c=4.2e9, b_tsuji=15.0, m=M, R=R, inertia=0.4, v_n=v_n, v_t=v_t,
-                       omega=0.0, mu=0.092, G_star=1.35e10, rescale=True)  # fmt: skip
+    r = oblique_impact(law, tl, m=M, R=R, v_n=v_n, v_t=v_t, separation="penetration", rtol=1e-12)
+    o = oblique_oracle(
+        c=4.2e9,
+        b_tsuji=15.0,
+        m=M,
+        R=R,
+        inertia=0.4,
+        v_n=v_n,
+        v_t=v_t,
+        omega=0.0,
+        mu=0.092,
+        G_star=1.35e10,
+        rescale=True,
+    )
     assert r.status_name == "separated" and int(r.num_switches) == o["switches"] == 2
     assert float(r.v_t_out) == pytest.approx(o["v_t_out"], rel=1e-9)
     assert float(r.omega_out) == pytest.approx(o["omega_out"], rel=1e-9)
@@ -552,12 +629,14 @@ def test_a_rescaled_history_that_sticks_to_the_end_separates():
 # the six impacts of benchmarks/oblique_scan.py that once ended `failed` (stop 32): a
 # Kelvin-Voigt contact (c = 1e5 N/m, b = 1.5 N s/m; 25 g, 5 mm) at 1 m/s, rescaled history,
 # penetration end, contact point on the surface: (name, G*, mu, degrees)
-KV_RESCALED = [("mindlin_rescale", 1e8, 0.1, 37.71479475167016),
-               ("mindlin_rescale", 1e8, 0.1, 75.71382061471192),
-               ("mindlin_rescale_force", 1e7, 0.1, 77.52659381797065),
-               ("mindlin_rescale_force", 1e8, 0.1, 83.04637272069169),
-               ("mindlin_rescale_force", 1e8, 0.3, 69.42383804323408),
-               ("mindlin_rescale_force", 1e8, 0.3, 81.54833143757001)]  # fmt: skip
+KV_RESCALED = [
+    ("mindlin_rescale", 1e8, 0.1, 37.71479475167016),
+    ("mindlin_rescale", 1e8, 0.1, 75.71382061471192),
+    ("mindlin_rescale_force", 1e7, 0.1, 77.52659381797065),
+    ("mindlin_rescale_force", 1e8, 0.1, 83.04637272069169),
+    ("mindlin_rescale_force", 1e8, 0.3, 69.42383804323408),
+    ("mindlin_rescale_force", 1e8, 0.3, 81.54833143757001),
+]
 
 
 @pytest.mark.slow
@@ -574,11 +653,23 @@ def test_a_rescaled_history_sticking_as_kelvin_voigt_lets_go(name, G_star, mu, d
     law = ji.law("kelvin_voigt", c=1e5, b=1.5)
     tl = tangential_law(name, G_star=G_star, mu=mu)
     v_n, v_t = (float(v) for v in incidence(1.0, np.deg2rad(degrees)))
-    r = oblique_impact(law, tl, m=0.025, R=0.005, v_n=v_n, v_t=v_t, separation="penetration",
-                       throw=False)  # fmt: skip
-    o = oblique_oracle(c=1e5, m=0.025, R=0.005, inertia=0.4, v_n=v_n, v_t=v_t, omega=0.0,
-                       mu=mu, G_star=G_star, kelvin_voigt=(1e5, 1.5), rescale=True,
-                       history="force" if name.endswith("force") else "displacement")  # fmt: skip
+    r = oblique_impact(
+        law, tl, m=0.025, R=0.005, v_n=v_n, v_t=v_t, separation="penetration", throw=False
+    )
+    o = oblique_oracle(
+        c=1e5,
+        m=0.025,
+        R=0.005,
+        inertia=0.4,
+        v_n=v_n,
+        v_t=v_t,
+        omega=0.0,
+        mu=mu,
+        G_star=G_star,
+        kelvin_voigt=(1e5, 1.5),
+        rescale=True,
+        history="force" if name.endswith("force") else "displacement",
+    )
     assert r.status_name == "separated" and int(r.num_switches) == o["switches"]
     assert float(r.v_t_out) == pytest.approx(o["v_t_out"], abs=1e-9)
     assert 0.005 * float(r.omega_out) == pytest.approx(0.005 * o["omega_out"], abs=1e-9)
@@ -615,10 +706,20 @@ def test_a_spring_held_at_the_limit_that_sticks_until_the_end_of_contact():
     (they round differently); against scipy (the oracle with the force criterion's end)."""
     rows = _rows_without_xla_flags(RESTICK_SCRIPT)
     for share, row in zip((0.0, 0.25), rows, strict=True):
-        o = oblique_oracle(c=1e5, kelvin_voigt=(100000.00000000003, 1.500000000000001),
-                           end="force", m=0.025000000000000005, R=0.005, inertia=0.4,
-                           v_n=0.5000000000000001, v_t=0.8660254037844386, omega=0.0, mu=0.3,
-                           kt=1e5, share=share)  # fmt: skip
+        o = oblique_oracle(
+            c=1e5,
+            kelvin_voigt=(100000.00000000003, 1.500000000000001),
+            end="force",
+            m=0.025000000000000005,
+            R=0.005,
+            inertia=0.4,
+            v_n=0.5000000000000001,
+            v_t=0.8660254037844386,
+            omega=0.0,
+            mu=0.3,
+            kt=1e5,
+            share=share,
+        )
         assert row["status"] == ji.Status.separated, (share, row)
         assert row["switches"] == o["switches"], (share, row, o)
         assert row["e"] == pytest.approx(o["e"], rel=1e-8), share
@@ -632,8 +733,10 @@ def test_forces_scaled_move_a_lighter_body_alike():
     the unscaled laws move `m` (the export's two spheres): e, e_t and the spin agree to
     1e-9, for a spring and for Mindlin, where the stick-slip switches are the same."""
     law, half = ji.law("kelvin_voigt", c=2e5, b=3.0), ji.law("kelvin_voigt", c=1e5, b=1.5)
-    for tl in (tangential_law("linear_history", kt=1e5, mu=0.3),
-               tangential_law("mindlin", G_star=2e8, mu=0.2)):  # fmt: skip
+    for tl in (
+        tangential_law("linear_history", kt=1e5, mu=0.3),
+        tangential_law("mindlin", G_star=2e8, mu=0.2),
+    ):
         scaled = tl.forces_scaled(0.5)
         for degrees in (10.0, 45.0):
             v_n, v_t = (float(v) for v in incidence(1.0, np.deg2rad(degrees)))

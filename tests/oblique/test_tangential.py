@@ -19,15 +19,22 @@ from jaximpact._oblique import (
 
 
 def test_table_names_and_histories():
-    assert TANGENTIAL_LAW_NAMES == ("linear_history", "mindlin", "mindlin_force",
-                                    "mindlin_rescale", "mindlin_rescale_force")  # fmt: skip
+    assert TANGENTIAL_LAW_NAMES == (
+        "linear_history",
+        "mindlin",
+        "mindlin_force",
+        "mindlin_rescale",
+        "mindlin_rescale_force",
+    )
     assert TANGENTIAL_LAWS["linear_history"].history == "displacement"
     assert TANGENTIAL_LAWS["mindlin"].history == "displacement"
     assert TANGENTIAL_LAWS["mindlin_force"].history == "force"
     assert TANGENTIAL_LAWS["mindlin_rescale"].history == "displacement"
     assert TANGENTIAL_LAWS["mindlin_rescale_force"].history == "force"
     assert [n for n, spec in TANGENTIAL_LAWS.items() if spec.rescaled] == [
-        "mindlin_rescale", "mindlin_rescale_force"]  # fmt: skip
+        "mindlin_rescale",
+        "mindlin_rescale_force",
+    ]
     for spec in TANGENTIAL_LAWS.values():
         assert "mu" in spec.parameters and spec.engines and spec.reference
 

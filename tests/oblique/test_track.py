@@ -72,8 +72,9 @@ def test_a_clean_track_gives_the_impacts_back():
     r = ji.track_rebounds(t, x, y, phi)
     assert len(r.v_n) == 4 and r.g_track == pytest.approx(G, rel=1e-9)
     for k, name in enumerate(FIELDS):
-        np.testing.assert_allclose(getattr(r, name), truth[:, k], rtol=1e-9, atol=1e-9,
-                                   err_msg=name)  # fmt: skip
+        np.testing.assert_allclose(
+            getattr(r, name), truth[:, k], rtol=1e-9, atol=1e-9, err_msg=name
+        )
     np.testing.assert_allclose(r.e_t, truth[:, 5] / truth[:, 2], rtol=1e-9)
     assert "rad/s" in r.summary() and set(r.to_dict()) >= set(FIELDS)
 

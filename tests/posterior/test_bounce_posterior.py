@@ -23,8 +23,7 @@ START = ji.law("hertz_rate", c=5.5e7, b1=100.0)
 
 
 def golf_times(seed=0):
-    b = bounce(ji.law("hertz_rate", c=5.5e7, b1=700.0), m=GOLF_M, h0=0.9, t_end=6.0,
-               max_impacts=16)  # fmt: skip
+    b = bounce(ji.law("hertz_rate", c=5.5e7, b1=700.0), m=GOLF_M, h0=0.9, t_end=6.0, max_impacts=16)
     times = np.asarray(b.impact_times[:8]) + 1.234
     return times + np.random.default_rng(seed).normal(0.0, NOISE, times.size)
 
@@ -114,8 +113,21 @@ def test_cli_fit_posterior(capsys, tmp_path, times, golf_post):
     same as the library's (the same fit, so the same compiled model)."""
     path = tmp_path / "impacts.csv"
     path.write_text("t\n" + "\n".join(repr(float(t)) for t in times) + "\n")
-    argv = ["fit", str(path), "--law", "hertz_rate", "--param", "c=5.5e7", "b1=100",
-            "--mass", str(GOLF_M), "--sigma", str(NOISE), "--posterior", "laplace"]  # fmt: skip
+    argv = [
+        "fit",
+        str(path),
+        "--law",
+        "hertz_rate",
+        "--param",
+        "c=5.5e7",
+        "b1=100",
+        "--mass",
+        str(GOLF_M),
+        "--sigma",
+        str(NOISE),
+        "--posterior",
+        "laplace",
+    ]
     code, out, _ = run_cli(capsys, argv + ["--json"])
     assert code == 0
     data = json.loads(out)
@@ -131,8 +143,19 @@ def test_cli_fit_posterior(capsys, tmp_path, times, golf_post):
 def test_cli_fit_posterior_bad_input_is_one_line(capsys, tmp_path):
     path = tmp_path / "impacts.csv"
     path.write_text("t\n0.0\n0.5\n0.9\n1.2\n")
-    argv = ["fit", str(path), "--law", "hertz_rate", "--param", "c=2e6", "b1=800",
-            "--mass", "1", "--prior", "b1=loguniform:1:1e4"]  # fmt: skip
+    argv = [
+        "fit",
+        str(path),
+        "--law",
+        "hertz_rate",
+        "--param",
+        "c=2e6",
+        "b1=800",
+        "--mass",
+        "1",
+        "--prior",
+        "b1=loguniform:1:1e4",
+    ]
     code, out, err = run_cli(capsys, argv)
     assert code == 2 and "--prior need --posterior" in err and len(err.strip().splitlines()) == 1
 
@@ -147,8 +170,14 @@ def test_nuts_agrees_with_laplace(golf_fit, golf_post):
     effective draws included)."""
     with warnings.catch_warnings():  # an ess a little under 100 warns; the check is below
         warnings.simplefilter("ignore", PosteriorWarning)
-        post = ji.posterior(golf_fit, method="nuts", num_samples=500, num_warmup=300,
-                            chains=2, key=jax.random.key(1))  # fmt: skip
+        post = ji.posterior(
+            golf_fit,
+            method="nuts",
+            num_samples=500,
+            num_warmup=300,
+            chains=2,
+            key=jax.random.key(1),
+        )
     assert post.diagnostics["divergences"] == 0
     assert post.diagnostics["r_hat"] < 1.05
     for k in post.names:

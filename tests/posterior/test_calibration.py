@@ -19,21 +19,31 @@ DATASETS = 60
 def test_intervals_cover_the_truth():
     rng = np.random.default_rng(2024)
     v0 = np.linspace(0.5, 3.0, 6)
+
     def one(c, b1, v):
         return ji.impact(ji.law("hertz_rate", c=c, b1=b1), m=M, v0=v)
 
     simulate = jax.jit(jax.vmap(one, (None, None, 0)))
     held, ranks = [], []
     for i in range(DATASETS):
-        truth = {k: float(np.exp(rng.uniform(np.log(lo), np.log(hi))))
-                 for k, (_, lo, hi) in PRIOR.items()}  # fmt: skip
+        truth = {
+            k: float(np.exp(rng.uniform(np.log(lo), np.log(hi))))
+            for k, (_, lo, hi) in PRIOR.items()
+        }
         r = simulate(truth["c"], truth["b1"], jnp.asarray(v0))
         e = np.asarray(r.e) + 0.01 * rng.normal(size=v0.size)
         T = np.asarray(r.T) * (1.0 + 0.03 * rng.normal(size=v0.size))
         s_T = 0.03 * np.asarray(r.T)
         fit = ji.calibrate(START, m=M, v0=v0, e=e, T=T, sigma_e=0.01, sigma_T=s_T)
-        post = ji.posterior(fit, prior=PRIOR, method="nuts", num_samples=250, num_warmup=300,
-                            chains=2, key=jax.random.key(i))  # fmt: skip
+        post = ji.posterior(
+            fit,
+            prior=PRIOR,
+            method="nuts",
+            num_samples=250,
+            num_warmup=300,
+            chains=2,
+            key=jax.random.key(i),
+        )
         for k, value in truth.items():
             lo, hi = post.interval(0.9)[k]
             held.append(lo <= value <= hi)

@@ -15,8 +15,16 @@ def _one_by_one(post, engine, x, draws, **kwargs):
     """Each of the band's draws exported on its own, at the median export's step."""
     es, Ts = [], []
     for law in post.draw_laws(draws):
-        one = ji.export(law, engine, m=M, v0=2.0, timestep=x.timestep or None, curves=False,
-                        strict=False, **kwargs)  # fmt: skip
+        one = ji.export(
+            law,
+            engine,
+            m=M,
+            v0=2.0,
+            timestep=x.timestep or None,
+            curves=False,
+            strict=False,
+            **kwargs,
+        )
         es.append(one.e)
         Ts.append(one.T)
     return np.asarray(es), np.asarray(Ts)
@@ -30,8 +38,12 @@ def test_the_band_is_the_draws_exported_one_by_one(laplace_post, engine, kwargs,
     post = laplace_post
     x = ji.export(post, engine, m=M, v0=2.0, band_draws=draws, progress=False, **kwargs)
     median = ji.export(post.median_law, engine, m=M, v0=2.0, **kwargs)
-    assert (x.e, x.T, x.timestep, x.parameters) == (median.e, median.T, median.timestep,
-                                                   median.parameters)  # fmt: skip
+    assert (x.e, x.T, x.timestep, x.parameters) == (
+        median.e,
+        median.T,
+        median.timestep,
+        median.parameters,
+    )
     es, Ts = _one_by_one(post, engine, x, draws, **kwargs)
     assert x.band_draws == draws
     assert x.e_band == pytest.approx(tuple(np.quantile(es, [0.05, 0.95])), rel=1e-12)

@@ -47,8 +47,7 @@ def test_evidence_picks_thornton_for_a_steel_ball():
         c=ji.hertz_stiffness(E=2.1e11, nu=0.3, R=R, E2=math.inf),
         x_y=ji.yield_overlap(E=2.1e11, nu=0.3, R=R, Y=1e9, E2=math.inf),
     )
-    ranks = ji.compare_laws(**_measured(steel, STEEL_M), laws=LAWS, by="evidence",
-                            progress=False)  # fmt: skip
+    ranks = ji.compare_laws(**_measured(steel, STEEL_M), laws=LAWS, by="evidence", progress=False)
     _check(ranks, "thornton")
     assert ranks[1].log_bayes_factor > math.log(100.0)  # decisive
 

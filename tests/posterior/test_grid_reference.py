@@ -42,8 +42,9 @@ def grid_quantiles(fit, e, T, s_e, s_T, box, n=161, width=8.0):
         half = width * float(fit.stderr[k]) / float(fit.params[k])
         lo, hi = np.log(box[k][0]), np.log(box[k][1])
         axes.append(np.linspace(max(centre - half, lo), min(centre + half, hi), n))
-    log_l = np.asarray(_grid_log_likelihood(*(jnp.asarray(a) for a in axes),
-                                            jnp.asarray(fit.v0), e, T, s_e, s_T))  # fmt: skip
+    log_l = np.asarray(
+        _grid_log_likelihood(*(jnp.asarray(a) for a in axes), jnp.asarray(fit.v0), e, T, s_e, s_T)
+    )
     p = np.exp(log_l - log_l.max())
     out = {}
     for i, k in enumerate(("c", "b1")):

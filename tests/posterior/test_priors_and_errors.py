@@ -8,8 +8,12 @@ import pytest
 import jaximpact as ji
 from jaximpact._posterior.priors import default_prior, parse_prior
 
-KINDS = [("loguniform", 1e3, 1e7), ("uniform", 0.2, 0.9), ("normal", 5.0, 2.0),
-         ("lognormal", 1.0, 0.5)]  # fmt: skip
+KINDS = [
+    ("loguniform", 1e3, 1e7),
+    ("uniform", 0.2, 0.9),
+    ("normal", 5.0, 2.0),
+    ("lognormal", 1.0, 0.5),
+]
 
 
 @pytest.mark.parametrize("spec", KINDS, ids=lambda s: s[0])

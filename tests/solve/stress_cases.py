@@ -212,8 +212,9 @@ def references(name, separation, members, rtol=1e-12):
     return e, tau, status
 
 
-def sweep_function(name, separation, *, method="integrate", gradients=("jacfwd", "grad"),
-                   rtol=None):
+def sweep_function(
+    name, separation, *, method="integrate", gradients=("jacfwd", "grad"), rtol=None
+):
     """`f(params, m, v0)` -> dict of the impact's fields and the requested derivatives with
     respect to the law's parameters, vmapped over members and jitted (one compilation per
     law and criterion): `"jacfwd"`, the forward-mode Jacobian of (e, T); `"grad"`,
@@ -260,8 +261,16 @@ def sweep_function(name, separation, *, method="integrate", gradients=("jacfwd",
     return jax.jit(jax.vmap(one))
 
 
-def run_sweep(name, separation, members, *, method="integrate", gradients=("jacfwd", "grad"),
-              rtol=None, dtype=None):
+def run_sweep(
+    name,
+    separation,
+    members,
+    *,
+    method="integrate",
+    gradients=("jacfwd", "grad"),
+    rtol=None,
+    dtype=None,
+):
     """Evaluate the sweep; returns (outputs as numpy, seconds for the first call, with
     tracing and compilation, and seconds for a second call)."""
     import time

@@ -359,8 +359,11 @@ def test_gradients_forward_reverse_and_finite_differences(monkeypatch):
 
     calls = []
     wrapped = bounce_module.through_forward_jacobian
-    monkeypatch.setattr(bounce_module, "through_forward_jacobian",
-                        lambda *a, **k: calls.append(1) or wrapped(*a, **k))  # fmt: skip
+    monkeypatch.setattr(
+        bounce_module,
+        "through_forward_jacobian",
+        lambda *a, **k: calls.append(1) or wrapped(*a, **k),
+    )
 
     def f(p):
         b = bounce(ji.law("hertz_rate", c=p[0], b1=p[1]), m=M, h0=H0, t_end=1.5, max_impacts=8)
@@ -479,8 +482,14 @@ def test_wrong_type_is_a_type_error(kwargs, message):
 
 def test_h0_zero_with_a_downward_speed_is_a_drop():
     """Only a ball at rest on the floor is refused: thrown down from the floor it bounces."""
-    b = bounce(ji.law("hertz_rate", c=1e6, b1=1350.0), m=M, h0=0.0, v_drop=1.0, t_end=0.3,
-               max_impacts=MAX_IMPACTS)  # fmt: skip
+    b = bounce(
+        ji.law("hertz_rate", c=1e6, b1=1350.0),
+        m=M,
+        h0=0.0,
+        v_drop=1.0,
+        t_end=0.3,
+        max_impacts=MAX_IMPACTS,
+    )
     assert int(b.num_impacts) >= 2
     assert float(b.impact_times[0]) == 0.0 and np.isfinite(float(b.e[0]))
 

@@ -151,8 +151,7 @@ def test_a_flagged_member_is_never_served():
     """Heavy damping (Hunt-Crossley a v0 = 5, Kelvin-Voigt zeta 0.88) and a force that
     pulls (penetration, b = 2e4) are not served; the grid's numbers there are wrong."""
     hc = grid_contact(_law(_hc_law, c=2e6, a=2.0), M, 2.5, separation="force")
-    kv = grid_contact(_law(_kv_law, c=2e6, b=0.88 * 2 * math.sqrt(2e6)), M, 2.5,
-                      separation="force")  # fmt: skip
+    kv = grid_contact(_law(_kv_law, c=2e6, b=0.88 * 2 * math.sqrt(2e6)), M, 2.5, separation="force")
     pull = grid_contact(_law(_pull_law, c=2e6, b=2e4), M, 2.5, separation="penetration")
     assert not bool(hc["served"]) and not bool(kv["served"]) and not bool(pull["served"])
     assert float(closed_forms.hunt_crossley_restitution(5.0)) < E_FLOOR
@@ -168,8 +167,16 @@ def test_impact_batch_serves_the_grid_and_integrates_the_rest():
     v0 = np.array([2.5, 2.5, 1.5, 1.2, 2.9])
     fields = ("e", "T", "x_max", "F_max", "status", "path")
     # at impact's rtol for a user's law (a batch's default is 1e-11)
-    out = ji.impact_batch(law, {"b": b}, m=M, v0=v0, separation="penetration", fields=fields,
-                          rtol=1e-12, progress=False)  # fmt: skip
+    out = ji.impact_batch(
+        law,
+        {"b": b},
+        m=M,
+        v0=v0,
+        separation="penetration",
+        fields=fields,
+        rtol=1e-12,
+        progress=False,
+    )
     assert list(out["path"]) == ["grid", "integrated", "grid", "integrated", "grid"]
     for k in range(b.size):
         r = ji.impact(law.replace(b=b[k]), m=M, v0=v0[k], separation="penetration")
@@ -178,8 +185,14 @@ def test_impact_batch_serves_the_grid_and_integrates_the_rest():
             want = float(getattr(r, name))
             assert abs(out[name][k] - want) <= 1e-9 * abs(want), (k, name)
         if out["path"][k] == "grid":
-            ref = reference_impact("hertz_rate", {"c": 2e6, "b1": b[k]}, m=M, v0=v0[k],
-                                   separation="penetration", rtol=1e-13)  # fmt: skip
+            ref = reference_impact(
+                "hertz_rate",
+                {"c": 2e6, "b1": b[k]},
+                m=M,
+                v0=v0[k],
+                separation="penetration",
+                rtol=1e-13,
+            )
             for name in ("e", "T", "x_max"):
                 assert abs(out[name][k] / ref[name] - 1) < 1e-9, (k, name)
     heavy = _law(_hc_law, c=2e6, a=2.0)  # a v0 = 5: e = 0.197

@@ -32,8 +32,9 @@ def test_vmap_over_masses_computes_the_good_member_and_refuses_the_bad():
     batch = jax.vmap(lambda m: ji.impact(LAW, m=m, v0=2.5))(jnp.array([1.0, 0.0]))
     eager = ji.impact(LAW, m=1.0, v0=2.5)
     for name in FLOATS:
-        assert float(getattr(batch, name)[0]) == pytest.approx(float(getattr(eager, name)),
-                                                               rel=1e-12)  # fmt: skip
+        assert float(getattr(batch, name)[0]) == pytest.approx(
+            float(getattr(eager, name)), rel=1e-12
+        )
     assert int(batch.status[0]) == ji.Status.separated
     _assert_refused(batch, 1)
     assert batch.to_dict()["status"] == ["separated", "invalid"]
@@ -119,8 +120,9 @@ def test_vmap_of_oblique_impact_refuses_a_zero_normal_speed():
     batch = jax.vmap(one)(jnp.array([3.0, 0.0]))
     single = one(3.0)
     for name in ("e", "e_t", "T", "v_t_out", "omega_out"):
-        assert float(getattr(batch, name)[0]) == pytest.approx(float(getattr(single, name)),
-                                                               rel=1e-9)  # fmt: skip
+        assert float(getattr(batch, name)[0]) == pytest.approx(
+            float(getattr(single, name)), rel=1e-9
+        )
         assert np.isnan(float(getattr(batch, name)[1])), name
     assert [int(s) for s in batch.status] == [ji.Status.separated, ji.Status.invalid]
 
@@ -141,6 +143,12 @@ def test_vmap_of_calibrate_refuses_a_bad_member():
         assert float(batch.params[key][0]) == pytest.approx(float(single.params[key]), rel=1e-9)
     for i in (1, 2):  # a mass of 0, an e above 1
         assert not bool(batch.converged[i]) and not bool(batch.reproduces[i])
-        for value in (batch.params["c"][i], batch.params["b1"][i], batch.e[i, 0],
-                      batch.T[i, 0], batch.loss[i], batch.law.params["c"][i]):  # fmt: skip
+        for value in (
+            batch.params["c"][i],
+            batch.params["b1"][i],
+            batch.e[i, 0],
+            batch.T[i, 0],
+            batch.loss[i],
+            batch.law.params["c"][i],
+        ):
             assert np.isnan(float(value))

@@ -37,8 +37,9 @@ def test_impact_takes_the_record_whole(method):
     same = ji.impact(LAW, m=1.0, v0=2.5, method=method, max_steps=2048, options=OPTIONS)
     _same(same, whole)
     # a field the record leaves None is the keyword's
-    part = ji.impact(LAW, m=1.0, v0=2.5, method="integrate", rtol=1e-10,
-                     options=ji.SolveOptions(max_steps=2048))  # fmt: skip
+    part = ji.impact(
+        LAW, m=1.0, v0=2.5, method="integrate", rtol=1e-10, options=ji.SolveOptions(max_steps=2048)
+    )
     _same(part, ji.impact(LAW, m=1.0, v0=2.5, method="integrate", rtol=1e-10, max_steps=2048))
 
 
@@ -51,8 +52,15 @@ def test_a_conflicting_keyword_is_refused_in_one_line():
     with pytest.raises(ValueError, match="calibrate got rtol=1e-09 and options.rtol=1e-10"):
         ji.calibrate(LAW, m=1.0, v0=2.5, e=0.8, rtol=1e-9, options=OPTIONS)
     with pytest.raises(ValueError, match="impact_batch got max_steps=100"):
-        ji.impact_batch("hertz_rate", {"c": 2e6, "b1": 800.0}, m=1.0, v0=2.5, max_steps=100,
-                        options=OPTIONS, progress=False)  # fmt: skip
+        ji.impact_batch(
+            "hertz_rate",
+            {"c": 2e6, "b1": 800.0},
+            m=1.0,
+            v0=2.5,
+            max_steps=100,
+            options=OPTIONS,
+            progress=False,
+        )
     with pytest.raises(TypeError, match="must be a jaximpact.SolveOptions, got dict"):
         ji.impact(LAW, m=1.0, v0=2.5, options=KEYWORDS)
 
@@ -61,22 +69,28 @@ def test_options_an_entry_point_decides_itself_are_refused():
     with pytest.raises(ValueError, match=r"calibrate takes no adjoint .*forward mode"):
         ji.calibrate(LAW, m=1.0, v0=2.5, e=0.8, options=ji.SolveOptions(adjoint=object()))
     with pytest.raises(ValueError, match=r"fit_bounces takes no peaks"):
-        ji.fit_bounces(LAW, m=1.0, impact_times=np.linspace(0.0, 1.0, 6),
-                       options=ji.SolveOptions(peaks=True))  # fmt: skip
+        ji.fit_bounces(
+            LAW, m=1.0, impact_times=np.linspace(0.0, 1.0, 6), options=ji.SolveOptions(peaks=True)
+        )
     with pytest.raises(ValueError, match=r"impact_batch takes no throw .*each row's status"):
-        ji.impact_batch("hertz_rate", {"c": 2e6, "b1": 800.0}, m=1.0, v0=2.5,
-                        options=ji.SolveOptions(throw=True), progress=False)  # fmt: skip
+        ji.impact_batch(
+            "hertz_rate",
+            {"c": 2e6, "b1": 800.0},
+            m=1.0,
+            v0=2.5,
+            options=ji.SolveOptions(throw=True),
+            progress=False,
+        )
 
 
 def test_the_record_under_jit_and_vmap():
     """Closed over by a `vmap`ped function, or passed through `jit` as an argument (a pytree
     with no leaves: static configuration), the record gives the keywords' numbers."""
     speeds = jnp.array([1.0, 2.5, 4.0])
-    want = jax.vmap(lambda v: ji.impact(LAW, m=1.0, v0=v, method="integrate", **KEYWORDS).e)(
+    want = jax.vmap(lambda v: ji.impact(LAW, m=1.0, v0=v, method="integrate", **KEYWORDS).e)(speeds)
+    closed = jax.vmap(lambda v: ji.impact(LAW, m=1.0, v0=v, method="integrate", options=OPTIONS).e)(
         speeds
     )
-    closed = jax.vmap(lambda v: ji.impact(LAW, m=1.0, v0=v, method="integrate",
-                                          options=OPTIONS).e)(speeds)  # fmt: skip
     passed = jax.jit(lambda o, v: ji.impact(LAW, m=1.0, v0=v, method="integrate", options=o).e)
     assert np.array_equal(closed, want)
     assert np.array_equal(passed(OPTIONS, speeds[1]), want[1])

@@ -63,17 +63,25 @@ def _one(k, d, m, radius, mu, v_n, v_t, stiction, inertia, rtol):
 
     out.terminal, out.direction = True, -1
     t_scale = math.sqrt(m / k)
-    sol = solve_ivp(rhs, (0.0, 1e3 * t_scale), [0.0, v_n, v_t, 0.0], method="Radau",
-                    rtol=rtol, atol=1e-14 * max(v_n, abs(v_t)), events=out,
-                    first_step=1e-6 * t_scale)  # fmt: skip
+    sol = solve_ivp(
+        rhs,
+        (0.0, 1e3 * t_scale),
+        [0.0, v_n, v_t, 0.0],
+        method="Radau",
+        rtol=rtol,
+        atol=1e-14 * max(v_n, abs(v_t)),
+        events=out,
+        first_step=1e-6 * t_scale,
+    )
     if not sol.t_events[0].size:
         raise RuntimeError("Drake's replica did not end the contact (no separation)")
     _, rate, v, omega = sol.y_events[0][0]
     return -rate / v_n, v / v_t, omega
 
 
-def oblique_replica(*, k, d, m, radius, mu, v_n, v_t, stiction=STICTION_TOLERANCE,
-                    inertia=INERTIA, rtol=1e-10):  # fmt: skip
+def oblique_replica(
+    *, k, d, m, radius, mu, v_n, v_t, stiction=STICTION_TOLERANCE, inertia=INERTIA, rtol=1e-10
+):
     """`(e, e_t, omega)` of a free sphere of mass `m` (kg), radius `radius` (m) and moment of
     inertia `inertia m R^2` meeting Drake's half space at normal and tangential speeds `v_n`,
     `v_t` (m/s; arrays of one shape, no spin before) in a continuous plant with point
@@ -81,8 +89,10 @@ def oblique_replica(*, k, d, m, radius, mu, v_n, v_t, stiction=STICTION_TOLERANC
     `stiction` (m/s): the normal and tangential restitution and the spin after (rad/s,
     positive rolling forward), each with a last axis of one (no first-touch phases)."""
     v_n, v_t = np.broadcast_arrays(np.asarray(v_n, float), np.asarray(v_t, float))
-    rows = [_one(k, d, m, radius, mu, a, b, stiction, inertia, rtol)
-            for a, b in zip(v_n.ravel(), v_t.ravel(), strict=True)]  # fmt: skip
+    rows = [
+        _one(k, d, m, radius, mu, a, b, stiction, inertia, rtol)
+        for a, b in zip(v_n.ravel(), v_t.ravel(), strict=True)
+    ]
     return tuple(np.array(column).reshape(v_n.shape + (1,)) for column in zip(*rows, strict=True))
 
 
@@ -125,7 +135,13 @@ class StribeckFriction(AbstractTangentialModel):
     def oblique(self, parameters, *, m, radius, v_n, v_t):
         """The continuous plant's oblique impact with the exported friction, integrated
         (`oblique_replica`)."""
-        return oblique_replica(k=parameters["point_contact_stiffness"],
-                               d=parameters["hunt_crossley_dissipation"], m=m, radius=radius,
-                               mu=parameters["friction"][0], v_n=v_n, v_t=v_t,
-                               stiction=parameters["stiction_tolerance"])  # fmt: skip
+        return oblique_replica(
+            k=parameters["point_contact_stiffness"],
+            d=parameters["hunt_crossley_dissipation"],
+            m=m,
+            radius=radius,
+            mu=parameters["friction"][0],
+            v_n=v_n,
+            v_t=v_t,
+            stiction=parameters["stiction_tolerance"],
+        )

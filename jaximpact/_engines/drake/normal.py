@@ -141,8 +141,9 @@ class PointContact(AbstractNormalModel):
     NEAREST = "its point_contact law"
     SCENES = None
 
-    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
-               limit_damping=False) -> Design:  # fmt: skip
+    def design(
+        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
+    ) -> Design:
         """`point_contact_stiffness` k (N/m) and `hunt_crossley_dissipation` d (s/m) that
         realise `e` and `T` (s) for mass `m` (kg) at `v0` (m/s): on the continuous plant
         (`timestep` None or 0: exact, from the closed-form e of `f = k x (1 + d v)`), or on a

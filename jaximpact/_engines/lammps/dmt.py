@@ -107,8 +107,7 @@ class DMT(AbstractNormalModel):
         Key("E", "Pa"),
         Key("damp", "1/(m s), viscoelastic damping: b = damp meff Reff^0.5"),
         script.COHESION,
-        Key("R_eff", "m, the contact's effective radius (default: from the radius)",
-            needed=False),
+        Key("R_eff", "m, the contact's effective radius (default: from the radius)", needed=False),
         script.POISSON,
         script.TIMESTEP,
     )
@@ -118,8 +117,9 @@ class DMT(AbstractNormalModel):
         "overlap: replicated"
     )
 
-    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
-               limit_damping=False) -> Design:  # fmt: skip
+    def design(
+        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
+    ) -> Design:
         """`pair_style granular` with `dmt E damp poisson cohesion damping viscoelastic` that
         is the law `scene.law` for the pair (every force scaled by `meff/m`: the module's
         docstring), two spheres of mass `m` (kg) and radius `radius` (m) or with
@@ -136,14 +136,27 @@ class DMT(AbstractNormalModel):
         damp = b / (m_eff * math.sqrt(R_eff))
         cohesion = pull / (4.0 * math.pi * R_eff)
         stepping, h, es, Ts, warnings = script.cohesive_stepping(
-            replica, dict(E=E, poisson=poisson, cohesion=cohesion, damp=damp, R_eff=R_eff),
-            wall=wall, m=m, v0=v0, e=e, T=T, timestep=timestep,
-        )  # fmt: skip
+            replica,
+            dict(E=E, poisson=poisson, cohesion=cohesion, damp=damp, R_eff=R_eff),
+            wall=wall,
+            m=m,
+            v0=v0,
+            e=e,
+            T=T,
+            timestep=timestep,
+        )
         text = model(E, damp, poisson, cohesion)
         parameters = script.granular_parameters(
-            text, h, E=E, poisson=poisson, R_eff=R_eff, wall=wall, damp=damp,
-            cohesion=cohesion, normal="dmt",
-        )  # fmt: skip
+            text,
+            h,
+            E=E,
+            poisson=poisson,
+            R_eff=R_eff,
+            wall=wall,
+            damp=damp,
+            cohesion=cohesion,
+            normal="dmt",
+        )
         return Design(
             parameters=parameters,
             **_stepping.realised(es, Ts, h),

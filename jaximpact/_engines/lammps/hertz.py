@@ -149,8 +149,9 @@ class HertzMaterial(AbstractNormalModel):
         "speed; LAMMPS's mdr normal model is elastic-plastic, but another law, not exported)"
     )
 
-    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
-               limit_damping=False) -> Design:  # fmt: skip
+    def design(
+        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
+    ) -> Design:
         """`pair_style granular` with `hertz/material ... damping coeff_restitution` for
         target `e` and `T` (s), two spheres of mass `m` (kg) and radius `radius` (m) at
         relative speed `v0` (m/s), or on a wall (`scene.geometry`) one such sphere at speed
@@ -178,11 +179,23 @@ class HertzMaterial(AbstractNormalModel):
         )
         text = clause(E, coefficient, poisson)
         parameters = script.granular_parameters(
-            text, h, E=E, poisson=poisson, wall=wall, coeff_restitution=coefficient, k=c,
-            b=b, limit_damping=limit_damping,
-        )  # fmt: skip
-        stepping = dict(E=E, coeff_restitution=coefficient, poisson=poisson,
-                        limit_damping=limit_damping, timestep=h)  # fmt: skip
+            text,
+            h,
+            E=E,
+            poisson=poisson,
+            wall=wall,
+            coeff_restitution=coefficient,
+            k=c,
+            b=b,
+            limit_damping=limit_damping,
+        )
+        stepping = dict(
+            E=E,
+            coeff_restitution=coefficient,
+            poisson=poisson,
+            limit_damping=limit_damping,
+            timestep=h,
+        )
         if wall:  # the wall at z = 0, the sphere above it: the pair's model (one material)
             stepping["geometry"] = "wall"
         return Design(

@@ -233,8 +233,9 @@ class JKR(AbstractNormalModel):
         "zero overlap, break at the least force): replicated"
     )
 
-    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
-               limit_damping=False) -> Design:  # fmt: skip
+    def design(
+        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
+    ) -> Design:
         """`pair_style granular` with `jkr E 0 poisson cohesion damping velocity` whose
         impact at `v0` (m/s) has restitution `e` and duration `T` (s) (a JKR law's): two
         spheres of mass `m` (kg) and radius `radius` (m), or with `geometry="wall"` one
@@ -253,9 +254,15 @@ class JKR(AbstractNormalModel):
         E = E_mix * 2.0 * (1.0 - poisson) * (1.0 + poisson)
         cohesion = 0.5 * q**2 * x_star**1.5 * E_mix / (2.0 * math.pi * math.sqrt(R_eff))
         stepping, h, es, Ts, warnings = script.cohesive_stepping(
-            replica, dict(E=E, poisson=poisson, cohesion=cohesion, R_eff=R_eff),
-            wall=wall, m=m, v0=v0, e=e, T=T, timestep=timestep,
-        )  # fmt: skip
+            replica,
+            dict(E=E, poisson=poisson, cohesion=cohesion, R_eff=R_eff),
+            wall=wall,
+            m=m,
+            v0=v0,
+            e=e,
+            T=T,
+            timestep=timestep,
+        )
         warnings.append(
             f"LAMMPS's jkr breaks the neck at the least force (-F_c), before JKR's pull-off "
             f"(the least overlap): it takes {ENERGY_RATIO:.1%} of the energy, so with a law's "
@@ -266,9 +273,16 @@ class JKR(AbstractNormalModel):
         )
         text = model(E, cohesion, poisson)
         parameters = script.granular_parameters(
-            text, h, E=E, poisson=poisson, R_eff=R_eff, wall=wall, cohesion=cohesion,
-            damping=0.0, pulloff_distance=float(pulloff_distance(R_eff, cohesion, E_mix)),
-        )  # fmt: skip
+            text,
+            h,
+            E=E,
+            poisson=poisson,
+            R_eff=R_eff,
+            wall=wall,
+            cohesion=cohesion,
+            damping=0.0,
+            pulloff_distance=float(pulloff_distance(R_eff, cohesion, E_mix)),
+        )
         return Design(
             parameters=parameters,
             **_stepping.realised(es, Ts, h),

@@ -71,8 +71,15 @@ def lammps_impact(q: float, beta: float, rtol: float = 1e-11) -> tuple[float, fl
     breaks.terminal, breaks.direction = True, -1
     turns_in.terminal, turns_in.direction = True, 1
     with np.errstate(over="ignore", invalid="ignore"):  # trial steps far off, rejected
-        out = solve_ivp(rhs, (0.0, 1e3), [0.0, 1.0], method="DOP853", rtol=rtol, atol=1e-14,
-                        events=[breaks, turns_in])  # fmt: skip
+        out = solve_ivp(
+            rhs,
+            (0.0, 1e3),
+            [0.0, 1.0],
+            method="DOP853",
+            rtol=rtol,
+            atol=1e-14,
+            events=[breaks, turns_in],
+        )
     if out.t_events[0].size:
         return float(-out.y_events[0][0][1]), float(out.t_events[0][0])
     if out.t_events[1].size:
@@ -175,8 +182,9 @@ class JKRViscoelastic(AbstractNormalModel):
         "overlap, break at the least force) and the damping at the half-step speed: replicated"
     )
 
-    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
-               limit_damping=False) -> Design:  # fmt: skip
+    def design(
+        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
+    ) -> Design:
         """`pair_style granular` with `jkr E damp poisson cohesion damping viscoelastic`
         whose impact at `v0` (m/s) keeps the law `scene.law`'s damping group there and has its
         restitution `e` and duration `T` (s) (the module's docstring): two spheres of mass
@@ -202,9 +210,15 @@ class JKRViscoelastic(AbstractNormalModel):
         cohesion = 0.5 * q**2 * x_star**1.5 * E_mix / (2.0 * math.pi * math.sqrt(R_eff))
         damp = beta * v0 / (x_star**1.5 * math.sqrt(R_eff))  # b = beta meff v0 / x*^1.5
         stepping, h, es, Ts, warnings = script.cohesive_stepping(
-            replica, dict(E=E, poisson=poisson, cohesion=cohesion, damp=damp, R_eff=R_eff),
-            wall=wall, m=m, v0=v0, e=e, T=T, timestep=timestep,
-        )  # fmt: skip
+            replica,
+            dict(E=E, poisson=poisson, cohesion=cohesion, damp=damp, R_eff=R_eff),
+            wall=wall,
+            m=m,
+            v0=v0,
+            e=e,
+            T=T,
+            timestep=timestep,
+        )
         warnings.append(
             "LAMMPS's jkr breaks the neck at the least force (-F_c), before JKR's pull-off "
             f"(the least overlap): this cohesion ({cohesion:.4g} J/m^2) gives the law's e at "
@@ -213,10 +227,17 @@ class JKRViscoelastic(AbstractNormalModel):
         )
         text = model(E, damp, poisson, cohesion)
         parameters = script.granular_parameters(
-            text, h, E=E, poisson=poisson, R_eff=R_eff, wall=wall, cohesion=cohesion,
-            damp=damp, normal="jkr",
+            text,
+            h,
+            E=E,
+            poisson=poisson,
+            R_eff=R_eff,
+            wall=wall,
+            cohesion=cohesion,
+            damp=damp,
+            normal="jkr",
             pulloff_distance=float(pulloff_distance(R_eff, cohesion, E_mix)),
-        )  # fmt: skip
+        )
         return Design(
             parameters=parameters,
             **_stepping.realised(es, Ts, h),
@@ -239,8 +260,12 @@ class JKRViscoelastic(AbstractNormalModel):
         R_eff = check_positive("R_eff", parameters["R_eff"], "m")
         m_eff = m if parameters.get("geometry", "spheres") == "wall" else m / 2.0
         root = math.sqrt(R_eff)
-        return {"c": 4.0 / 3.0 * emix(E, nu) * root, "b": damp * m_eff * root, "R": R_eff,
-                "w": 2.0 * cohesion * ENERGY_RATIO**0.6}  # fmt: skip
+        return {
+            "c": 4.0 / 3.0 * emix(E, nu) * root,
+            "b": damp * m_eff * root,
+            "R": R_eff,
+            "w": 2.0 * cohesion * ENERGY_RATIO**0.6,
+        }
 
     def response(self, parameters, *, m, radius=None):
         """`(law, "force")`: `law_parameters`' `jkr_viscoelastic` law for `parameters` of

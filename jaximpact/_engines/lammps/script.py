@@ -61,14 +61,23 @@ def with_effective_radius(parameters, radius) -> dict:
     return {**parameters, "R_eff": radius if wall else radius / 2.0}
 
 
-def granular_parameters(clause: str, h: float, *, E: float, poisson: float, wall: bool,
-                        R_eff: float | None = None, **model) -> dict:  # fmt: skip
+def granular_parameters(
+    clause: str,
+    h: float,
+    *,
+    E: float,
+    poisson: float,
+    wall: bool,
+    R_eff: float | None = None,
+    **model,
+) -> dict:
     """An export's `parameters` for LAMMPS's `pair_style granular` with the normal model's
     `clause` and no tangential force, at time step `h` (s): the commands, Young's modulus
     `E` (Pa), `poisson`, `R_eff` (m, where the model has one), the model's own values
     (`model`, SI units), and with `wall` the `fix wall/gran` on the plane z = 0."""
-    lines = commands(clause, FRICTIONLESS, limit_damping=model.get("limit_damping", False),
-                     wall=wall)  # fmt: skip
+    lines = commands(
+        clause, FRICTIONLESS, limit_damping=model.get("limit_damping", False), wall=wall
+    )
     parameters = {
         "pair_style": "pair_style granular",
         "pair_coeff": lines["pair_coeff"],
@@ -86,8 +95,9 @@ def granular_parameters(clause: str, h: float, *, E: float, poisson: float, wall
     return parameters
 
 
-def cohesive_stepping(replica, stepping: dict, *, wall: bool, m: float, v0: float, e: float,
-                      T: float, timestep):  # fmt: skip
+def cohesive_stepping(
+    replica, stepping: dict, *, wall: bool, m: float, v0: float, e: float, T: float, timestep
+):
     """`(stepping, h, es, Ts, warnings)` of a cohesive model's design (`jkr`, damped `jkr`,
     `dmt`): the replica's `stepping` parameters (with the wall's geometry) at the time step
     `h` (s) that realises `e` and `T` (s) at `v0` (m/s), or at the `timestep` given
@@ -95,6 +105,10 @@ def cohesive_stepping(replica, stepping: dict, *, wall: bool, m: float, v0: floa
     stepping = {**stepping, **({"geometry": "wall"} if wall else {})}
     h, es, Ts, warnings = _stepping.step_and_response(
         lambda h: replica({**stepping, "timestep": h}, m, v0),
-        e, T, timestep, engine="LAMMPS", step="timestep",
-    )  # fmt: skip
+        e,
+        T,
+        timestep,
+        engine="LAMMPS",
+        step="timestep",
+    )
     return {**stepping, "timestep": h}, h, es, Ts, warnings

@@ -64,8 +64,9 @@ class Granular(AbstractTangentialModel):
         the normal model's (`design.clause`), and under `tangential`."""
         clause = self.clause(tangential)
         p = design.parameters
-        lines = script.commands(design.clause, clause, wall="fix_wall" in p,
-                                limit_damping=p.get("limit_damping", False))  # fmt: skip
+        lines = script.commands(
+            design.clause, clause, wall="fix_wall" in p, limit_damping=p.get("limit_damping", False)
+        )
         return {**p, "tangential": clause, **lines}
 
     def realised(self, parameters, tangential):
@@ -94,7 +95,8 @@ def tangential_clause(tangential) -> str:
     one-line ValueError for one LAMMPS does not take."""
     model = TANGENTIAL.get(tangential.name)
     if model is None:
-        raise ValueError(f"LAMMPS takes the tangential laws {', '.join(TANGENTIAL)}, not "
-                         f"{tangential.name!r}")  # fmt: skip
+        raise ValueError(
+            f"LAMMPS takes the tangential laws {', '.join(TANGENTIAL)}, not {tangential.name!r}"
+        )
     model.check(tangential, timestep=None)
     return model.clause(tangential)

@@ -26,8 +26,19 @@ from ..lammps import hertz
 
 MIN_COEFFICIENT = 0.05  # createCoeffRest: "0.05 < coefficientRestitution <= 1 required"
 # the values of LAMMPS's design a LIGGGHTS export keeps (and of tangential.py)
-_DESIGN_KEYS = ("timestep", "timestep_s", "youngs_modulus", "coeff_restitution", "poisson", "k",
-                "b", "friction", "G_star", "tangential_beta", "tangential_damping")  # fmt: skip
+_DESIGN_KEYS = (
+    "timestep",
+    "timestep_s",
+    "youngs_modulus",
+    "coeff_restitution",
+    "poisson",
+    "k",
+    "b",
+    "friction",
+    "G_star",
+    "tangential_beta",
+    "tangential_damping",
+)
 _LAMMPS = hertz.HertzMaterial()  # the same contact, design and stepping, in other words
 
 
@@ -96,8 +107,9 @@ class Hertz(AbstractNormalModel):
     NEAREST = "its tsuji law"
     SCENES = None
 
-    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
-               limit_damping=False) -> Design:  # fmt: skip
+    def design(
+        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
+    ) -> Design:
         """LAMMPS's design in LIGGGHTS's names. `geometry="wall"`: a sphere on a primitive
         `fix wall/gran` of its own material (atom type 1). Its contact, `fix_wall_gran.cpp`
         and `normal_model_hertz.h`: the particle's own mass and radius (`reff = radi` on a
@@ -106,8 +118,9 @@ class Hertz(AbstractNormalModel):
         engines give the same e and T to every digit printed)."""
         if poisson < 0:
             raise ValueError(f"LIGGGHTS requires 0 <= poissonsRatio <= 0.5, got {poisson:g}")
-        out = _LAMMPS.design(e, T, scene, poisson=poisson, timestep=timestep,
-                             limit_damping=limit_damping)  # fmt: skip
+        out = _LAMMPS.design(
+            e, T, scene, poisson=poisson, timestep=timestep, limit_damping=limit_damping
+        )
         p = out.parameters
         if p["coeff_restitution"] <= MIN_COEFFICIENT:
             separation = "force" if limit_damping else "penetration"

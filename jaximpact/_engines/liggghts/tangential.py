@@ -68,16 +68,25 @@ def tangential_values(p: dict, tangential) -> dict:
     damped = params.get("beta", 0.0) > 0.0
     # LIGGGHTS's -betaeff: LAMMPS's damp coefficient over sqrt(5)
     beta = damp_coefficient(p["coeff_restitution"]) / math.sqrt(5.0) if damped else 0.0
-    return dict(p, friction=params["mu"], G_star=y_star(p) * shear_ratio(float(p["poisson"])),
-                tangential_beta=beta, tangential_damping=damped)  # fmt: skip
+    return dict(
+        p,
+        friction=params["mu"],
+        G_star=y_star(p) * shear_ratio(float(p["poisson"])),
+        tangential_beta=beta,
+        tangential_damping=damped,
+    )
 
 
 def realised(parameters: dict, tangential):
     """The `mindlin` law LIGGGHTS realises with the exported `parameters`."""
     from ..._oblique import tangential_law
 
-    return tangential_law("mindlin", G_star=parameters["G_star"], mu=parameters["friction"],
-                          beta=parameters["tangential_beta"])  # fmt: skip
+    return tangential_law(
+        "mindlin",
+        G_star=parameters["G_star"],
+        mu=parameters["friction"],
+        beta=parameters["tangential_beta"],
+    )
 
 
 def differences(parameters: dict, tangential) -> list[str]:
@@ -123,10 +132,12 @@ class TangentialHistory(AbstractTangentialModel):
         `mindlin` law) as LIGGGHTS's tangential history: its friction, the damper on or
         off."""
         parameters = design.parameters
-        p = tangential_values({k: parameters[k] for k in _DESIGN_KEYS if k in parameters},
-                              tangential)  # fmt: skip
-        return render(p, parameters["limitForce"], parameters["particle_range"],
-                      "fix_wall" in parameters)  # fmt: skip
+        p = tangential_values(
+            {k: parameters[k] for k in _DESIGN_KEYS if k in parameters}, tangential
+        )
+        return render(
+            p, parameters["limitForce"], parameters["particle_range"], "fix_wall" in parameters
+        )
 
     def realised(self, parameters, tangential):
         """The `mindlin` law LIGGGHTS realises (its G* and damper tied to E, nu, e)."""

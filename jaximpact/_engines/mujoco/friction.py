@@ -85,8 +85,18 @@ def _edge_solve(J, aref, D, inv_mass):
     return best
 
 
-def oblique_replica(solref, timestep, *, mu, radius, v_n, v_t, phases=_stepping.PHASES,
-                    impedance=SOLIMP[0], inertia=INERTIA):  # fmt: skip
+def oblique_replica(
+    solref,
+    timestep,
+    *,
+    mu,
+    radius,
+    v_n,
+    v_t,
+    phases=_stepping.PHASES,
+    impedance=SOLIMP[0],
+    inertia=INERTIA,
+):
     """`(e, e_t, omega)` per start phase (the last axis; `v_n`, `v_t` arrays of one shape
     before it): the normal restitution, the centre's tangential
     restitution and the spin after (rad/s, positive rolling forward) of a free sphere of
@@ -151,8 +161,13 @@ class PyramidalFriction(AbstractTangentialModel):
         unchanged."""
         parameters = design.parameters
         mu = float(tangential.params["mu"])
-        out = dict(parameters, friction=[mu, 0.0, 0.0], condim=3 if mu > 0 else 1,
-                   cone="pyramidal", impratio=1.0)  # fmt: skip
+        out = dict(
+            parameters,
+            friction=[mu, 0.0, 0.0],
+            condim=3 if mu > 0 else 1,
+            cone="pyramidal",
+            impratio=1.0,
+        )
         if mu > 0:
             out["solref"] = frictional_solref(parameters["solref"], parameters["timestep"], mu)
             out["cone_factor"] = head_on_factor(mu)
@@ -182,8 +197,9 @@ class PyramidalFriction(AbstractTangentialModel):
         without friction the normal replica, the tangential speed and spin unchanged."""
         mu = float(parameters.get("friction", [0.0])[0])
         if mu > 0:
-            return oblique_replica(parameters["solref"], parameters["timestep"], mu=mu,
-                                   radius=radius, v_n=v_n, v_t=v_t)  # fmt: skip
+            return oblique_replica(
+                parameters["solref"], parameters["timestep"], mu=mu, radius=radius, v_n=v_n, v_t=v_t
+            )
         v_n = np.atleast_1d(np.asarray(v_n, float))
         e = np.stack([replica(parameters["solref"], parameters["timestep"], v)[0] for v in v_n])
         return e, np.ones_like(e), np.zeros_like(e)

@@ -31,8 +31,7 @@ def _corrected(e: float, T: float, v0: float, timestep) -> tuple[float, float, f
     zeta = dampratio_for(e)
     w0 = continuous(zeta)[1] / T
     tol = _stepping.STEP_TOL - _CORRECTION_TOL
-    h = _stepping.recommended_step(lambda h: replica(_solref_at(w0, zeta, h), h, v0), T, None,
-                                   tol)  # fmt: skip
+    h = _stepping.recommended_step(lambda h: replica(_solref_at(w0, zeta, h), h, v0), T, None, tol)
     while True:
         w0, zeta, es, Ts = _at_step(e, T, v0, h)
         if _stepping.realises(es, Ts, e, T) or T / h > _stepping.MAX_STEPS:
@@ -102,8 +101,9 @@ class Solref(AbstractNormalModel):
     NEAREST = "its kelvin_voigt law"
     SCENES = None
 
-    def design(self, e, T, scene: Scene, *, timestep=None, poisson=0.3,
-               limit_damping=False) -> Design:  # fmt: skip
+    def design(
+        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
+    ) -> Design:
         """solref, solimp and time step that realise `e` and `T` (s; None: MuJoCo's default
         timeconst) at `v0` (m/s) in MuJoCo, and what MuJoCo realises with them. The contact
         per unit mass does not depend on the mass `m`; the other options do not apply."""
