@@ -37,10 +37,11 @@ from .._solve.options import (
 from .._status import Status
 from .._xla_log import quietly_compiled
 from .forward_jacobian import value_and_jacobian, with_forward_jacobian
+from .least_squares import LeastSquares, levenberg_marquardt
 from .parameters import default_free, law_with, to_unbounded
 from .restitution_tables import restitution_table
 
-OPTIMIZERS = ("lbfgs", "lm")
+OPTIMIZERS = ("auto", "lbfgs", "lm")
 
 
 class Fit(eqx.Module):
@@ -249,12 +250,109 @@ class Fit(eqx.Module):
         return {
             "law": law,
             **out,
+            "g": jsonable(self.g),
             "free": list(self.free),
             "optimizer": self.optimizer,
             "undetermined": list(self.undetermined),
             "weighted": self.weighted,
             "notes": list(self.notes),
         }
+
+    @classmethod
+    def from_dict(cls, data: dict, *, law=None) -> "Fit":
+        """The fit that `to_dict()` wrote (`Fit.from_dict(fit.to_dict()).to_dict()` is
+        `fit.to_dict()`), or the JSON of `jaximpact calibrate --json` (one law), which
+        names the law by `law` with its `params` and gives each speed as one of `rows`
+        (`v0`, the measured `e` and `T`, `e_fit`, `T_fit`, `x_max`, `F_max`). `law`: where
+        a name cannot rebuild the law (a user's own, `custom_law`), the law, or a function
+        that builds it from the parameters (a dict of numbers, checked first).
+
+        Its numbers and words come back (`summary()`, the goodness of fit, `to_dict()`);
+        what a dict does not hold is None (`setup`, the sigmas: `posterior` needs the fit
+        itself), a per-speed value it lacks NaN. A one-line `ValueError` for a dict that is
+        no fit: no law name or no parameters, a law or a parameter the law table does not
+        have, a parameter that is not a finite number, a mass (kg) or a speed (m/s) that is
+        not a number > 0.
+
+        **Example**: `Fit.from_dict(json.loads(text)).law`.
+        """
+        import math
+
+        from .._laws import LAWS, law as named_law
+
+        def number(value):
+            return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+        given = data.get("law")
+        name = given.get("name") if isinstance(given, dict) else given
+        if not isinstance(name, str):
+            raise ValueError(
+                "no law name ('law'): is it a Fit.to_dict(), or the output of 'jaximpact "
+                "calibrate --json'?"
+            )
+        params = data.get("params", given.get("parameters") if isinstance(given, dict) else None)
+        if not isinstance(params, dict) or not params:
+            raise ValueError("no parameters ('params': an object NAME -> number)")
+        for key, value in params.items():
+            if not (number(value) and math.isfinite(value)):
+                raise ValueError(f"parameter {key} = {value!r} is not a finite number")
+        if law is not None and not isinstance(law, AbstractLaw):
+            law = law({k: float(v) for k, v in params.items()})
+        elif law is None:
+            if name not in LAWS:
+                raise ValueError(f"law {name!r} is not one of 'jaximpact laws' (LAW_NAMES)")
+            unknown = sorted(set(params) - set(LAWS[name].parameters))
+            if unknown:
+                raise ValueError(f"law {name} has no parameter {', '.join(unknown)}")
+            law = named_law(name, **{k: float(v) for k, v in params.items()})
+        m = data.get("m")
+        if m is not None and not (number(m) and math.isfinite(m) and m > 0):
+            raise ValueError(f"mass m = {m!r} is not a number > 0 (kg)")
+        rows = data.get("rows") if isinstance(data.get("rows"), list) else []
+        rows = [row for row in rows if isinstance(row, dict)]
+
+        def per_speed(key, in_rows):  # to_dict's list (one number: simulate's), or the rows'
+            values = data[key] if key in data else [row.get(in_rows) for row in rows]
+            return np.atleast_1d(np.asarray(values, dtype=float))  # null: NaN
+
+        v0 = data["v0"] if "v0" in data else [row.get("v0") for row in rows]
+        if not all(number(v) and math.isfinite(v) and v > 0 for v in np.ravel(v0)):
+            raise ValueError("a speed ('v0' or 'rows'[].v0) is not a number > 0 (m/s)")
+
+        def read(key, kind=float, where=data):  # None where not given; a null number NaN
+            value = where.get(key)
+            if value is None and (kind is not float or key not in where):
+                return None
+            return np.asarray(value, dtype=kind)
+
+        stderr = data.get("stderr")
+        return cls(
+            law=law,
+            params={k: np.asarray(float(v)) for k, v in params.items()},
+            v0=per_speed("v0", "v0"),
+            e=per_speed("e", "e_fit"),
+            T=per_speed("T", "T_fit"),
+            e_target=per_speed("e_target", "e"),
+            T_target=per_speed("T_target", "T"),
+            residuals=read("residuals"),
+            loss=read("loss"),
+            converged=read("converged", bool),
+            iterations=read("iterations", int),
+            history=read("history"),
+            stderr=None if stderr is None else {k: read(k, where=stderr) for k in stderr},
+            free=tuple(data.get("free", ())),
+            optimizer=data.get("optimizer"),
+            undetermined=tuple(data.get("undetermined", ())),
+            m=None if m is None else np.asarray(float(m)),
+            x_max=per_speed("x_max", "x_max"),
+            F_max=per_speed("F_max", "F_max"),
+            reproduces=read("reproduces", bool),
+            target_tol=read("target_tol"),
+            n_data=read("n_data", int),
+            weighted=bool(data.get("weighted", False)),
+            notes=tuple(data.get("notes", ())),
+            g=float(data.get("g") or 0.0),
+        )
 
     def __repr__(self) -> str:
         return self.summary()
@@ -643,7 +741,7 @@ def calibrate(
     free=None,
     separation: str = "force",
     g=0.0,
-    optimizer="lbfgs",
+    optimizer="auto",
     init: str = "auto",
     max_iter: int = 100,
     tol: float = 1e-12,
@@ -660,8 +758,13 @@ def calibrate(
     damping); the others keep the values in `law`. Parameters are fitted in a transformed
     space that keeps them physical (logarithms; a logit for `e_nominal`).
 
-    - `optimizer`: `"lbfgs"` (the default: optax L-BFGS with a zoom line search), `"lm"`
-      (optimistix Levenberg-Marquardt), or any optax `GradientTransformation`.
+    - `optimizer`: `"auto"` (the default) is `"lm"` for an eager fit whose impacts are
+      integrated, else `"lbfgs"`; `"lbfgs"`: optax L-BFGS with a zoom line search inside
+      the compiled fit; `"lm"`: Levenberg-Marquardt, driven from Python around one compiled
+      program (the residuals, the peaks and the forward-mode Jacobian) for an eager fit of
+      integrated impacts, which compiles the solve once where the in-graph optimisers
+      compile it three times, else optimistix's inside the compiled fit; or any optax
+      `GradientTransformation`. `Fit.optimizer` names the one that ran.
     - `init`: `"auto"` starts from the law's nondimensional restitution table (one damping
       group sets `e`, then `T` sets the stiffness) so most fits need a few iterations;
       `"given"` starts from the values in `law`.
@@ -745,6 +848,12 @@ def calibrate(
         rtol=solve.rtol,
         fit=True,
     )
+    # an eager fit runs its optimiser in Python around one compiled program; a traced one
+    # (jit, vmap) runs it inside the compiled fit
+    eager = not any(is_traced(x) for x in jax.tree.leaves((law, m, v0, e, T, sigma_e, sigma_T, g)))
+    on_host = eager and optimizer in ("auto", "lm")
+    if optimizer == "auto":
+        optimizer = "lm" if on_host else "lbfgs"
     start_on_curves = init == "auto" and path.name == "similarity"
     if init == "auto" and not start_on_curves:
         law = _initial_law(law, free, m=m, v0=v0, e=e, T=T, separation=separation)
@@ -771,7 +880,7 @@ def calibrate(
     )
     # g = 0 as a Python number is static to filter_jit (a numpy scalar would be traced):
     # the formulas without gravity are compiled alone
-    fit = _fit(
+    fit = (_fit_on_host if on_host else _fit)(
         law,
         data,
         m,
@@ -916,6 +1025,19 @@ class _Options(eqx.Module):
         return self.impact.closed_form
 
 
+def _solved_by_start(law, options, rows) -> bool:
+    """One speed, e and T, stiffness and damping free: the start read off the curves is the
+    solution itself (two equations, two unknowns), so no optimiser runs."""
+    return (
+        options.start_on_curves
+        and rows == 1
+        and options.has_e
+        and options.has_T
+        and set(options.free) == {"c", damping_parameter(law)}
+        and damping_parameter(law) != "e_nominal"  # not read off the curves (a formula)
+    )
+
+
 @eqx.filter_jit
 def _fit(law, data, m, g, target_tol, options):
     """The compiled part of `calibrate`: optimise, then evaluate the fit."""
@@ -938,16 +1060,7 @@ def _fit(law, data, m, g, target_tol, options):
         return 0.5 * jnp.sum(r**2)
 
     theta0 = jnp.stack([to_unbounded(k, law.parameters[k]) for k in free])
-    # one speed, e and T, stiffness and damping free: the start read off the curves is the
-    # solution itself (two equations, two unknowns), so no optimiser runs
-    exact = (
-        options.start_on_curves
-        and rows == 1
-        and options.has_e
-        and options.has_T
-        and set(free) == {"c", damping_parameter(law)}
-        and damping_parameter(law) != "e_nominal"  # not read off the curves (a formula)
-    )
+    exact = _solved_by_start(law, options, rows)
     if exact:
         theta, iterations, stopped, history = theta0, jnp.asarray(0), jnp.asarray(True), None
     elif optimizer == "lm":
@@ -965,14 +1078,27 @@ def _fit(law, data, m, g, target_tol, options):
     # the final point once more, with the peaks (x_max, F_max: the sanity echo); on the
     # curves they cost nothing, an integrated law adds their events to this one solve
     final = _residuals(law, free, dataclasses.replace(options.impact, peaks=True), **targets)
-    r, (e_fit, T_fit, status, x_max, F_max) = final(theta, data)
+    r, predictions = final(theta, data)
     (_, _), jacobian = jacobian_fn(theta, data)
     final_loss = 0.5 * jnp.sum(r**2)
     if history is None:
         history = jnp.stack([loss(theta0, data), final_loss])[-1 if exact else 0 :]
-    else:
-        filled = jnp.arange(history.shape[0]) < iterations
-        history = jnp.where(filled, history, final_loss)
+    else:  # L-BFGS's fixed-length record: the steps not taken hold the final loss
+        history = jnp.where(jnp.arange(history.shape[0]) < iterations, history, final_loss)
+    name = optimizer if isinstance(optimizer, str) else type(optimizer).__name__
+    solved = (theta, r, predictions, jacobian, history, iterations, stopped)
+    return _recorded(law, solved, data, m, g, target_tol, options, exact=exact, optimizer=name)
+
+
+def _recorded(law, solved, data, m, g, target_tol, options, *, exact, optimizer):
+    """The `Fit` of a solved fit: `solved` is `(theta, r, (e, T, status, x_max, F_max),
+    jacobian, history, iterations, stopped)` at the optimiser's last point; the goodness of
+    fit and the standard errors (from `J^T J`) follow from them."""
+    theta, r, (e_fit, T_fit, status, x_max, F_max), jacobian, history, iterations, stopped = solved
+    free = options.free
+    v0, e, T = data[0], data[1], data[2]
+    rows = v0.shape[0]
+    final_loss = 0.5 * jnp.sum(r**2)
     fitted = law_with(law, free, theta)
     # every impact separated; with a law that holds the body (adhesion), a row measured as
     # stuck (e = 0) is matched by a captured impact
@@ -1017,7 +1143,67 @@ def _fit(law, data, m, g, target_tol, options):
         target_tol=jnp.asarray(target_tol, dtype=float),
         n_data=jnp.asarray(n_data),
         weighted=options.has_sigma,
-        optimizer=optimizer if isinstance(optimizer, str) else type(optimizer).__name__,
+        optimizer=optimizer,
         g=g,
         setup=options,
+    )
+
+
+# ------------------------------------------------ an eager integrated fit: one program
+
+
+@eqx.filter_jit
+def _evaluated(law, theta, data, m, g, options):
+    """`(r, (e, T, status, x_max, F_max), J)` at `theta`: the one compiled program of a fit
+    driven from Python (the residuals with the peaks and their forward-mode Jacobian)."""
+    targets = dict(m=m, g=g, has_e=options.has_e, has_T=options.has_T)
+    with_peaks = dataclasses.replace(options.impact, peaks=True)
+    raw = _residuals(law, options.free, with_peaks, **targets)
+    (r, predictions), jacobian = value_and_jacobian(raw, theta, data)
+    return r, predictions, jacobian
+
+
+_recorded_compiled = eqx.filter_jit(_recorded)
+# the largest step of a parameter (a logarithm, or a logit for `e_nominal`) in one iteration,
+# a factor e^2 = 7.4: a longer one from a far start can saturate the logit, where the loss is
+# flat and the fit stops (Lankarani-Nikravesh from e_nominal = 0.08 went to 1)
+_MAX_STEP = 2.0
+_start_compiled = eqx.filter_jit(_start_on_curves)
+
+
+def _fit_on_host(law, data, m, g, target_tol, options):
+    """An eager fit: `levenberg_marquardt`'s numpy loop around `_evaluated`, traced and
+    compiled once (the in-graph optimisers' program holds the solve three times: the
+    loss's, the Jacobian's and the final one with the peaks), then `_fit`'s record."""
+    v0, e, T = data[0], data[1], data[2]
+    if options.start_on_curves and options.has_e:
+        law = _start_compiled(
+            law, options.free, m=m, v0=v0, e=e, T=T, has_T=options.has_T, key=options.curves
+        )
+    theta0 = np.stack([np.asarray(to_unbounded(k, law.parameters[k])) for k in options.free])
+
+    def evaluate(theta):
+        r, predictions, jacobian = _evaluated(law, jnp.asarray(theta), data, m, g, options)
+        return np.asarray(r), np.asarray(jacobian), predictions
+
+    exact = _solved_by_start(law, options, v0.shape[0])
+    if exact:
+        r, jacobian, predictions = evaluate(theta0)
+        history = np.asarray([0.5 * float(r @ r)])
+        result = LeastSquares(theta0, r, jacobian, predictions, history, True, 0)
+    else:
+        result = levenberg_marquardt(
+            evaluate, theta0, max_iter=options.max_iter, tol=options.tol, max_step=_MAX_STEP
+        )
+    solved = (
+        jnp.asarray(result.theta),
+        jnp.asarray(result.residuals),
+        result.extra,
+        jnp.asarray(result.jacobian),
+        jnp.asarray(result.history),
+        result.iterations,
+        jnp.asarray(result.converged),
+    )
+    return _recorded_compiled(
+        law, solved, data, m, g, target_tol, options, exact=exact, optimizer="lm"
     )

@@ -30,12 +30,14 @@ class LeastSquares:
 
 
 def levenberg_marquardt(
-    evaluate, theta0, active=None, *, max_iter: int, tol: float
+    evaluate, theta0, active=None, *, max_iter: int, tol: float, max_step: float = np.inf
 ) -> LeastSquares:
     """Minimise `|r|^2/2` over the `active` components of `theta` (numpy driver around the
     compiled `evaluate(theta) -> (r, J, extra)`). Marquardt's scaling with a floor, so a
     direction the data do not see stays where it is. `active`: a mask of the components
-    to move (default all). Converged: the scaled gradient, the relative decrease or the
+    to move (default all). `max_step`: the largest move of one component in one step (a
+    step beyond it is shortened along its direction), for parameters in logarithms or
+    logits, where a long step can land where the loss is flat. Converged: the scaled gradient, the relative decrease or the
     step fell below `tol`, or no step lowers the loss any more."""
     theta = np.array(theta0, dtype=float)
     r, J, extra = evaluate(theta)
@@ -57,6 +59,7 @@ def levenberg_marquardt(
         improved = False
         while lam < 1e12:
             step = np.linalg.lstsq(A + lam * np.diag(diag), -grad, rcond=None)[0]
+            step *= min(1.0, max_step / max(np.max(np.abs(step), initial=0.0), 1e-300))
             trial = theta.copy()
             trial[active] += step
             r_new, J_new, extra_new = evaluate(trial)

@@ -252,7 +252,8 @@ BAD_INPUTS = [
 
 @pytest.mark.parametrize("bad, message", BAD_INPUTS, ids=[m for _, m in BAD_INPUTS])
 def test_refuses_impossible_targets_before_any_work(monkeypatch, bad, message):
-    monkeypatch.setattr(_calibrate, "_fit", _no_work)
+    for fitter in ("_fit", "_fit_on_host"):
+        monkeypatch.setattr(_calibrate, fitter, _no_work)
     kwargs = {"m": M, "v0": V0, **bad}
     with pytest.raises(ValueError) as error:
         ji.calibrate(ji.law("hertz_rate", **LAW14), **kwargs)
@@ -261,7 +262,8 @@ def test_refuses_impossible_targets_before_any_work(monkeypatch, bad, message):
 
 
 def test_refuses_what_is_not_a_law(monkeypatch):
-    monkeypatch.setattr(_calibrate, "_fit", _no_work)
+    for fitter in ("_fit", "_fit_on_host"):
+        monkeypatch.setattr(_calibrate, fitter, _no_work)
     with pytest.raises(TypeError, match="calibrate needs a law"):
         ji.calibrate({"c": 2e6, "b1": 800.0}, m=M, v0=V0, e=0.8)
 
@@ -277,7 +279,8 @@ def test_accepts_the_edge_of_the_admissible(monkeypatch):
         reached.append(args)
         raise Reached
 
-    monkeypatch.setattr(_calibrate, "_fit", fit)
+    for fitter in ("_fit", "_fit_on_host"):
+        monkeypatch.setattr(_calibrate, fitter, fit)
     with pytest.raises(Reached):
         ji.calibrate(ji.law("hertz_rate", **LAW14), m=M, v0=V0, e=1.0)
     with pytest.raises(Reached):

@@ -147,7 +147,8 @@ def test_calibrate_asks_choose_path_for_its_path(monkeypatch, law, g, method, pa
         asked.append(options)
         raise Reached
 
-    monkeypatch.setattr(_calibrate, "_fit", fit)
+    for fitter in ("_fit", "_fit_on_host"):
+        monkeypatch.setattr(_calibrate, fitter, fit)
     with pytest.raises(Reached):
         ji.calibrate(law, m=1.0, v0=2.5, e=0.8, T=5e-3, g=g, method=method)
     (question, setup) = asked
@@ -170,7 +171,8 @@ def test_a_fit_never_builds_curves_once_compiling(monkeypatch, tmp_path):
 
     monkeypatch.setattr(build, "build_curves", refuse)
     reached = []
-    monkeypatch.setattr(_calibrate, "_fit", lambda *a: reached.append(a))
+    for fitter in ("_fit", "_fit_on_host"):
+        monkeypatch.setattr(_calibrate, fitter, lambda *a: reached.append(a))
     store.curves_for.cache_clear()
     try:
         law = ji.law("hunt_crossley", c=2e6, a=0.1, n=1.37)  # not a shipped shape
