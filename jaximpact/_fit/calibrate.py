@@ -1195,13 +1195,17 @@ def _fit_on_host(law, data, m, g, target_tol, options):
         result = levenberg_marquardt(
             evaluate, theta0, max_iter=options.max_iter, tol=options.tol, max_step=_MAX_STEP
         )
+    # the history padded with the final loss to L-BFGS's fixed length, and every number an
+    # array: one compiled record for every fit of these shapes
+    history = np.full(options.max_iter + 1, result.history[-1])
+    history[: len(result.history)] = result.history
     solved = (
         jnp.asarray(result.theta),
         jnp.asarray(result.residuals),
         result.extra,
         jnp.asarray(result.jacobian),
-        jnp.asarray(result.history),
-        result.iterations,
+        jnp.asarray(history),
+        jnp.asarray(result.iterations),
         jnp.asarray(result.converged),
     )
     return _recorded_compiled(
