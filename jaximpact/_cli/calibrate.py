@@ -109,9 +109,10 @@ def add_calibrate(subparsers):
     )
     parser.add_argument(
         "--optimizer",
-        choices=("lbfgs", "lm"),
-        default="lbfgs",
-        help="optax L-BFGS (default) or optimistix Levenberg-Marquardt",
+        choices=("auto", "lbfgs", "lm"),
+        default="auto",
+        help="auto (default): Levenberg-Marquardt driven from Python around one compiled "
+        "program; lbfgs: optax L-BFGS inside the compiled fit (compiles longer)",
     )
     parser.add_argument(
         "--init",
@@ -415,7 +416,7 @@ def _run_one(args, data, sampling=None):
         m=args.mass,
         separation=args.separation,
         g=args.gravity,
-        optimizer=args.optimizer,
+        optimizer=fit.optimizer,  # the one that ran (auto: lm for an eager fit)
         init=init,
         start={k: float(v) for k, v in start.parameters.items()},
         given=sorted(given),
@@ -538,7 +539,7 @@ def _run_all(args, data):
         m=args.mass,
         separation=args.separation,
         g=args.gravity,
-        optimizer=args.optimizer,
+        optimizer=rankings[0].fit.optimizer,
         criterion="aic" if has_sigma else "sum_sq",
         bad_fit=bad_fit,
         n_data=n_data,
