@@ -12,8 +12,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._laws import AbstractLaw, damping_parameter
+from .._least_squares import levenberg_marquardt
 from .._solve.bounce import chain, trajectory_from_records
-from .least_squares import levenberg_marquardt
 from .parameters import from_unbounded, law_with, to_unbounded
 
 

@@ -23,6 +23,7 @@ from .._format import (
     jsonable,
 )
 from .._laws import AbstractLaw, damping_parameter, shape_of
+from .._least_squares import LeastSquares, levenberg_marquardt
 from .._solve.impact import ImpactOptions, solve_impact
 from .._solve.options import (
     FIT_DECIDES,
@@ -37,7 +38,6 @@ from .._solve.options import (
 from .._status import Status
 from .._xla_log import quietly_compiled
 from .forward_jacobian import value_and_jacobian, with_forward_jacobian
-from .least_squares import LeastSquares, levenberg_marquardt
 from .parameters import default_free, law_with, to_unbounded
 from .restitution_tables import restitution_table
 

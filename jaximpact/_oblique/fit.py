@@ -12,12 +12,12 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
-import optimistix as optx
 from jaxtyping import Array
 
 from .._checks import check_positive, is_traced
 from .._format import format_fields, format_value, jsonable
 from .._laws import AbstractLaw
+from .._least_squares import levenberg_marquardt
 from .._solve.options import CUSTOM_RTOL, DEFAULT_RTOL
 from .._solve.precision import resolvable_tolerances
 from .._status import Status
@@ -289,26 +289,33 @@ def _evaluate(problem, thetas):
 
 
 @eqx.filter_jit
-def _refine(problem, start, max_steps, tol):
-    """Levenberg-Marquardt from `start`: the parameters, whether it met `tol`, its steps,
-    and there the residuals, their Jacobian and the impacts (in the same program: a
-    separate one compiled for 35 s more, this pass costs 5 s)."""
-    solution = optx.least_squares(
-        lambda theta, _: problem.residuals(problem.predict(theta)),
-        optx.LevenbergMarquardt(rtol=tol, atol=tol),
-        start,
-        max_steps=max_steps,
-        throw=False,
-    )
-    ok = solution.result == optx.RESULTS.successful
+def _linearised(problem, theta):
+    """The residuals at `theta`, their forward-mode Jacobian and the impacts: the one
+    program a refinement compiles (the in-graph optimistix solver compiled the solve into
+    its loop besides, 35 s more on a first call)."""
 
     def with_aux(t):
         result = problem.predict(t)
         r = problem.residuals(result)
         return r, (r, result)
 
-    jacobian, (r, result) = jax.jacfwd(with_aux, has_aux=True)(solution.value)
-    return solution.value, ok, solution.stats["num_steps"], (r, jacobian, result)
+    jacobian, (r, result) = jax.jacfwd(with_aux, has_aux=True)(theta)
+    return r, jacobian, result
+
+
+def _refine(problem, start, max_steps, tol):
+    """Levenberg-Marquardt from `start` (`levenberg_marquardt`, driven from Python around
+    `_linearised`): the parameters, whether it met `tol`, its steps, and there the
+    residuals, their Jacobian and the impacts."""
+
+    def evaluate(theta):
+        r, jacobian, result = _linearised(problem, jnp.asarray(theta))
+        return np.asarray(r), np.asarray(jacobian), result
+
+    fit = levenberg_marquardt(
+        evaluate, np.asarray(start, dtype=float), max_iter=max_steps, tol=tol, max_step=2.0
+    )
+    return fit.theta, fit.converged, fit.iterations, (fit.residuals, fit.jacobian, fit.extra)
 
 
 def _chi2_parts(problem, thetas) -> tuple[np.ndarray, np.ndarray]:

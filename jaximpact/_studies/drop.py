@@ -9,8 +9,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._fit.least_squares import levenberg_marquardt
 from .._format import PrintedFields
+from .._least_squares import levenberg_marquardt
 
 
 class DropDesign(PrintedFields, eqx.Module):
@@ -20,7 +20,7 @@ class DropDesign(PrintedFields, eqx.Module):
     - `target`, `apexes` (m): the wanted and the achieved apex heights after each contact.
     - `residuals`: `ln(apexes / target)`; `loss`: half their sum of squares.
     - `converged`: the scaled gradient, the relative decrease or the step fell below `tol`
-      (`_fit.least_squares`).
+      (`_least_squares`).
     - `iterations`; `history`: the loss at each accepted iterate.
     """
 
