@@ -3,7 +3,15 @@ Parquet) file; on one process or several (`jax.distributed`)."""
 
 from pathlib import Path
 
-from .common import CLIError, command_parser, emit, file_law, is_file_law, parse_params
+from .common import (
+    CLIError,
+    add_law_arguments,
+    command_parser,
+    emit,
+    file_law,
+    is_file_law,
+    parse_params,
+)
 
 
 def add_batch(subparsers):
@@ -43,20 +51,11 @@ def add_batch(subparsers):
     parser.add_argument(
         "source", type=Path, metavar="IN", help="CSV or Parquet file, one body per row"
     )
-    parser.add_argument(
-        "--law",
-        required=True,
-        metavar="NAME",
-        help="see `jaximpact laws`; or a user's law FILE.py:NAME, the function NAME(x, v, "
+    add_law_arguments(
+        parser,
+        law="see `jaximpact laws`; or a user's law FILE.py:NAME, the function NAME(x, v, "
         "params) of a Python file",
-    )
-    parser.add_argument(
-        "--param",
-        action="extend",
-        nargs="+",
-        default=[],
-        metavar="NAME=VALUE",
-        help="a law parameter for every row, SI units (--param c=2e6 b1=800, or repeated)",
+        param="a law parameter for every row, SI units (--param c=2e6 b1=800, or repeated)",
     )
     parser.add_argument("--mass", type=float, metavar="KG", help="m for every row, kg")
     parser.add_argument("--v0", type=float, metavar="M/S", help="impact speed for every row")

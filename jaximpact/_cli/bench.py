@@ -8,7 +8,6 @@ on; `--json` for the numbers, `--plot` for a bar chart of the ratios against the
 
 import math
 import sys
-import textwrap
 
 from .._bench import LAWS, TARGETS, require_scipy, run_bench, steps
 from .._format import format_number
@@ -22,6 +21,7 @@ from .common import (
     emit,
     format_table,
     terminal_width,
+    wrap_text,
 )
 
 
@@ -113,7 +113,9 @@ def _text(data, width=None) -> str:
     cache = machine["compilation_cache"]
 
     def prose(*paragraphs) -> list[str]:  # each wrapped to the width
-        return [line for p in paragraphs for line in (_wrap(p, width) if p else [""])]
+        return [
+            line for p in paragraphs for line in (wrap_text(p, width, then="  ") if p else [""])
+        ]
 
     out = prose(
         f"jaximpact bench{' --quick' if cond['quick'] else ''}: default impact() against scipy "
@@ -220,11 +222,3 @@ def _plot(data, path):
     )
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     save_figure(fig, path)
-
-
-def _wrap(text: str, width: int) -> list[str]:
-    """`text` in lines of at most `width` characters (a word longer than that, such as a
-    path, on a line of its own), continuations indented by two."""
-    return textwrap.wrap(
-        text, width, subsequent_indent="  ", break_long_words=False, break_on_hyphens=False
-    )

@@ -11,14 +11,16 @@ import math
 from pathlib import Path
 
 from .._choices import unknown_name
-from .._files import cell_number
 from .._format import format_number, format_quantity
 from .._interrupt import check_interrupt, set_note
 from .._plotting import new_figure, plain_log_axis, save_figure
 from .._progress import metered
 from .common import (
+    LAW_HELP,
     MASS_HELP,
     CLIError,
+    add_contact_arguments,
+    add_free_argument,
     add_law_arguments,
     add_output_arguments,
     check_plot_path,
@@ -31,8 +33,9 @@ from .common import (
     parse_params,
     read_table,
     require_mass,
+    wrap_text,
 )
-from .laws import concrete_units
+from .laws import law_title, law_units
 
 COLUMNS = ("v0", "e", "T", "sigma_e", "sigma_T")
 ALL = "all"
@@ -53,23 +56,21 @@ def add_calibrate(subparsers):
         "the law's nondimensional restitution table. With sigmas the residuals are weighted "
         "and the standard errors of the parameters are printed. --law all fits every law of "
         "the seed paper and ranks them (by AIC with sigmas, else by the sum of squared "
-        "residuals). The first fit of a law compiles it (10-30 s); later runs reuse JAX's "
-        "persistent compilation cache.",
+        "residuals; --by evidence: by their evidence, with Bayes factors). The first fit of "
+        "a law compiles it (10-30 s); later runs reuse JAX's persistent compilation cache.",
         example="jaximpact calibrate --law hertz_rate --mass 1 --v0 2.5 --e 0.85 --T 7.8e-3\n"
-        "jaximpact calibrate --law kelvin_voigt --mass 1 --v0 2.5 --e 0.7 --T 2e-3 --free c,b --json\n"
+        "jaximpact calibrate --law kelvin_voigt --mass 1 --v0 2.5 --e 0.7 --T 2e-3 --free c,b "
+        "--json\n"
         "jaximpact calibrate --law hertz_rate --mass 0.0027 --data drops.csv --plot fit.png\n"
-        "jaximpact calibrate --law all --mass 0.0027 --data drops.csv",
+        "jaximpact calibrate --law all --mass 0.0027 --data drops.csv --by evidence",
     )
-    add_law_arguments(parser)
-    for action in parser._actions:
-        if action.dest == "law":
-            action.help += f", or '{ALL}' to fit every law of the seed paper and rank them"
-        elif action.dest == "param":
-            action.help = (
-                "start value of a parameter (or value of a fixed one), SI units, e.g. "
-                "--param c=1e6 b1=100 (default: jaximpact.starting_law, then the law's "
-                "restitution table where it has one)"
-            )
+    add_law_arguments(
+        parser,
+        law=f"{LAW_HELP}, or '{ALL}' to fit every law of the seed paper and rank them",
+        param="start value of a parameter (or value of a fixed one), SI units, e.g. --param "
+        "c=1e6 b1=100 (default: jaximpact.starting_law, then the law's restitution table "
+        "where it has one)",
+    )
     parser.add_argument("--mass", type=float, metavar="KG", help=MASS_HELP)
     parser.add_argument("--v0", type=float, metavar="M/S", help="impact speed, m/s (> 0)")
     parser.add_argument("--e", type=float, metavar="E", help="measured restitution, in (0, 1]")
@@ -87,26 +88,10 @@ def add_calibrate(subparsers):
         help="measurements, one impact speed per row: a header with v0,e and optionally "
         "T,sigma_e,sigma_T (SI units); instead of --v0/--e/--T",
     )
-    parser.add_argument(
-        "--free",
-        action="extend",
-        nargs="+",
-        metavar="NAME",
-        help="parameters to fit, e.g. --free c,b1 (default: c if T is given, and the damping)",
+    add_free_argument(
+        parser, "parameters to fit, e.g. --free c,b1 (default: c if T is given, and the damping)"
     )
-    parser.add_argument(
-        "--separation",
-        choices=("force", "penetration"),
-        default="force",
-        help="end of contact: force back to zero (default) or penetration back to zero",
-    )
-    parser.add_argument(
-        "--gravity",
-        type=float,
-        default=0.0,
-        metavar="M/S^2",
-        help="gravity along the inward normal during contact, m/s^2 (default 0)",
-    )
+    add_contact_arguments(parser)
     parser.add_argument(
         "--optimizer",
         choices=("auto", "lbfgs", "lm"),
@@ -122,6 +107,14 @@ def add_calibrate(subparsers):
     )
     parser.add_argument(
         "--max-iter", type=int, default=100, metavar="N", help="iteration limit (default 100)"
+    )
+    parser.add_argument(
+        "--by",
+        choices=("aic", "evidence"),
+        default="aic",
+        help="with --law all: rank by AIC (the default; by the sum of squared residuals "
+        "without sigmas) or by the evidence, each law's marginal likelihood (the Laplace "
+        "approximation of its posterior, default priors), printed with its Bayes factors",
     )
     add_posterior_arguments(parser)
     add_output_arguments(parser)
@@ -239,43 +232,19 @@ def sample_posterior(fit, options):
 # --------------------------------------------------------------------------- the data
 
 
-def _cell(text, where, column):
-    """The number in a cell of `--data` (NaN where empty); a `CLIError` naming the file and
-    line (`where`) and the column of one that is not a number (`_files.cell_number`)."""
-    if not text.strip():
-        return math.nan
-    try:
-        return cell_number(text)
-    except ValueError as error:
-        raise CLIError(f"{where}, column {column}: {error}") from None
-
-
 def read_data(path: Path) -> dict:
     """`{column: [float, ...]}` from a CSV with a header naming some of `COLUMNS`; empty
     cells are NaN; blank lines and lines starting with `#` are skipped."""
-    header, rows = read_table(
-        path, COLUMNS, label=f"--data {path}", hint="v0,e[,T,sigma_e,sigma_T]"
-    )
-    for needed in ("v0", "e"):
-        if needed not in header:
-            raise CLIError(f"--data {path}: no column {needed!r} (need v0,e[,T,sigma_e,sigma_T])")
-    columns = {name: [] for name in header}
-    for number, cells in rows:
-        if len(cells) != len(header):
-            raise CLIError(
-                f"--data {path}, line {number}: {len(cells)} cells for {len(header)} columns"
-            )
-        for name, cell in zip(header, cells, strict=True):
-            columns[name].append(_cell(cell, f"--data {path}, line {number}", name))
+    label, hint = f"--data {path}", "v0,e[,T,sigma_e,sigma_T]"
+    header, rows = read_table(path, COLUMNS, label=label, hint=hint, needed=("v0", "e"))
+    for line, values in rows:
         for name in ("v0", "e"):
-            if math.isnan(columns[name][-1]):
+            if math.isnan(values[name]):
                 what = "impact speed" if name == "v0" else "restitution (T may be left empty)"
-                raise CLIError(
-                    f"--data {path}, line {number}: no {name}; every row needs its {what}"
-                )
-    if not columns["v0"]:
-        raise CLIError(f"--data {path} has a header but no rows")
-    return columns
+                raise CLIError(f"{label}, line {line}: no {name}; every row needs its {what}")
+    if not rows:
+        raise CLIError(f"{label} has a header but no rows")
+    return {name: [values[name] for _, values in rows] for name in header}
 
 
 def measurements(args) -> dict:
@@ -347,6 +316,8 @@ def run_calibrate(args):
     if args.max_iter < 1:
         raise CLIError("--max-iter must be at least 1")
     sampling = posterior_options(args)
+    if args.by != "aic" and args.law != ALL:
+        raise CLIError(f"--by {args.by} ranks the laws of --law all: give --law all")
     data = measurements(args)
     if args.law == ALL:
         if args.free or args.param:
@@ -438,114 +409,97 @@ def _run_one(args, data, sampling=None):
 
 
 def _fit_record(name, fit, data, order=None):
-    """What one fit of the law `name` found, for --json and the text (`order`: the order of
-    its parameters, a user's law's as given; a law of the table has its own)."""
-    import numpy as np
-
+    """What one fit of the law `name` found, for --json and the text: `Fit.to_dict()` with
+    the law by its name, its parameters in its order (`order`: a user's law's as given; a
+    law of the table has its own), `sum_sq`, `max_residual`, `goodness` and one row per
+    speed (measured and fitted e and T, the sigmas, x_max and F_max)."""
     from .._fit.calibrate import goodness_text
     from .._laws import LAWS
 
+    record = fit.to_dict()
+    order = LAWS[name].parameters if name in LAWS else (order or fit.law.parameters)
     rows = []
-    for i in range(data["rows"]):
-        T = None if data["T"] is None else data["T"][i]
+    for i, v0 in enumerate(data["v0"]):
+        T = record["T_target"][i]
         rows.append(
             dict(
-                v0=data["v0"][i],
+                v0=v0,
                 e=data["e"][i],
-                e_fit=float(fit.e[i]),
-                T=None if T is None or math.isnan(T) else T,
-                T_fit=float(fit.T[i]),
+                e_fit=record["e"][i],
+                T=T,
+                T_fit=record["T"][i],
                 sigma_e=None if data["sigma_e"] is None else data["sigma_e"][i],
-                sigma_T=None
-                if data["sigma_T"] is None or T is None or math.isnan(T)
-                else data["sigma_T"][i],
+                sigma_T=None if data["sigma_T"] is None or T is None else data["sigma_T"][i],
+                x_max=record["x_max"][i],
+                F_max=record["F_max"][i],
             )
         )
-    residuals = np.asarray(fit.residuals)
-    order = [k for k in (order or fit.law.parameters) if k in fit.params]
-    if name in LAWS:  # the law's own order (a compiled fit returns its dict sorted)
-        order = [k for k in LAWS[name].parameters if k in fit.params]
-    for i, row in enumerate(rows):
-        row.update(x_max=float(fit.x_max[i]), F_max=float(fit.F_max[i]))
-    return dict(
-        law=name,
-        params={k: float(fit.params[k]) for k in order},
-        free=list(fit.free),
-        stderr=None if fit.stderr is None else {k: float(v) for k, v in fit.stderr.items()},
-        converged=bool(fit.converged),
-        reproduces=bool(fit.reproduces),
-        target_tol=float(fit.target_tol),
-        undetermined=list(fit.undetermined),
-        iterations=int(fit.iterations),
-        loss=float(fit.loss),
-        max_residual=float(np.max(np.abs(residuals))) if residuals.size else 0.0,
-        n_data=int(fit.n_data),
-        dof=int(fit.dof),
-        weighted=fit.weighted,
-        sum_sq=float(fit.chi2),
-        reduced_chi2=_number(fit.reduced_chi2),
-        p_value=_number(fit.p_value),
-        rms_e=_number(fit.rms_e),
-        rms_T=_number(fit.rms_T),
-        goodness=goodness_text(fit),
-        notes=list(fit.notes),
-        rows=rows,
-    )
-
-
-def _number(value):
-    """A float, or None for NaN (JSON has no NaN)."""
-    value = float(value)
-    return value if math.isfinite(value) else None
+    return {
+        **record,
+        "law": name,
+        "params": {k: record["params"][k] for k in order if k in record["params"]},
+        "sum_sq": record["chi2"],
+        "max_residual": float(fit.max_residual),
+        "goodness": goodness_text(fit),
+        "rows": rows,
+    }
 
 
 def _run_all(args, data):
-    from .._fit.model_choice import PAPER_LAWS, compare_laws, fits_badly
+    """`--law all`: every law of the seed paper fitted and ranked (`compare_laws`, by
+    `--by`), a law whose fit fails reported beside the others' ranking."""
+    from .._fit.model_choice import PAPER_LAWS, fits_badly
+    from .._posterior.evidence import compare_laws
 
-    laws = tuple(MODEL_CHOICE_LAWS or PAPER_LAWS)
-    has_sigma = data["sigma_e"] is not None
-    kwargs = _fit_kwargs(args, data)
-    rankings, failed = [], {}
-    with metered(heartbeat_meter(), len(laws), "fitting laws") as bar:
-        for done, name in enumerate(laws):
-            set_note(
-                f"{done} of {len(laws)} laws fitted, nothing written (the ranking is "
-                "printed at the end)"
-            )
-            check_interrupt()  # a safe point between fits: a Ctrl-C stops here at the latest
-            try:  # one law at a time: the verdict on the best one comes at the end
-                rankings += compare_laws(laws=(name,), progress=False, warn=False, **kwargs)
-            except Exception as error:  # one law's failure must not hide the others' fits
-                check_interrupt()  # unless it was an interrupt that JAX reported as an error
-                failed[name] = f"{type(error).__name__}: {str(error).splitlines()[0]}"
-            bar.update(1, name)
+    failed, skipped, seen = {}, {}, []
+
+    def note():  # what an interrupt says
+        done = f"{len(seen)} of {len(PAPER_LAWS)} laws fitted"
+        set_note(f"{done}, nothing written (the ranking is printed at the end)")
+
+    def done(index, name, result):  # after each law: a safe point for Ctrl-C
+        check_interrupt()  # also where JAX reported an interrupt as the fit's error
+        seen.append(name)
+        if isinstance(result, Exception):
+            failed[index] = (name, f"{type(result).__name__}: {str(result).splitlines()[0]}")
+        elif result is None:
+            skipped[index] = name
+        note()
+
+    note()
+    rankings = compare_laws(
+        laws=PAPER_LAWS,
+        by=args.by,
+        progress=heartbeat_meter(),
+        warn=False,
+        errors="skip",
+        callback=done,
+        **_fit_kwargs(args, data),
+    )
     set_note(None)
+    failed = dict(failed[i] for i in sorted(failed))
     if not rankings:
         raise CLIError(
             "no law could be fitted: "
             + ("; ".join(f"{k}: {v}" for k, v in failed.items()) or "more parameters than data")
         )
-    rankings.sort(key=(lambda r: r.aic) if has_sigma else (lambda r: r.sum_sq))
     ranked = []
     for rank, item in enumerate(rankings, start=1):
-        record = _fit_record(item.name, item.fit, data)
-        record.update(rank=rank, k=item.k, chi2=item.sum_sq, aic=item.aic, bic=item.bic)
-        ranked.append(record)
-    bad_fit = fits_badly(rankings[0].fit)
+        extra = {k: v for k, v in item.to_dict().items() if k not in ("name", "fit")}
+        ranked.append({**_fit_record(item.name, item.fit, data), **extra, "rank": rank})
     n_data = len(data["e"]) + (
         0 if data["T"] is None else sum(not math.isnan(t) for t in data["T"])
     )
+    weighted = data["sigma_e"] is not None
     result = dict(
         m=args.mass,
         separation=args.separation,
         g=args.gravity,
         optimizer=rankings[0].fit.optimizer,
-        criterion="aic" if has_sigma else "sum_sq",
-        bad_fit=bad_fit,
+        criterion="evidence" if args.by == "evidence" else "aic" if weighted else "sum_sq",
+        bad_fit=fits_badly(rankings[0].fit),
         n_data=n_data,
-        skipped=[
-            name for name in laws if name not in {r.name for r in rankings} and name not in failed
-        ],
+        skipped=[skipped[i] for i in sorted(skipped)],
         failed=failed,
         best=ranked[0]["law"],
         ranking=ranked,
@@ -553,37 +507,16 @@ def _run_all(args, data):
     if args.plot is not None:
         _plot(args, data, [(r.name, r.fit) for r in rankings[:3]])
         result["plot"] = str(args.plot)
-    emit(args, result, lambda: _all_text(result, data))
+    table = rankings.table() if args.by == "evidence" else None
+    emit(args, result, lambda: _all_text(result, data, table))
     return 0
-
-
-# Laws `--law all` fits (None: the seed paper's, `compare_laws`'s default); tests narrow it.
-MODEL_CHOICE_LAWS: tuple[str, ...] | None = None
 
 
 # ---------------------------------------------------------------------------- text
 
 
-def _law_line(name):
-    from .._laws import LAWS
-
-    spec = LAWS.get(name)
-    if spec is None:  # a user's law, FILE.py:NAME
-        return name
-    eq = f"eq. {spec.equation}: " if spec.equation != "-" else ""
-    return f"{name} ({eq}F = {spec.formula})"
-
-
-def _units(name, params):
-    from .._laws import LAWS
-
-    if name not in LAWS:  # a user's law: its units are its own
-        return {}
-    return concrete_units(LAWS[name], params)
-
-
 def _params_text(name, params, stderr=None, indent=11):
-    units = _units(name, params)
+    units = law_units(name, params)
     width = max(len(k) for k in params)
     lines = []
     for key, value in params.items():
@@ -649,20 +582,6 @@ def _reproduces_text(record):
     return f"does not reproduce the data within {meaning}: largest residual {largest}"
 
 
-def _wrapped(head, text, width=100):
-    """`head` then `text` wrapped to `width` columns, continued under the text."""
-    import textwrap
-
-    return textwrap.fill(
-        text,
-        width=width,
-        initial_indent=head,
-        subsequent_indent=" " * len(head),
-        break_on_hyphens=False,
-        break_long_words=False,
-    )
-
-
 def _sanity_text(record):
     """The sizes the fitted law implies at the measured speeds, with the mass and the
     kinetic energy: a mass typed in grams as kilograms shows as a force and an energy a
@@ -705,7 +624,7 @@ def _one_text(result, data):
     kept = {k: v for k, v in result["params"].items() if k not in result["free"]}
     rows = data["rows"]
     lines = [
-        f"law        {_law_line(result['law'])}",
+        f"law        {law_title(result['law'])}",
         f"data       {rows} impact{'s' if rows > 1 else ''}, m = {format_number(result['m'])} kg, "
         f"separation by {result['separation']}"
         + (f", g = {format_number(result['g'])} m/s^2" if result["g"] else ""),
@@ -723,41 +642,36 @@ def _one_text(result, data):
             )
             why.append(f"{', '.join(assumed)}: {origin}")
         lines.append(f"fixed      {_params_text(result['law'], kept)}")
-        lines.append(
-            _wrapped(
-                "           ",
-                f"(not fitted: {'; '.join(why)}; --param sets a value, --free fits it)",
-            )
-        )
-    lines.append(
-        _wrapped(
-            "fit        ",
-            f"{_status_text(result)} ({result['optimizer']}, start {result['init']}), "
-            f"loss {format_number(result['loss'], 3)}",
-        )
+        why = f"(not fitted: {'; '.join(why)}; --param sets a value, --free fits it)"
+        lines += wrap_text(why, 100, first=" " * 11)
+    status = f"{_status_text(result)} ({result['optimizer']}, start {result['init']})"
+    lines += wrap_text(
+        f"{status}, loss {format_number(result['loss'], 3)}", 100, first="fit        "
     )
-    lines.append(_wrapped("goodness   ", result["goodness"]))
-    lines.append(_wrapped("           ", _reproduces_text(result)))
+    lines += wrap_text(result["goodness"], 100, first="goodness   ")
+    lines += wrap_text(_reproduces_text(result), 100, first=" " * 11)
     if result["stderr"] is not None:
         source = "the sigmas" if result["weighted"] else "the residuals' scatter (no sigmas given)"
         lines.append(f"           +- one standard error, from the Jacobian and {source}")
-    lines.append(_wrapped("check      ", _sanity_text(result)))
+    lines += wrap_text(_sanity_text(result), 100, first="check      ")
     for note in result["notes"]:
-        lines.append(_wrapped("note       ", note))
+        lines += wrap_text(note, 100, first="note       ")
     lines += ["", _rows_text(data, result["rows"])]
     if "plot" in result:
         lines.append(f"plot written to {result['plot']}")
     return "\n".join(lines)
 
 
-def _all_text(result, data):
-    criterion = result["criterion"]
-    weighted = criterion == "aic"
+def _all_text(result, data, evidence=None):
+    """The ranking as a table; `evidence`: the Bayes factors' (`--by evidence`)."""
+    weighted = result["ranking"][0]["weighted"]
     by = (
         "AIC = chi2 + 2k (chi2: the sum of squared normalised residuals)"
         if weighted
         else "sum_sq, the sum of squared residuals e_fit - e and (T_fit - T)/T (no sigmas)"
     )
+    if evidence is not None:
+        by = "the evidence, each law's marginal likelihood (Laplace at the mode)"
     lines = [
         f"model choice: {result['n_data']} measurements at {data['rows']} speed"
         f"{'s' if data['rows'] > 1 else ''}, m = {format_number(result['m'])} kg; "
@@ -798,7 +712,7 @@ def _all_text(result, data):
         else "rms_e: RMS of e_fit - e" + ("; rms_T: RMS of (T_fit - T)/T" if has_T else "")
     )
     lines.append(f"  {meaning}; converged: the optimiser reached a minimum")
-    lines.append("")
+    lines += ["", evidence, ""] if evidence is not None else [""]
     lines.append(f"best: {result['best']}")
     if result["bad_fit"]:
         lines.append(

@@ -10,7 +10,7 @@ import os
 import re
 import sys
 import textwrap
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 
 from .._cache import enable_cache
@@ -113,29 +113,40 @@ LAW_HELP = (
 )
 
 
-def add_law_arguments(parser, *, required: bool = True):
-    """`--law NAME` (or `FILE.py:NAME`) and `--param NAME=VALUE` (repeatable); read them with
-    `law_from_args`."""
-    parser.add_argument("--law", required=required, metavar="NAME", help=LAW_HELP)
+PARAM_HELP = (
+    "a law parameter in SI units, e.g. --param c=2e6 --param b1=800 (or --param c=2e6 b1=800)"
+)
+
+
+def add_law_arguments(parser, *, required: bool = True, law=LAW_HELP, param=PARAM_HELP):
+    """`--law NAME` (or `FILE.py:NAME`) and `--param NAME=VALUE` (repeatable), with the
+    helps `law` and `param`; read them with `law_from_args`."""
+    parser.add_argument("--law", required=required, metavar="NAME", help=law)
     parser.add_argument(
-        "--param",
-        action="extend",
-        nargs="+",
-        default=[],
-        metavar="NAME=VALUE",
-        help="a law parameter in SI units, e.g. --param c=2e6 --param b1=800 "
-        "(or --param c=2e6 b1=800)",
+        "--param", action="extend", nargs="+", default=[], metavar="NAME=VALUE", help=param
     )
 
 
-# jaximpact.TANGENTIAL_LAW_NAMES (no JAX import here; tests/cli checks they agree)
-TANGENTIAL_CHOICES = (
-    "mindlin",
-    "mindlin_force",
-    "mindlin_rescale",
-    "mindlin_rescale_force",
-    "linear_history",
-)
+def add_free_argument(parser, help: str):
+    """`--free NAME ...` (or `--free c,b1`): the parameters to fit (`free_names`)."""
+    parser.add_argument("--free", action="extend", nargs="+", metavar="NAME", help=help)
+
+
+class _TangentialNames(Sequence):
+    """`jaximpact.TANGENTIAL_LAW_NAMES`, the library's table read when argparse first asks
+    (to check `--tangential` or to print its help): importing it loads the oblique solver
+    (diffrax), a second that every start of the command line would otherwise spend."""
+
+    def __getitem__(self, index):
+        from .._oblique.tangential import TANGENTIAL_LAW_NAMES
+
+        return TANGENTIAL_LAW_NAMES[index]
+
+    def __len__(self):
+        return len(self[:])
+
+
+TANGENTIAL_CHOICES = _TangentialNames()
 
 
 def add_tangential_arguments(parser, *, required: bool, help: str, tparam_help: str):
@@ -146,7 +157,7 @@ def add_tangential_arguments(parser, *, required: bool, help: str, tparam_help: 
         required=required,
         choices=TANGENTIAL_CHOICES,
         metavar="NAME",
-        help=f"{help} (one of {', '.join(TANGENTIAL_CHOICES)})",
+        help=f"{help} (one of %(choices)s)",
     )
     parser.add_argument(
         "--tparam",
@@ -187,12 +198,9 @@ def require_mass(args) -> float:
     return args.mass
 
 
-def add_impact_arguments(parser):
-    """`--mass`, `--v0`, `--separation` and `--gravity`, the conditions of one impact."""
-    parser.add_argument("--mass", type=float, metavar="KG", help=MASS_HELP)
-    parser.add_argument(
-        "--v0", type=float, required=True, metavar="M/S", help="impact speed, m/s (> 0)"
-    )
+def add_contact_arguments(parser, *, gravity: float = 0.0):
+    """`--separation` and `--gravity` (default `gravity`, m/s^2): how a contact ends, and
+    the gravity during it."""
     parser.add_argument(
         "--separation",
         choices=("force", "penetration"),
@@ -203,9 +211,10 @@ def add_impact_arguments(parser):
     parser.add_argument(
         "--gravity",
         type=float,
-        default=0.0,
+        default=gravity,
         metavar="M/S^2",
-        help="gravity along the inward normal, m/s^2 (default 0; 9.81 for a ball on a floor)",
+        help=f"gravity along the inward normal, m/s^2 (default {gravity:g}; 9.81 for a ball on "
+        "a floor)",
     )
 
 
@@ -250,13 +259,17 @@ def parse_params(items: Iterable[str], flag: str = "--param") -> dict[str, float
     return params
 
 
-def read_table(path: Path, columns, *, label: str, hint: str):
+def read_table(path: Path, columns, *, label: str, hint: str, needed=()):
     """`(header, rows)` of the small CSV file at `path` (`_files.read_text` and `read_csv`:
     as people save it, `#` comments skipped), its header stripped and checked against
-    `columns`; one-line `CLIError`s that name the file as `label` (e.g. `--data in.csv`)
-    for a file that cannot be read or is not text, is empty, has an unknown column
-    (`hint`: the columns expected, in words) or a column named twice."""
-    from .._files import NotText, read_csv, read_text
+    `columns` (those in `needed` must be there), each row `(line number, {column: number})`,
+    an empty cell NaN. One-line `CLIError`s that name the file as `label` (e.g. `--data
+    in.csv`) for a file that cannot be read or is not text, is empty, has an unknown column
+    (`hint`: the columns expected, in words), a column named twice or one of `needed`
+    missing, a row with too many or too few cells, or a cell that is not a number."""
+    import math
+
+    from .._files import NotText, cell_number, read_csv, read_text
 
     try:
         text = read_text(path)  # as people save it: a byte-order mark, UTF-16, cp1252
@@ -275,7 +288,21 @@ def read_table(path: Path, columns, *, label: str, hint: str):
         )
     if len(set(header)) != len(header):
         raise CLIError(f"{label}: a column is named twice in the header")
-    return header, rows
+    for name in needed:
+        if name not in header:
+            raise CLIError(f"{label}: no column {name!r} (need {hint})")
+    numbers = []
+    for line, cells in rows:
+        if len(cells) != len(header):
+            raise CLIError(f"{label}, line {line}: {len(cells)} cells for {len(header)} columns")
+        values = {}
+        for column, cell in zip(header, cells, strict=True):
+            try:
+                values[column] = cell_number(cell) if cell.strip() else math.nan
+            except ValueError as error:
+                raise CLIError(f"{label}, line {line}, column {column}: {error}") from None
+        numbers.append((line, values))
+    return header, numbers
 
 
 def check_argument_scales(args):
@@ -605,8 +632,22 @@ def configure_jax():
 # --------------------------------------------------------------------------------------
 
 NARROWEST = 60  # columns: below this a table is not made narrower
-_WHOLE_WORDS = dict(break_long_words=False, break_on_hyphens=False)  # wrap at spaces only
 KEEP_TOGETHER = "\xa0"  # a space that `format_table` does not wrap at (printed as a space)
+
+
+def wrap_text(text: str, width: int, *, first: str = "", then: str | None = None) -> list[str]:
+    """`text` in lines of at most `width` characters, broken at spaces only (a longer word,
+    such as a path, on a line of its own): the first after `first`, the others after
+    `then` (default: as many spaces as `first`)."""
+    then = " " * len(first) if then is None else then
+    return textwrap.wrap(
+        text,
+        width,
+        initial_indent=first,
+        subsequent_indent=then,
+        break_long_words=False,
+        break_on_hyphens=False,
+    )
 
 
 def terminal_width(default: int = 88) -> int:
@@ -629,8 +670,6 @@ def format_table(header, rows, *, width=None, wrap=(), keep=1, notes=None, note_
     by `KEEP_TOGETHER` (a no-break space) stay on one line.
 
     **Example**: `format_table(["law", "e"], [["kelvin_voigt", "0.5"]], width=80)`."""
-    import textwrap
-
     width = terminal_width() if width is None else width
     header = [str(h) for h in header]
     rows = [[str(c) for c in row] for row in rows]
@@ -693,7 +732,7 @@ def format_table(header, rows, *, width=None, wrap=(), keep=1, notes=None, note_
     def cell_lines(text, i):
         if len(text) <= widths[i]:
             return [text]
-        return textwrap.wrap(text, widths[i], **_WHOLE_WORDS) or [""]
+        return wrap_text(text, widths[i]) or [""]
 
     def render(cells, wrapped):
         parts = [cell_lines(c, i) if (i in wrapped) else [c] for i, c in enumerate(cells)]
@@ -714,7 +753,7 @@ def format_table(header, rows, *, width=None, wrap=(), keep=1, notes=None, note_
         note = None if notes is None else notes[index]
         if note:  # from `note_column`, or further left where a word would not fit there
             at = max(0, min(indent, width - max(map(len, note.split()))))
-            out += [" " * at + line for line in textwrap.wrap(note, width - at, **_WHOLE_WORDS)]
+            out += wrap_text(note, width, first=" " * at)
     return [line.replace(KEEP_TOGETHER, " ") for line in out]
 
 
@@ -731,58 +770,39 @@ def heartbeat_meter(delay=None):
     return TextMeter(interval=10.0, delay=delay, heartbeat=0.2)
 
 
-def read_fit_record(path: str, law: str | None = None):
-    """`(data, record)` of the JSON file `path` ('-': stdin) that `jaximpact calibrate
-    --json` writes: the whole object, and the one fit in it (one law; of `--law all`'s
-    ranking its best, or the law `law` names), whose `law` is a name and whose `params`
-    are finite numbers. Each missing or mismatched field is a one-line `CLIError` (the one
-    reading of a fit's file, for `export --from` and `fit-oblique --from`)."""
-    import json
-    import math
+def read_fit(path: str, law: str | None = None):
+    """`(data, record, fit)` of the JSON file `path` ('-': stdin) that `jaximpact calibrate
+    --json` writes: the whole object, the one fit in it (one law; of `--law all`'s ranking
+    its best, or the law `law` names) and that fit read back (`Fit.from_dict`; a user's law
+    FILE.py:NAME from its file). A file that is no such fit is a one-line `CLIError` (the
+    one reading of a fit's file, for `export --from` and `fit-oblique --from`)."""
+    from .._fit.calibrate import Fit
 
-    where = f"--from {path}"
+    where, hint = f"--from {path}", "write it with 'jaximpact calibrate ... --json > FILE'"
     try:
-        if path == "-":
-            text = sys.stdin.read()
-        else:
-            with open(path, encoding="utf-8") as handle:
-                text = handle.read()
+        data = json.loads(sys.stdin.read() if path == "-" else Path(path).read_bytes())
     except OSError as error:
         raise CLIError(f"{where}: cannot read it ({error.strerror or error})") from None
     except UnicodeDecodeError as error:
-        raise CLIError(
-            f"{where}: not JSON ({error.reason}); write it with 'jaximpact "
-            "calibrate ... --json > FILE'"
-        ) from None
-    try:
-        data = json.loads(text)
+        raise CLIError(f"{where}: not JSON ({error.reason}); {hint}") from None
     except json.JSONDecodeError as error:
-        raise CLIError(
-            f"{where}: not JSON ({error.msg}, line {error.lineno}); write it with "
-            "'jaximpact calibrate ... --json > FILE'"
-        ) from None
+        raise CLIError(f"{where}: not JSON ({error.msg}, line {error.lineno}); {hint}") from None
     if not isinstance(data, dict):
         raise CLIError(f"{where}: expected the JSON object of 'jaximpact calibrate --json'")
     record = data
-    if isinstance(data.get("ranking"), list):  # calibrate --law all
-        ranked = [r for r in data["ranking"] if isinstance(r, dict)]
-        names = [r.get("law") for r in ranked]
-        wanted = law if law is not None else data.get("best", names[0] if names else None)
-        if wanted not in names:
+    if isinstance(data.get("ranking"), list):  # calibrate --law all: its m, g, separation
+        ranked = {r.get("law"): {**data, **r} for r in data["ranking"] if isinstance(r, dict)}
+        wanted = law if law is not None else data.get("best", next(iter(ranked), None))
+        if wanted not in ranked:
             raise CLIError(
-                f"{where}: its ranking has no law {wanted!r}; it has {', '.join(map(str, names))}"
+                f"{where}: its ranking has no law {wanted!r}; it has {', '.join(map(str, ranked))}"
             )
-        record = ranked[names.index(wanted)]
+        record = ranked[wanted]
     name = record.get("law")
-    if not isinstance(name, str):
-        raise CLIError(f"{where}: no law name ('law'); is it the output of calibrate --json?")
-    if law is not None and law != name:
+    if law is not None and law != name and isinstance(name, str):
         raise CLIError(f"--law {law} but {path} holds a fit of {name}")
-    params = record.get("params")
-    if not isinstance(params, dict) or not params:
-        raise CLIError(f"{where}: no parameters ('params': an object NAME -> number)")
-    for key, value in params.items():
-        number = isinstance(value, (int, float)) and not isinstance(value, bool)
-        if not number or not math.isfinite(value):
-            raise CLIError(f"{where}: parameter {key} = {value!r} is not a finite number")
-    return data, record
+    user = (lambda params: file_law(name, params)) if is_file_law(name) else None
+    try:
+        return data, record, Fit.from_dict(record, law=user)
+    except ValueError as error:
+        raise CLIError(f"{where}: {error}") from None

@@ -8,6 +8,7 @@ from .._choices import unknown_name
 from .._format import format_number
 from .common import (
     CLIError,
+    add_law_arguments,
     add_output_arguments,
     add_tangential_arguments,
     command_parser,
@@ -16,7 +17,7 @@ from .common import (
     is_file_law,
     make_law,
     parse_params,
-    read_fit_record,
+    read_fit,
     tangential_from_args,
     warn_sphere_density,
 )
@@ -110,13 +111,7 @@ def add_export(subparsers):
         help="with --from a posterior: the engine's band over N of its draws (default 200; "
         "one export each: about 10 ms for LAMMPS, 0.5 s for MuJoCo)",
     )
-    parser.add_argument(
-        "--law",
-        metavar="NAME",
-        help="a law of 'jaximpact laws', or a user's law FILE.py:NAME, the function "
-        "NAME(x, v, params) of a Python file (its parameters all from --param)",
-    )
-    parser.add_argument("--param", action="extend", nargs="+", default=[], metavar="NAME=VALUE")
+    add_law_arguments(parser, required=False)
     parser.add_argument("--e", type=float, help="target restitution in (0, 1] (without --law)")
     parser.add_argument("--T", type=float, metavar="S", help="target contact duration, s")
     parser.add_argument(
@@ -212,7 +207,8 @@ def _run_export(args):
             raise CLIError("give either --from or --e/--T, not both")
         if args.param:
             raise CLIError("--param conflicts with --from: the fit gives the parameters")
-        name, params, args.mass, args.v0, notes, posterior = read_fit(args.source, args)
+        source, args.mass, args.v0, notes, posterior = _from_fit(args.source, args)
+        name = source.name
         if args.band_draws < 1:
             raise CLIError(f"--band-draws must be at least 1, got {args.band_draws}")
     else:
@@ -224,8 +220,7 @@ def _run_export(args):
             raise CLIError("--param needs --law")
         if args.v0 is None:
             raise CLIError("--v0 is required: the impact speed, m/s")
-        name, params = args.law, parse_params(args.param)
-        posterior = None
+        name, params, posterior, source = args.law, parse_params(args.param), None, None
     chosen = _engines()[engine]
     missing = []
     if args.mass is None and (name is not None or chosen.MASS_DEPENDS is not None):
@@ -238,8 +233,7 @@ def _run_export(args):
             raise CLIError(missing_mass(engine, name is not None, f"give {what}"))
         raise CLIError(f"{engine} needs {what} of the {'sphere' if args.wall else 'two spheres'}")
     warn_sphere_density(args.mass, args.radius)
-    source = None
-    if name is not None:
+    if source is None and name is not None:
         source = make_law(name, params)
     tangential = tangential_from_args(args)
     try:  # with --no-strict, the refusal comes as a warning (one line on stderr)
@@ -391,102 +385,66 @@ def _band(x, posterior: dict, name: str, args, tangential):
     return x, f"{origin} (band over {x.band_draws} of its draws{of})", []
 
 
-def read_fit(path: str, args):
-    """`(law name, parameters, m, v0, notes, posterior)` of the fit in the JSON file `path`
-    ('-': stdin) that `jaximpact calibrate --json` writes (one law, or `--law all`'s
-    ranking: its best, or the one `--law` names), or `simulate --json`: its `law`,
-    `params`, `m` (kg) and speed (`rows[].v0`, or `v0`), m/s. With `calibrate --posterior
-    --json`'s `posterior`, the law is at the posterior medians of its free parameters and
-    `posterior` is that record (else None). `--mass` and `--law`, where given, must agree
-    with the file; `--v0` picks the speed (required where the fit has several). Each
-    missing or mismatched field is a one-line `CLIError`; `notes` are warnings for the
-    output."""
+def _from_fit(path: str, args):
+    """`(law, m, v0, notes, posterior)` of the fit in the JSON file `path` ('-': stdin) that
+    `jaximpact calibrate --json` (or `simulate --json`) writes (`common.read_fit`): its law,
+    its mass (kg) and its speed (m/s). With `calibrate --posterior --json`'s `posterior`,
+    the law is at the posterior medians of its free parameters and `posterior` is that
+    record (else None). `--mass` and `--law`, where given, must agree with the file; `--v0`
+    picks the speed (required where the fit has several). Each missing or mismatched field
+    is a one-line `CLIError`; `notes` are warnings for the output."""
     import math
 
-    from .._laws import LAWS
-
     where = f"--from {path}"
-    data, record = read_fit_record(path, args.law)
-    name, params = record["law"], record["params"]
-    user = is_file_law(name)  # a fit of a user's law, FILE.py:NAME: its file is read again
-    if name not in LAWS and not user:
-        raise CLIError(f"{where}: law {name!r} is not one of 'jaximpact laws'")
-    unknown = [] if user else sorted(set(params) - set(LAWS[name].parameters))
-    if unknown:
-        raise CLIError(f"{where}: law {name} has no parameter {', '.join(unknown)}")
-    m = data.get("m", record.get("m"))
+    _, record, fit = read_fit(path, args.law)
+    m = args.mass if fit.m is None else float(fit.m)
     if m is None:
-        if args.mass is None:
-            raise CLIError(f"{where}: no mass ('m'); give --mass (kg), the one it was fitted for")
-        m = args.mass
-    elif not _number(m) or not (math.isfinite(m) and m > 0):
-        raise CLIError(f"{where}: mass m = {m!r} is not a number > 0 (kg)")
-    elif args.mass is not None and not math.isclose(args.mass, m, rel_tol=1e-12):
+        raise CLIError(f"{where}: no mass ('m'); give --mass (kg), the one it was fitted for")
+    if args.mass is not None and not math.isclose(args.mass, m, rel_tol=1e-12):
         raise CLIError(
             f"--mass {args.mass:g} but {path} was fitted for m = {m:g} kg: the law's e and T "
             "depend on the mass; leave --mass out"
         )
-    speeds = _speeds(record)
-    if speeds is None:
-        raise CLIError(f"{where}: a speed ('rows'[].v0 or 'v0') is not a number > 0 (m/s)")
-    notes = []
+    speeds, notes = sorted(set(fit.v0.tolist())), []
+    span = f"{speeds[0]:g} to {speeds[-1]:g}" if speeds else ""
     if args.v0 is not None:
         v0 = args.v0
-        if speeds and not (min(speeds) <= v0 <= max(speeds)):
+        if speeds and not (speeds[0] <= v0 <= speeds[-1]):
             notes.append(
-                f"v0 = {v0:g} m/s is outside the speeds of the fit ({_span(speeds)} m/s): the "
-                "law is extrapolated"
+                f"v0 = {v0:g} m/s is outside the speeds of the fit ({span} m/s): the law is "
+                "extrapolated"
             )
-    elif len(set(speeds)) == 1:
+    elif len(speeds) == 1:
         v0 = speeds[0]
     elif not speeds:
         raise CLIError(f"{where}: no impact speed ('rows'[].v0 or 'v0'); give --v0 (m/s)")
     else:
         raise CLIError(
-            f"{where}: the fit has {len(set(speeds))} speeds ({_span(speeds)} m/s); give --v0, "
-            "the speed the export is to be exact at"
+            f"{where}: the fit has {len(speeds)} speeds ({span} m/s); give --v0, the speed "
+            "the export is to be exact at"
         )
-    separation = data.get("separation", record.get("separation", "force"))
+    separation = record.get("separation", "force")
     if separation != "force":
         raise CLIError(
             f"{where}: fitted with separation {separation!r}; the engines' contacts end when "
             "the force does (separation 'force'): refit with --separation force, or export "
             "the measured --e and --T"
         )
-    g = data.get("g", record.get("g", 0.0))
-    if _number(g) and g != 0:
+    if fit.g:
         notes.append(
-            f"the fit had gravity g = {g:g} m/s^2 during contact; the export's targets are the "
-            "law's e and T without it"
+            f"the fit had gravity g = {fit.g:g} m/s^2 during contact; the export's targets are "
+            "the law's e and T without it"
         )
-    if record.get("converged") is False:
+    if fit.converged is not None and not fit.converged:
         notes.append(f"the fit in {path} did not converge")
-    params = {k: float(v) for k, v in params.items()}
-    posterior = record.get("posterior")
+    law, posterior = fit.law, record.get("posterior")
     if posterior is not None:
         median = posterior.get("median") if isinstance(posterior, dict) else None
-        if not isinstance(median, dict) or not all(_number(v) for v in median.values()):
+        if not isinstance(median, dict) or not all(map(_number, median.values())):
             raise CLIError(f"{where}: its 'posterior' has no 'median' (NAME -> number)")
-        params.update({k: float(v) for k, v in median.items() if k in params})
-    return name, params, float(m), float(v0), notes, posterior
-
-
-def _speeds(record) -> list[float] | None:
-    """The impact speeds (m/s) of a fit record (`rows`[].v0 or `v0`), None if one is bad."""
-    import math
-
-    rows = record.get("rows")
-    values = [r.get("v0") for r in rows if isinstance(r, dict)] if isinstance(rows, list) else []
-    if not values and "v0" in record:
-        v0 = record["v0"]
-        values = v0 if isinstance(v0, list) else [v0]
-    if not all(_number(v) and math.isfinite(v) and v > 0 for v in values):
-        return None
-    return [float(v) for v in values]
-
-
-def _span(speeds) -> str:
-    return f"{min(speeds):g} to {max(speeds):g}"
+        params = {k: float(v) for k, v in fit.params.items()}
+        law = make_law(law.name, {**params, **{k: float(median[k]) for k in params if k in median}})
+    return law, m, float(v0), notes, posterior
 
 
 def add_engine_e(subparsers):

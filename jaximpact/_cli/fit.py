@@ -19,6 +19,8 @@ from .._plotting import new_figure, save_figure
 from .calibrate import add_posterior_arguments, posterior_options, sample_posterior
 from .common import (
     CLIError,
+    add_contact_arguments,
+    add_free_argument,
     add_law_arguments,
     add_output_arguments,
     check_plot_path,
@@ -64,23 +66,12 @@ def add_fit(subparsers):
         default="auto",
         help="what FILE holds (default: detect it)",
     )
-    parser.add_argument(
-        "--free",
-        action="extend",
-        nargs="+",
-        metavar="NAME",
-        help="law parameters to fit, e.g. --free c,b1 (default: the damping; the others keep "
+    add_free_argument(
+        parser,
+        "law parameters to fit, e.g. --free c,b1 (default: the damping; the others keep "
         "--param's values)",
     )
-    parser.add_argument(
-        "--separation",
-        choices=("force", "penetration"),
-        default="force",
-        help="end of contact: force back to zero (default) or penetration back to zero",
-    )
-    parser.add_argument(
-        "--gravity", type=float, default=9.81, metavar="M/S^2", help="gravity (default 9.81)"
-    )
+    add_contact_arguments(parser, gravity=9.81)
     parser.add_argument(
         "--drag",
         type=float,
@@ -175,11 +166,9 @@ def _fit_one(law, args, recording, name, data, length_scale, y_axis):
             )
         return fit_bounces(law, impact_times=times, **common)
     t, y = (np.asarray(a, dtype=float) for a in data)
-    if recording.video:
-        if args.frame_rate is None:
-            raise CLIError("a video track's time is in frames: give --frame-rate FPS")
-        t = t / args.frame_rate
-    elif args.frame_rate is not None:
+    if recording.video and args.frame_rate is None:
+        raise CLIError("a video track's time is in frames: give --frame-rate FPS")
+    if args.frame_rate is not None:
         t = t / args.frame_rate
     return fit_bounces(law, t=t, y=y, length_scale=length_scale, y_axis=y_axis, **common)
 

@@ -1,7 +1,7 @@
 """`jaximpact laws`: the force laws, their equations, parameters and units."""
 
 from .._choices import plain_name, unknown_name
-from .._format import concrete_units as concrete_units, format_number
+from .._format import concrete_units, format_number
 from .common import (
     KEEP_TOGETHER,
     CLIError,
@@ -11,6 +11,7 @@ from .common import (
     format_table,
     is_file_law,
     terminal_width,
+    wrap_text,
 )
 
 # --------------------------------------------------------------------------------------
@@ -40,6 +41,26 @@ def add_laws(subparsers):
     )
     add_output_arguments(parser, plot=False)
     parser.set_defaults(handler=_run_laws)
+
+
+def law_title(name: str) -> str:
+    """`hertz_rate (eq. 14: F = c x^1.5 + b1 x^0.5 v)`: the law `name` with its equation and
+    formula (a user's law, FILE.py:NAME, by its name alone)."""
+    from .._laws import LAWS
+
+    spec = LAWS.get(name)
+    if spec is None:
+        return name
+    eq = f"eq. {spec.equation}: " if spec.equation != "-" else ""
+    return f"{name} ({eq}F = {spec.formula})"
+
+
+def law_units(name: str, params: dict) -> dict[str, str]:
+    """The units of the parameters of the law `name` (`-`: a pure number), its exponents
+    filled in from `params`; none for a user's law (it has no row of the table)."""
+    from .._laws import LAWS
+
+    return concrete_units(LAWS[name], params) if name in LAWS else {}
 
 
 def _law_rows():
@@ -144,17 +165,8 @@ def _laws_text(rows, width=None, tangential=()) -> str:
         for (name, equation, formula, parameters), row in zip(table, rows, strict=True):
             lines.append(name + ("" if equation == "-" else f" (eq. {equation})"))
             for text in (f"F = {formula}", parameters, f"ref.: {row['reference']}"):
-                lines += [
-                    line.replace(KEEP_TOGETHER, " ")
-                    for line in textwrap.wrap(
-                        text,
-                        width,
-                        initial_indent="    ",
-                        subsequent_indent="      ",
-                        break_long_words=False,
-                        break_on_hyphens=False,
-                    )
-                ]
+                shown = wrap_text(text, width, first="    ", then="      ")
+                lines += [line.replace(KEEP_TOGETHER, " ") for line in shown]
     intro = (
         "Force laws: F(x, v) in N, positive pushing the body out; x = penetration (m), "
         "v = dx/dt (m/s). Equation numbers: Polukoshko, Viba, Kononova & Sokolova, Proc. "

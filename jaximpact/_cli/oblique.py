@@ -15,11 +15,11 @@ import math
 import textwrap
 from pathlib import Path
 
-from .._files import cell_number
 from .._progress import metered
 from .._status import Status
 from .common import (
     CLIError,
+    add_free_argument,
     add_law_arguments,
     add_output_arguments,
     add_tangential_arguments,
@@ -29,6 +29,7 @@ from .common import (
     free_names,
     heartbeat_meter,
     law_from_args,
+    read_fit,
     read_table,
     tangential_from_args,
     warn_sphere_density,
@@ -102,13 +103,7 @@ def add_fit_oblique(subparsers):
         "track, 0 for rebounds)",
     )
     _add_sphere_arguments(parser, "fit with the engine's to export to it")
-    parser.add_argument(
-        "--free",
-        action="extend",
-        nargs="+",
-        metavar="NAME",
-        help="tangential parameters to fit (default: the stiffness and mu)",
-    )
+    add_free_argument(parser, "tangential parameters to fit (default: the stiffness and mu)")
     add_output_arguments(parser)
     parser.set_defaults(handler=run_fit_oblique)
 
@@ -176,18 +171,18 @@ def add_oblique_impact_arguments(parser):
     _add_sphere_arguments(parser, "as the engine you export to", "with --tangential: ")
 
 
-# the fields of an oblique impact printed by `simulate`: name, unit ("" a pure number,
-# "deg" an angle shown in degrees, None a count), in order
-_OBLIQUE_FIELDS = (
-    ("e", ""),
-    ("e_t", ""),
-    ("e_t_contact", ""),
-    ("v_t_out", "m/s"),
-    ("omega_out", "rad/s"),
-    ("angle_out", "deg"),
-    ("angle_out_contact", "deg"),
-    ("T", "s"),
-    ("num_switches", None),
+# the fields of `simulate`'s table of oblique impacts, one row per angle (their units the
+# result's own, `ObliqueResult`'s `_SHOWN`; angles in degrees)
+_TABLE = (
+    "e",
+    "e_t",
+    "e_t_contact",
+    "v_t_out",
+    "omega_out",
+    "angle_out",
+    "angle_out_contact",
+    "T",
+    "num_switches",
 )
 
 
@@ -255,11 +250,12 @@ def run_oblique_impact(args, law, head: list[str]) -> int:
     """`simulate --tangential`: one oblique impact per `--angle`, printed as text (a line
     per field for one angle, a table for several) or JSON; `head`: the normal law's lines."""
     from .._oblique import oblique_impact
+    from .._oblique.results import _SHOWN
     from .common import format_table
 
     tangential = tangential_from_args(args)
     v0 = args.v0[0]
-    runs = []
+    runs, results = [], []
     for angle in args.angle:
         theta = math.radians(angle)
         result = oblique_impact(
@@ -282,8 +278,10 @@ def run_oblique_impact(args, law, head: list[str]) -> int:
             value = data[name]
             data[f"{name}_deg"] = None if value is None else math.degrees(value)
         runs.append(data)
+        results.append(result)
     if args.plot is not None:
-        _plot_oblique(args.plot, runs)
+        series = {k: [math.nan if d[k] is None else d[k] for d in runs] for k in MEASURED}
+        _plot(args.plot, [d["angle_deg"] for d in runs], series)
     conditions = [
         f"sphere     m = {args.mass:g} kg, R = {args.radius:g} m, I = {args.inertia:g} m R^2, "
         f"contact point {args.contact_point}",
@@ -291,27 +289,16 @@ def run_oblique_impact(args, law, head: list[str]) -> int:
         f"separation by {args.separation}",
     ]
     lines = [*head, f"tangential {tangential!r}", *conditions, ""]
-    if len(runs) == 1:
-        (data,) = runs
-        lines += [f"{'angle':<17} = {data['angle_deg']:g} deg"]
-        lines += [
-            f"{name:<17} = {_oblique_cell(data, name, unit, True)}"
-            for name, unit in _OBLIQUE_FIELDS
-        ]
-        lines.append(f"{'status':<17} = {data['status']}")
+    if len(runs) == 1:  # the result as it prints itself, after its incidence
+        lines += [f"{'angle':<17} = {runs[0]['angle_deg']:g} deg", results[0].summary()]
     else:
-        header = ["angle (deg)"] + [
-            f"{name} ({unit})" if unit else name for name, unit in _OBLIQUE_FIELDS
-        ]
+        units = {name: "deg" if unit == "rad" else unit for name, unit in _SHOWN}
+        header = [f"{n} ({units[n]})" if units[n] else n for n in _TABLE]
         rows = [
-            [
-                f"{d['angle_deg']:g}",
-                *(_oblique_cell(d, n, u, False) for n, u in _OBLIQUE_FIELDS),
-                d["status"],
-            ]
+            [f"{d['angle_deg']:g}", *(_table_cell(d, n, units[n]) for n in _TABLE), d["status"]]
             for d in runs
         ]
-        lines += format_table(header + ["status"], rows)
+        lines += format_table(["angle (deg)", *header, "status"], rows)
     lines += ["", *textwrap.wrap(_OBLIQUE_LEGEND, 92)]
     if args.plot is not None:
         lines.append(f"plot written to {args.plot}")
@@ -332,35 +319,13 @@ def run_oblique_impact(args, law, head: list[str]) -> int:
     return 1 if failed else 0
 
 
-def _oblique_cell(data: dict, name: str, unit: str | None, with_unit: bool) -> str:
-    """One field of an oblique run as text (`with_unit`: a prefixed unit, else the table's
-    plain number); angles in degrees, a missing value (NaN) as `-`."""
-    from .._format import format_number, format_quantity
-
+def _table_cell(data: dict, name: str, unit: str | None) -> str:
+    """One field of an oblique run in the table: a plain number (angles in degrees), a
+    count, or `-` where missing (NaN)."""
     value = data[f"{name}_deg"] if unit == "deg" else data[name]
     if value is None:
         return "-"
-    if unit is None:
-        return str(int(value))
-    if unit == "deg":
-        return f"{value:.4g} deg" if with_unit else f"{value:.4g}"
-    if not with_unit:
-        return f"{value:.5g}"
-    return format_quantity(value, unit) if unit else format_number(value, 4)
-
-
-def _plot_oblique(path: Path, runs):
-    """e_t and the spin after (rad/s) against the incidence (degrees)."""
-    from .._plotting import new_figure, save_figure
-
-    fig = new_figure(figsize=(9, 3.6))
-    angles = [d["angle_deg"] for d in runs]
-    for k, (name, label) in enumerate((("e_t", "e_t"), ("omega_out", "spin after [rad/s]"))):
-        ax = fig.add_subplot(1, 2, k + 1)
-        ax.plot(angles, [math.nan if d[name] is None else d[name] for d in runs], "o-")
-        ax.set_xlabel("incidence from the normal [deg]")
-        ax.set_ylabel(label)
-    save_figure(fig, path)
+    return str(int(value)) if unit is None else f"{value:.4g}" if unit == "deg" else f"{value:.5g}"
 
 
 def read_track(path: Path, header, rows, g: float) -> dict:
@@ -372,17 +337,12 @@ def read_track(path: Path, header, rows, g: float) -> dict:
 
     if set(header) != set(TRACK):
         raise CLIError(f"{path}: a track has the columns {', '.join(TRACK)} (one row per frame)")
-    columns = {name: [] for name in TRACK}
-    for number, cells in rows:
-        if len(cells) != len(header):
-            raise CLIError(f"{path}, line {number}: {len(cells)} cells for {len(header)} columns")
-        for name, cell in zip(header, cells, strict=True):
-            value = _number(cell, path, number, name)
-            if math.isnan(value):
-                raise CLIError(f"{path}, line {number}: no {name}; drop frames not tracked")
-            columns[name].append(value)
+    for line, values in rows:
+        for name in header:
+            if math.isnan(values[name]):
+                raise CLIError(f"{path}, line {line}: no {name}; drop frames not tracked")
     try:
-        track = track_rebounds(*(np.asarray(columns[k]) for k in TRACK), g=g)
+        track = track_rebounds(*(np.asarray([v[k] for _, v in rows]) for k in TRACK), g=g)
         inputs = track.fit_inputs()
     except ValueError as error:
         raise CLIError(f"{path}: {error}") from None
@@ -414,12 +374,8 @@ def read_rebounds(path: Path, speed: float | None, g: float = 9.81) -> dict:
     if not set(MEASURED) & set(header):
         raise CLIError(f"{path}: no measured column (e_t and/or omega_out)")
     columns = {name: [] for name in COLUMNS}
-    for number, cells in rows:
-        if len(cells) != len(header):
-            raise CLIError(f"{path}, line {number}: {len(cells)} cells for {len(header)} columns")
-        values = dict.fromkeys(COLUMNS, math.nan) | {"omega": 0.0}
-        for name, cell in zip(header, cells, strict=True):
-            values[name] = _number(cell, path, number, name)
+    for number, given in rows:
+        values = dict.fromkeys(COLUMNS, math.nan) | {"omega": 0.0} | given
         if by_angle:
             theta = values["theta_deg"]
             if not 0.0 <= theta < 90.0:
@@ -445,15 +401,6 @@ def read_rebounds(path: Path, speed: float | None, g: float = 9.81) -> dict:
             "takes degrees from the normal"
         )
     return columns
-
-
-def _number(cell: str, path: Path, line: int, column: str) -> float:
-    if not cell.strip():
-        return math.nan
-    try:
-        return cell_number(cell)
-    except ValueError as error:
-        raise CLIError(f"{path}, line {line}, column {column}: {error}") from None
 
 
 def run_fit_oblique(args):
@@ -510,7 +457,7 @@ def run_fit_oblique(args):
         )
         bar.update(1, "done")
     if args.plot is not None:
-        _plot(args.plot, rows, fit)
+        _plot(args.plot, rows["theta"], {k: getattr(fit, k) for k in MEASURED}, rows)
     check = _sanity(law, args.mass, float(np.max(rows["v_n"])))
     record = {**fit.to_dict(), "check": check, **({"normal": normal} if normal else {})}
     emit(args, record, lambda: _report(fit, rows, check, normal))
@@ -519,39 +466,30 @@ def run_fit_oblique(args):
 
 def normal_law_from_fit(path: Path, name: str | None, mass: float):
     """`(law, record)`: the normal law of the fit in the JSON file `path` that `jaximpact
-    calibrate --json` writes (one law, or `--law all`'s ranking: its best, or the law
-    `name` names), and what the output says of it (`law`, `params`, `separation`, `from`).
-    Its mass must be `mass` (kg); each missing or mismatched field is a one-line
-    `CLIError`, a fit that did not converge a warning."""
+    calibrate --json` writes (`common.read_fit`: one law, or `--law all`'s ranking: its
+    best, or the law `name` names), and what the output says of it (`law`, `params`,
+    `separation`, `from`). Its mass must be `mass` (kg); each missing or mismatched field
+    is a one-line `CLIError`, a fit that did not converge a warning."""
     import warnings
 
-    from .common import make_law, read_fit_record
-
-    where = f"--from {path}"
-    data, record = read_fit_record(path, name)
-    law_name, params = record["law"], record["params"]
-    m = data.get("m", record.get("m"))
-    if m is not None and not (isinstance(m, (int, float)) and math.isclose(m, mass, rel_tol=1e-12)):
+    _, record, fit = read_fit(path, name)
+    if fit.m is not None and not math.isclose(float(fit.m), mass, rel_tol=1e-12):
         raise CLIError(
-            f"--mass {mass:g} but {path} was fitted for m = {m!r} kg: the normal law's e and "
-            "T depend on the mass; give the sphere's mass the law was fitted for"
+            f"--mass {mass:g} but {path} was fitted for m = {float(fit.m)!r} kg: the normal "
+            "law's e and T depend on the mass; give the sphere's mass the law was fitted for"
         )
-    separation = data.get("separation", record.get("separation", "force"))
+    separation = record.get("separation", "force")
     if separation not in ("force", "penetration"):
-        raise CLIError(f"{where}: separation {separation!r} is not 'force' or 'penetration'")
-    try:
-        law = make_law(law_name, {k: float(v) for k, v in params.items()})
-    except ValueError as error:
-        raise CLIError(f"{where}: {error}") from None
-    if record.get("converged") is False:
+        raise CLIError(f"--from {path}: separation {separation!r} is not 'force' or 'penetration'")
+    if fit.converged is not None and not fit.converged:
         warnings.warn(f"the fit in {path} did not converge", stacklevel=2)
-    out = {
-        "law": law_name,
-        "params": {k: float(v) for k, v in params.items()},
+    params = {k: float(v) for k, v in fit.params.items()}
+    return fit.law, {
+        "law": fit.law.name,
+        "params": params,
         "separation": separation,
         "from": str(path),
     }
-    return law, out
 
 
 def _sanity(law, m: float, v_n: float) -> dict:
@@ -603,19 +541,23 @@ def _cell(value: float, spec: str) -> str:
     return "-" if math.isnan(value) else format(value, spec)
 
 
-def _plot(path: Path, rows, fit):
-    """e_t and the spin after impact against the incidence: measured points, fitted law."""
+def _plot(path: Path, theta, fitted, measured=None):
+    """e_t and the spin after impact (rad/s) against the incidence (degrees): `fitted`
+    (the fit's, or `simulate`'s runs: `{"e_t": [...], "omega_out": [...]}`) as a line, and
+    where given the `measured` points."""
     import numpy as np
 
     from .._plotting import new_figure, save_figure
 
     fig = new_figure(figsize=(9, 3.6))
-    order = np.argsort(rows["theta"])
+    order = np.argsort(theta)
     for k, (name, label) in enumerate((("e_t", "e_t"), ("omega_out", "spin after [rad/s]"))):
         ax = fig.add_subplot(1, 2, k + 1)
-        ax.plot(rows["theta"][order], np.asarray(getattr(fit, name))[order], "-", label="fit")
-        ax.plot(rows["theta"], rows[name], "o", label="measured")
+        line = np.asarray(fitted[name], dtype=float)[order]
+        ax.plot(np.asarray(theta)[order], line, "-" if measured else "o-", label="fit")
+        if measured:
+            ax.plot(theta, measured[name], "o", label="measured")
+            ax.legend()
         ax.set_xlabel("incidence from the normal [deg]")
         ax.set_ylabel(label)
-        ax.legend()
     save_figure(fig, path)

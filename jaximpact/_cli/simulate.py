@@ -6,8 +6,9 @@ import textwrap
 from .._format import format_number, format_quantity
 from .._plotting import new_figure, save_figure
 from .common import (
+    MASS_HELP,
     CLIError,
-    add_impact_arguments,
+    add_contact_arguments,
     add_law_arguments,
     add_output_arguments,
     check_contact_scales,
@@ -20,23 +21,13 @@ from .common import (
     require_mass,
     terminal_width,
 )
-from .laws import concrete_units
+from .laws import law_title, law_units
 from .oblique import add_oblique_impact_arguments, check_oblique_arguments, run_oblique_impact
 
 # --------------------------------------------------------------------------------------
 # jaximpact simulate
 # --------------------------------------------------------------------------------------
 
-# field of ImpactResult -> SI unit, in the order printed
-_RESULT_UNITS = {
-    "e": "",
-    "T": "s",
-    "x_max": "m",
-    "F_max": "N",
-    "t_max": "s",
-    "dissipated": "J",
-    "v_out": "m/s",
-}
 _STATUS_NOTES = {
     "stuck": "a dry force held the body at rest inside the surface (e = 0); T is when it stopped",
     "captured": "the body never left the surface (e = 0); T is when the solve gave up",
@@ -57,18 +48,25 @@ def add_simulate(subparsers):
         "largest force F_max, the energy dissipated and how the contact ended. Several "
         "speeds (--v0 0.5 1 2 4) give a sweep: one row per speed with units in the header "
         "(--json: a list of the one-speed objects; --plot: e and T against v0).",
-        example="jaximpact simulate --law hertz_rate --param c=2e6 --param b1=800 --v0 2.5 --mass 1\n"
+        example="jaximpact simulate --law hertz_rate --param c=2e6 --param b1=800 --v0 2.5 "
+        "--mass 1\n"
         "jaximpact simulate --law kelvin_voigt --param c=2e6 b=400 --mass 1 --v0 2.5 "
         "--separation penetration --json\n"
-        "jaximpact simulate --law bingham --param c=2e6 b=200 P=400 --v0 2.5 --mass 1 --plot bingham.png\n"
+        "jaximpact simulate --law bingham --param c=2e6 b=200 P=400 --v0 2.5 --mass 1 --plot "
+        "bingham.png\n"
         "jaximpact simulate --law hertz_rate --param c=2e6 b1=800 --mass 1 --v0 0.5 1 2 4",
     )
     add_law_arguments(parser)
-    add_impact_arguments(parser)
-    for action in parser._actions:  # --v0: one speed, or several for a sweep
-        if action.dest == "v0":
-            action.nargs = "+"
-            action.help = "impact speed, m/s (> 0); several for a sweep of e(v0), T(v0)"
+    parser.add_argument("--mass", type=float, metavar="KG", help=MASS_HELP)
+    parser.add_argument(
+        "--v0",
+        type=float,
+        nargs="+",
+        required=True,
+        metavar="M/S",
+        help="impact speed, m/s (> 0); several for a sweep of e(v0), T(v0)",
+    )
+    add_contact_arguments(parser)
     add_output_arguments(parser)
     add_oblique_impact_arguments(parser)
     parser.set_defaults(handler=_run_simulate)
@@ -103,10 +101,9 @@ def _run_simulate(args):
             "v0": v0,
             "separation": args.separation,
             "g": args.gravity,
+            **result.to_dict(),
         }
-        data.update({k: getattr(result, k) for k in _RESULT_UNITS})
-        data.update(status=result.status_name, path=result.path, num_steps=result.num_steps)
-        data["units"] = {k: u or "-" for k, u in _RESULT_UNITS.items()}
+        data["units"] = {k: u or "-" for k, u in _result_units().items()}
         runs.append(data)
     if len(runs) > 1:
         if args.plot is not None:
@@ -130,19 +127,22 @@ def _run_simulate(args):
     return 0
 
 
+def _result_units() -> dict[str, str]:
+    """The impact's fields and their units as `ImpactResult` shows them (its `_SHOWN`),
+    in its order; the solver's steps are said with the path."""
+    from .._solve.results import _SHOWN
+
+    return {name: unit for name, unit in _SHOWN if unit is not None}
+
+
 def _head(law, data) -> list[str]:
     """The law, its parameters with units and the impact's conditions (`data`: one run)."""
-    from .._laws import LAWS
-
-    spec = LAWS.get(law.name)
-    units = concrete_units(spec, data["params"]) if spec is not None else {}
+    units = law_units(law.name, data["params"])
     params = ", ".join(
         f"{k} = {format_number(v)}" + (f" {units[k]}" if units.get(k, "-") != "-" else "")
         for k, v in data["params"].items()
     )
-    eq = f"eq. {spec.equation}: " if spec is not None and spec.equation != "-" else ""
-    formula = f" ({eq}F = {spec.formula})" if spec is not None else ""
-    return [f"law        {law.name}{formula}", f"params     {params}"]
+    return [f"law        {law_title(law.name)}", f"params     {params}"]
 
 
 def _sweep_text(law, runs, width=None) -> str:
@@ -155,8 +155,9 @@ def _sweep_text(law, runs, width=None) -> str:
         f"m/s^2, separation by {first['separation']}",
         "",
     ]
-    keys = [k for k in _RESULT_UNITS if first[k] is not None and k != "v_out"]  # v_out = -e v0
-    header = ["v0 (m/s)", *(f"{k} ({_RESULT_UNITS[k]})" if _RESULT_UNITS[k] else k for k in keys)]
+    units = _result_units()
+    keys = [k for k in units if first[k] is not None and k != "v_out"]  # v_out = -e v0
+    header = ["v0 (m/s)", *(f"{k} ({units[k]})" if units[k] else k for k in keys)]
     # status and path as columns where they change with the speed, else said once
     varying = [k for k in ("status", "path") if len({r[k] for r in runs}) > 1]
     header += varying
@@ -200,7 +201,7 @@ def _simulate_text(law, data) -> str:
         f"g = {format_number(data['g'])} m/s^2, separation by {data['separation']}",
         "",
     ]
-    for key, unit in _RESULT_UNITS.items():
+    for key, unit in _result_units().items():
         value = data[key]
         if value is None:
             continue

@@ -246,6 +246,8 @@ def compare_laws(
     max_rms_e=MAX_RMS_E,
     max_rms_T=MAX_RMS_T,
     workers: int | None = None,
+    callback=None,
+    errors: str = "raise",
     **calibrate_options,
 ) -> list[Ranking]:
     """Fit every law of `laws` to the same measurements and rank them, best first.
@@ -269,8 +271,16 @@ def compare_laws(
     compile in parallel): default one per CPU core, `1` one after another. The results do
     not depend on it.
 
+    `callback(index, name, result)`, if given, is called on the calling thread after each
+    law, as its fit ends (for progress): `index` its place in `laws`, `result` its
+    `Ranking`, None for a law skipped, or the exception its fit raised. `errors`: `"raise"`
+    (the default) stops at the first fit that raises; `"skip"` leaves that law out of the
+    ranking and goes on (the callback sees its exception).
+
     **Example**: `compare_laws(m=0.0027, v0=[1, 2, 3], e=[0.9, 0.87, 0.85])[0].name`.
     """
+    if errors not in ("raise", "skip"):
+        raise ValueError(f"errors must be 'raise' or 'skip', got {errors!r}")
     v0_rows = np.atleast_1d(np.asarray(v0, dtype=float))
     e_rows = np.broadcast_to(np.atleast_1d(np.asarray(e, dtype=float)), v0_rows.shape)
     T_rows = None
@@ -284,13 +294,21 @@ def compare_laws(
     middle = int(np.argsort(v0_rows)[len(v0_rows) // 2])
     n_data = len(e_rows) + (0 if T_rows is None else int(np.sum(np.isfinite(T_rows))))
     has_sigma = sigma_e is not None or sigma_T is not None
-    jobs, skipped = [], []  # (name, start law, free parameters), in the order of `laws`
-    for entry in laws:
+    jobs, skipped = [], []  # (index, name, law or name, free), in the order of `laws`
+    for index, entry in enumerate(laws):
         if isinstance(entry, AbstractLaw):  # a law object (a user's own): its own start
-            name, start = entry.name, entry
+            name = entry.name
             free = _free_for_law(entry, has_T=T_rows is not None, n_data=n_data)
         else:
             name = entry
+            free = _free_for(name, has_T=T_rows is not None, n_data=n_data)
+        (skipped if len(free) > n_data else jobs).append((index, name, entry, free))
+    # the main thread's precision, for the threads (JAX's config contexts are per thread)
+    x64 = jnp.result_type(float) == jnp.float64
+
+    def one(job):
+        _, name, start, free = job
+        if not isinstance(start, AbstractLaw):  # a name: the start from the middle row
             start = starting_law(
                 name,
                 m=float(m),
@@ -298,13 +316,6 @@ def compare_laws(
                 e=float(e_rows[middle]),
                 T=None if T_rows is None else float(T_rows[middle]),
             )
-            free = _free_for(name, has_T=T_rows is not None, n_data=n_data)
-        (skipped if len(free) > n_data else jobs).append((name, start, free))
-    # the main thread's precision, for the threads (JAX's config contexts are per thread)
-    x64 = jnp.result_type(float) == jnp.float64
-
-    def one(job):
-        name, start, free = job
         with jax.enable_x64(x64):
             fit = calibrate(
                 start,
@@ -327,19 +338,28 @@ def compare_laws(
     workers = _workers(workers, len(jobs))
     rankings: list[Ranking | None] = [None] * len(jobs)
     with metered(progress, len(laws), "fitting laws") as bar:
-        for name, _, _ in skipped:
+        for index, name, _, _ in skipped:
             bar.update(1, f"{name} (skipped)")
+            if callback is not None:
+                callback(index, name, None)
         pool = concurrent.futures.ThreadPoolExecutor(max_workers=workers)
         try:
             futures = {pool.submit(one, job): i for i, job in enumerate(jobs)}
             for future in concurrent.futures.as_completed(futures):
-                ranking = future.result()
-                rankings[futures[future]] = ranking
-                bar.update(1, ranking.name)
+                index, name, _, _ = jobs[futures[future]]
+                try:
+                    result = rankings[futures[future]] = future.result()
+                except Exception as error:
+                    if errors == "raise":
+                        raise
+                    result = error
+                bar.update(1, name)
+                if callback is not None:
+                    callback(index, name, result)
         finally:  # an interrupt or a failed fit: the fits not started are dropped
             pool.shutdown(wait=False, cancel_futures=True)
     key = (lambda r: r.aic) if has_sigma else (lambda r: r.sum_sq)
-    rankings = sorted(rankings, key=key)
+    rankings = sorted((r for r in rankings if r is not None), key=key)
     if warn and rankings:
         why = fits_badly(rankings[0].fit, max_rms_e=max_rms_e, max_rms_T=max_rms_T)
         if why is not None:

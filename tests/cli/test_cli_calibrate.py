@@ -13,7 +13,7 @@ import pytest
 from helpers import assert_one_line_error, assert_rel, run_cli
 from reference import reference_impact
 
-from jaximpact._cli import calibrate as _cli_calibrate, common as _cli_common
+from jaximpact._cli import common as _cli_common
 from jaximpact._fit import model_choice as _model_choice
 
 LAW14 = dict(c=2e6, b1=800.0)
@@ -131,16 +131,15 @@ def test_data_file_with_missing_T_and_plot(capsys, tmp_path, law14_csv):
 def test_model_choice(capsys, monkeypatch, law14_csv):
     """`--law all` (narrowed to two laws, plus one whose fit raises): the true law first, the
     failing one reported, not fatal."""
-    laws = ("kelvin_voigt", "maxwell", "hertz_rate")
-    monkeypatch.setattr(_cli_calibrate, "MODEL_CHOICE_LAWS", laws)
-    compare_laws = _model_choice.compare_laws
+    monkeypatch.setattr(_model_choice, "PAPER_LAWS", ("kelvin_voigt", "maxwell", "hertz_rate"))
+    calibrate = _model_choice.calibrate
 
-    def failing_maxwell(*, laws, **kwargs):
-        if laws == ("maxwell",):
+    def failing_maxwell(start, **kwargs):
+        if start.name == "maxwell":
             raise RuntimeError("boom\nsecond line")
-        return compare_laws(laws=laws, **kwargs)
+        return calibrate(start, **kwargs)
 
-    monkeypatch.setattr(_model_choice, "compare_laws", failing_maxwell)
+    monkeypatch.setattr(_model_choice, "calibrate", failing_maxwell)
     status, out, err = run_cli(
         capsys, ["calibrate", "--mass", "1", "--law", "all", "--data", str(law14_csv)]
     )
@@ -156,7 +155,7 @@ def test_model_choice(capsys, monkeypatch, law14_csv):
     assert "ranked by sum_sq, the sum of squared residuals e_fit - e and (T_fit - T)/T" in out
     assert "best: hertz_rate" in out and "fits these data badly" not in out
     assert "failed: maxwell (RuntimeError: boom)" in out
-    monkeypatch.setattr(_cli_calibrate, "MODEL_CHOICE_LAWS", ("kelvin_voigt", "hertz_rate"))
+    monkeypatch.setattr(_model_choice, "PAPER_LAWS", ("kelvin_voigt", "hertz_rate"))
     status, out, _ = run_cli(
         capsys, ["calibrate", "--mass", "1", "--law", "all", "--data", str(law14_csv), "--json"]
     )
@@ -172,7 +171,7 @@ def test_model_choice(capsys, monkeypatch, law14_csv):
 def test_model_choice_warns_when_the_best_law_fits_badly(capsys, monkeypatch, law14_csv):
     """Kelvin-Voigt alone on law 14's falling e: its optimiser converges, it is the best
     of one, and it fits badly (RMS of e_fit - e above 0.01, no sigmas): a warning line."""
-    monkeypatch.setattr(_cli_calibrate, "MODEL_CHOICE_LAWS", ("kelvin_voigt",))
+    monkeypatch.setattr(_model_choice, "PAPER_LAWS", ("kelvin_voigt",))
     status, out, err = run_cli(
         capsys, ["calibrate", "--mass", "1", "--law", "all", "--data", str(law14_csv)]
     )
@@ -181,6 +180,55 @@ def test_model_choice_warns_when_the_best_law_fits_badly(capsys, monkeypatch, la
     (line,) = [line for line in out.splitlines() if line.startswith("warning:")]
     assert line.startswith("warning: the best law, kelvin_voigt, fits these data badly: RMS")
     assert "badly means an RMS residual above 0.01 in e or 5 % in T" in line
+
+
+@pytest.mark.slow  # the Laplace approximation of two laws' posteriors compiles
+def test_model_choice_by_evidence(capsys, monkeypatch, law14_csv):
+    """`--law all --by evidence`: the laws ranked by their evidence, with the Bayes factors'
+    table (`compare_laws(by="evidence")`); the true law first, its Bayes factor 1."""
+    monkeypatch.setattr(_model_choice, "PAPER_LAWS", ("kelvin_voigt", "hertz_rate"))
+    argv = ["calibrate", "--mass", "1", "--law", "all", "--data", str(law14_csv), "--by"]
+    status, out, err = run_cli(capsys, [*argv, "evidence"])
+    assert status == 0 and err == "", err
+    assert "ranked by the evidence" in out and "best: hertz_rate" in out
+    header = next(line.split() for line in out.splitlines() if "bayes_factor" in line)
+    assert header[:5] == ["rank", "law", "k", "log_evidence", "bayes_factor"]
+    status, out, _ = run_cli(capsys, [*argv, "evidence", "--json"])
+    data = json.loads(out)
+    assert data["criterion"] == "evidence" and data["ranking"][0]["bayes_factor"] == 1.0
+    assert data["ranking"][1]["bayes_factor"] > 1.0 and data["ranking"][1]["aic_rank"] == 2
+    bad = ["calibrate", "--mass", "1", "--law", "hertz_rate", "--v0", "1", "--e", "0.8"]
+    assert_one_line_error(*run_cli(capsys, [*bad, "--by", "evidence"]), contains="--law all")
+
+
+def test_compare_laws_reports_each_law_to_its_callback(monkeypatch):
+    """`compare_laws(callback=...)` is called after each law with its place, its name and its
+    `Ranking` or the exception of its fit; `errors="skip"` ranks the others (the command
+    line's `--law all` goes through it). The fits are stand-ins (no solve)."""
+    from types import SimpleNamespace
+
+    import jax.numpy as jnp
+
+    def stand_in(start, **kwargs):
+        if start.name == "maxwell":
+            raise RuntimeError("boom")
+        return SimpleNamespace(residuals=jnp.asarray([0.1 if start.name == "hertz_rate" else 0.2]))
+
+    monkeypatch.setattr(_model_choice, "calibrate", stand_in)
+    seen = []
+    kwargs = dict(m=1.0, v0=[1.0, 2.0, 3.0], e=[0.9, 0.85, 0.8], progress=False, warn=False)
+    kwargs.update(laws=("kelvin_voigt", "maxwell", "hertz_rate"))
+    ranked = _model_choice.compare_laws(
+        **kwargs, errors="skip", callback=lambda *call: seen.append(call)
+    )
+    assert [r.name for r in ranked] == ["hertz_rate", "kelvin_voigt"]
+    assert sorted((i, name, type(r).__name__) for i, name, r in seen) == [
+        (0, "kelvin_voigt", "Ranking"),
+        (1, "maxwell", "RuntimeError"),
+        (2, "hertz_rate", "Ranking"),
+    ]
+    with pytest.raises(RuntimeError, match="boom"):
+        _model_choice.compare_laws(**kwargs)
 
 
 # -------------------------------------------------------------------- bad input
@@ -259,12 +307,12 @@ def test_free_accepts_commas_and_words():
 
 
 def test_model_choice_when_every_law_fails(capsys, monkeypatch, tmp_path):
-    monkeypatch.setattr(_cli_calibrate, "MODEL_CHOICE_LAWS", ("maxwell",))
+    monkeypatch.setattr(_model_choice, "PAPER_LAWS", ("maxwell",))
 
-    def failing(**kwargs):
+    def failing(start, **kwargs):
         raise RuntimeError("boom")
 
-    monkeypatch.setattr(_model_choice, "compare_laws", failing)
+    monkeypatch.setattr(_model_choice, "calibrate", failing)
     argv = [
         "calibrate",
         "--mass",
