@@ -18,8 +18,9 @@ The tables a run reads are opened as people save them, by one owner for every re
 not UTF-8 (Excel's plain "CSV" on a Western system, a Latin-1 note) is read as cp1252
 (`as_read`), so that only a cell the run reads can make it fail, as a number that is not
 one. `cell_number` is the one reading of a number in a cell. `read_csv` reads a small CSV
-file whole (`calibrate --data`, recordings); the tables of `batch` stream in chunks through
-`_jobs.readers` instead.
+file whole (`calibrate --data`, recordings), and `read_table` checks its header and numbers
+(one-line `ValueError`s naming the file, line and column); the tables of `batch` stream in
+chunks through `_jobs.readers` instead.
 """
 
 import codecs
@@ -313,3 +314,47 @@ def read_csv(text: str, *, comments: bool = False):
             rows.append((kept[start][0], cells))
         start = reader.line_num
     return (rows[0][1], rows[1:]) if rows else ([], [])
+
+
+def read_table(path: Path, columns, *, label: str, hint: str, needed=()):
+    """`(header, rows)` of the small CSV file at `path` (`read_text` and `read_csv`:
+    as people save it, `#` comments skipped), its header stripped and checked against
+    `columns` (those in `needed` must be there), each row `(line number, {column: number})`,
+    an empty cell NaN. One-line `ValueError`s that name the file as `label` (e.g. `--data
+    in.csv`) for a file that cannot be read or is not text, is empty, has an unknown column
+    (`hint`: the columns expected, in words), a column named twice or one of `needed`
+    missing, a row with too many or too few cells, or a cell that is not a number."""
+    import math
+
+    try:
+        text = read_text(path)  # as people save it: a byte-order mark, UTF-16, cp1252
+    except OSError as error:
+        raise ValueError(f"cannot read {label}: {error.strerror or error}") from None
+    except NotText:
+        raise ValueError(f"{label} is not a text file (a CSV with columns {hint})") from None
+    header, rows = read_csv(text, comments=True)
+    if not header:
+        raise ValueError(f"{label} is empty")
+    header = [name.strip() for name in header]
+    unknown = [name for name in header if name not in columns]
+    if unknown:
+        raise ValueError(
+            f"{label}: unknown column {', '.join(map(repr, unknown))}; the columns are {hint}"
+        )
+    if len(set(header)) != len(header):
+        raise ValueError(f"{label}: a column is named twice in the header")
+    for name in needed:
+        if name not in header:
+            raise ValueError(f"{label}: no column {name!r} (need {hint})")
+    numbers = []
+    for line, cells in rows:
+        if len(cells) != len(header):
+            raise ValueError(f"{label}, line {line}: {len(cells)} cells for {len(header)} columns")
+        values = {}
+        for column, cell in zip(header, cells, strict=True):
+            try:
+                values[column] = cell_number(cell) if cell.strip() else math.nan
+            except ValueError as error:
+                raise ValueError(f"{label}, line {line}, column {column}: {error}") from None
+        numbers.append((line, values))
+    return header, numbers

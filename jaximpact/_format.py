@@ -1,8 +1,10 @@
 """Numbers and quantities as people read them, and values as JSON can hold them: shared by
 the library's tables and reports, the results' `repr`, `summary()` and `to_dict()`
-(`ImpactResult`, `Fit`, `Ranking`) and the command line."""
+(`ImpactResult`, `Fit`, `Ranking`) and the command line; and tables that fit the terminal
+(`format_table`, `wrap_text`, `terminal_width`)."""
 
 import math
+import textwrap
 
 _MULTIPLE_UNITS = {"N", "Pa", "W"}
 _PREFIXES = [
@@ -179,3 +181,131 @@ class PrintedFields:
 
     def __repr__(self) -> str:
         return self.summary()
+
+
+# tables that fit the terminal
+
+NARROWEST = 60  # columns: below this a table is not made narrower
+KEEP_TOGETHER = "\xa0"  # a space that `format_table` does not wrap at (printed as a space)
+
+
+def wrap_text(text: str, width: int, *, first: str = "", then: str | None = None) -> list[str]:
+    """`text` in lines of at most `width` characters, broken at spaces only (a longer word,
+    such as a path, on a line of its own): the first after `first`, the others after
+    `then` (default: as many spaces as `first`)."""
+    then = " " * len(first) if then is None else then
+    return textwrap.wrap(
+        text,
+        width,
+        initial_indent=first,
+        subsequent_indent=then,
+        break_long_words=False,
+        break_on_hyphens=False,
+    )
+
+
+def terminal_width(default: int = 88) -> int:
+    """The columns text output may fill: `COLUMNS`, else the terminal's width, else
+    `default` (88) where stdout is not a terminal (a pipe, a file); never below 60."""
+    import shutil
+
+    return max(NARROWEST, shutil.get_terminal_size((default, 24)).columns)
+
+
+def format_table(header, rows, *, width=None, wrap=(), keep=1, notes=None, note_column=1):
+    """`rows` (lists of strings) under `header` as lines of at most `width` characters
+    (default `terminal_width()`), where that can be done without cutting a word.
+
+    The columns are two spaces apart, the header cells wrapped at spaces. A table wider
+    than `width` has the cells of the columns in `wrap` (indices of free text) wrapped
+    at spaces; if it is still too wide, its other columns go to further tables, each
+    repeating the first `keep` columns (the row's names). `notes` (one string or None per
+    row): a line under the row, from column `note_column` on, wrapped alike. Words joined
+    by `KEEP_TOGETHER` (a no-break space) stay on one line.
+
+    **Example**: `format_table(["law", "e"], [["kelvin_voigt", "0.5"]], width=80)`."""
+    width = terminal_width() if width is None else width
+    header = [str(h) for h in header]
+    rows = [[str(c) for c in row] for row in rows]
+    n = len(header)
+
+    def longest_word(text):
+        return max((len(w) for w in text.split()), default=0)
+
+    natural = [max([len(r[i]) for r in rows] + [len(header[i])]) for i in range(n)]
+    # narrowest each column can go: its longest word where it wraps, else its longest cell;
+    # a header wraps at its spaces
+    least = [
+        max(
+            [longest_word(r[i]) if i in wrap else len(r[i]) for r in rows]
+            + [longest_word(header[i])]
+        )
+        for i in range(n)
+    ]
+    widths = list(natural)
+    excess = sum(widths) + 2 * (n - 1) - width
+    cells = [max([len(r[i]) for r in rows] + [least[i]]) for i in range(n)]
+    while excess > 0:  # first wrap the headers wider than their cells, the most so first
+        i = max(range(n), key=lambda k: widths[k] - cells[k])
+        if widths[i] <= cells[i]:
+            break
+        widths[i] -= 1
+        excess -= 1
+    while excess > 0:  # then the free-text columns, the widest first, a character at a time
+        room = [i for i in wrap if widths[i] > least[i]]
+        if not room:
+            break
+        widths[max(room, key=lambda k: widths[k])] -= 1
+        excess -= 1
+    if excess > 0 and n > keep + 1:  # too wide still: further tables of the other columns
+        sections, current = [], []
+        fixed = sum(widths[:keep]) + 2 * keep
+        for i in range(keep, n):
+            if current and fixed + sum(widths[k] + 2 for k in current) + widths[i] > width:
+                sections.append(current)
+                current = []
+            current.append(i)
+        sections.append(current)
+        if len(sections) > 1:
+            out = []
+            for number, section in enumerate(sections):
+                columns = [*range(keep), *section]
+                if number:
+                    out.append("")
+                out += format_table(
+                    [header[i] for i in columns],
+                    [[r[i] for i in columns] for r in rows],
+                    width=width,
+                    wrap=[columns.index(i) for i in wrap if i in columns],
+                    keep=keep,
+                    notes=notes if number == len(sections) - 1 else None,
+                    note_column=min(note_column, len(columns) - 1),
+                )
+            return out
+
+    def cell_lines(text, i):
+        if len(text) <= widths[i]:
+            return [text]
+        return wrap_text(text, widths[i]) or [""]
+
+    def render(cells, wrapped):
+        parts = [cell_lines(c, i) if (i in wrapped) else [c] for i, c in enumerate(cells)]
+        height = max(len(p) for p in parts)
+        lines = []
+        for k in range(height):
+            line = "  ".join(
+                (p[k] if k < len(p) else "").ljust(widths[i]) for i, p in enumerate(parts)
+            )
+            lines.append(line.rstrip())
+        return lines
+
+    out = render(header, range(n))
+    out.append("  ".join("-" * w for w in widths))
+    indent = sum(widths[:note_column]) + 2 * note_column
+    for index, row in enumerate(rows):
+        out += render(row, wrap)
+        note = None if notes is None else notes[index]
+        if note:  # from `note_column`, or further left where a word would not fit there
+            at = max(0, min(indent, width - max(map(len, note.split()))))
+            out += wrap_text(note, width, first=" " * at)
+    return [line.replace(KEEP_TOGETHER, " ") for line in out]

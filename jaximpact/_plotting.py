@@ -1,4 +1,6 @@
-"""Figures of one impact, in the style of the seed paper's (Polukoshko et al. 2007, Figs. 2-11).
+"""Figures: one impact, in the style of the seed paper's (Polukoshko et al. 2007, Figs. 2-11),
+and those of the command line's `--plot FILE` (a fit against the impact speed, a sweep, oblique
+rebounds, recorded bounces, the benchmark's ratios).
 
 matplotlib is imported inside the functions only, so `import jaximpact` never needs it.
 """
@@ -184,3 +186,161 @@ def save_figure(fig, path):
             fig.savefig(temporary, dpi=150, bbox_inches="tight")
     except OSError as error:
         raise OSError(f"cannot write {path}: {error.strerror or error}") from None
+
+
+# ---------------------------------------------------------------- the commands' figures
+
+
+def plot_fitted_speeds(path, data, speeds, curves, title: str):
+    """e (and T, ms) against the impact speed on a log axis, written to `path`: the
+    measured points of `data` (`v0`, `e`, `T` or None, `sigma_e`, `sigma_T`: lists, T NaN
+    where not measured) with error bars from the sigmas, and one line per `(name, e, T)`
+    of `curves` at `speeds` (m/s), the first drawn heavier (`jaximpact calibrate`)."""
+    v0 = np.asarray(data["v0"])
+    has_T = data["T"] is not None
+    fig = new_figure(figsize=(11.0 if has_T else 5.8, 4.2), layout="constrained")
+    axes = fig.subplots(1, 2 if has_T else 1, squeeze=False)[0]
+    for k, (name, es, Ts) in enumerate(curves):
+        style = dict(lw=2.0 if k == 0 else 1.2, ls="-" if k == 0 else "--")
+        axes[0].plot(speeds, es, label=f"{name} (fit)", **style)
+        if has_T:
+            axes[1].plot(speeds, 1e3 * np.asarray(Ts), label=f"{name} (fit)", **style)
+    e_err = None if data["sigma_e"] is None else data["sigma_e"]
+    axes[0].errorbar(
+        v0, data["e"], yerr=e_err, fmt="o", color="k", ms=5, capsize=3, label="measured", zorder=5
+    )
+    axes[0].set_ylabel("coefficient of restitution e")
+    if has_T:
+        T = np.asarray(data["T"], dtype=float)
+        T_err = None if data["sigma_T"] is None else 1e3 * np.asarray(data["sigma_T"])
+        if T_err is not None:
+            T_err = np.where(np.isnan(T), 0.0, T_err)
+        axes[1].errorbar(
+            v0, 1e3 * T, yerr=T_err, fmt="o", color="k", ms=5, capsize=3, label="measured", zorder=5
+        )
+        axes[1].set_ylabel("contact duration T [ms]")
+    for ax in axes:
+        ax.set_xscale("log")
+        plain_log_axis(ax.xaxis)
+        ax.set_xlabel("impact speed v0 [m/s]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(title, fontsize=10)
+    save_figure(fig, path)
+
+
+def plot_speed_sweep(path, v0, e, T, title: str):
+    """e and T (ms) against the impact speeds `v0` (m/s), one point each, written to
+    `path` (`jaximpact simulate --v0 ...`)."""
+    fig = new_figure(figsize=(9.0, 3.6), layout="constrained")
+    ax_e, ax_T = fig.subplots(1, 2)
+    ax_e.plot(v0, e, "o-")
+    ax_e.set_xlabel("impact speed v0 (m/s)")
+    ax_e.set_ylabel("restitution e")
+    ax_T.plot(v0, [1e3 * t for t in T], "o-")
+    ax_T.set_xlabel("impact speed v0 (m/s)")
+    ax_T.set_ylabel("contact duration T (ms)")
+    fig.suptitle(title)
+    save_figure(fig, path)
+
+
+def plot_oblique(path, theta, fitted, measured=None):
+    """e_t and the spin after impact (rad/s) against the incidence `theta` (degrees),
+    written to `path`: `fitted` (`{"e_t": [...], "omega_out": [...]}`, a fit's or a sweep's)
+    as a line, and where given the `measured` points (`jaximpact fit-oblique`, `simulate
+    --tangential`)."""
+    fig = new_figure(figsize=(9, 3.6))
+    order = np.argsort(theta)
+    for k, (name, label) in enumerate((("e_t", "e_t"), ("omega_out", "spin after [rad/s]"))):
+        ax = fig.add_subplot(1, 2, k + 1)
+        line = np.asarray(fitted[name], dtype=float)[order]
+        ax.plot(np.asarray(theta)[order], line, "-" if measured else "o-", label="fit")
+        if measured:
+            ax.plot(theta, measured[name], "o", label="measured")
+            ax.legend()
+        ax.set_xlabel("incidence from the normal [deg]")
+        ax.set_ylabel(label)
+    save_figure(fig, path)
+
+
+def plot_bounce_fits(path, fits: dict, trajectory: bool):
+    """The fits of recorded bounces (`fit_bounces`, name -> `BounceFit`) in three panels,
+    written to `path`: a `trajectory`'s heights measured and fitted with their residuals
+    (its first fit), or the impact intervals and the impact-time residuals of each; then
+    the fitted e against the impact speed (`jaximpact fit`)."""
+    fig = new_figure(figsize=(13.5, 4.2), layout="constrained")
+    axes = fig.subplots(1, 3)
+    if trajectory:
+        name, fit = next(iter(fits.items()))
+        ts = np.linspace(float(np.min(fit.t)), float(np.max(fit.t)), 1500)
+        axes[0].plot(fit.t, fit.y, ".", ms=3, label="measured")
+        axes[0].plot(ts, fit.predict(ts), "-", lw=1.2, label="fitted")
+        if fit.y_sign < 0:
+            axes[0].invert_yaxis()
+        axes[0].set_xlabel("time (s)")
+        axes[0].set_ylabel("height (data units)")
+        axes[0].set_title(f"{name}: measured and fitted")
+        axes[0].legend(fontsize="small")
+        axes[1].plot(fit.t, fit.y - fit.y_fit, ".", ms=3)
+        axes[1].set_xlabel("time (s)")
+        axes[1].set_ylabel("residual (data units)")
+        axes[1].set_title("residuals")
+    else:
+        for name, fit in fits.items():
+            gaps = np.diff(fit.times)
+            whole = np.diff(fit.index) == 1
+            model = np.diff(fit.impact_times)
+            axes[0].plot(fit.index[:-1][whole], gaps[whole], "o", ms=3)
+            axes[0].plot(np.arange(model.size), model, "-", lw=1, color="0.3")
+            axes[1].plot(fit.times, fit.residuals * fit.sigma * 1e3, ".", ms=4, label=name)
+        axes[0].set_xlabel("impact number")
+        axes[0].set_ylabel("interval (s)")
+        axes[0].set_title("intervals: measured (dots), fitted (lines)")
+        axes[1].set_xlabel("time (s)")
+        axes[1].set_ylabel("residual (ms)")
+        axes[1].set_title("impact-time residuals")
+    for fit in fits.values():
+        axes[2].errorbar(fit.impact_speeds, fit.e, yerr=fit.e_stderr, fmt="o-", ms=3, lw=0.8)
+    axes[2].set_xlabel("impact speed (m/s)")
+    axes[2].set_ylabel("restitution e")
+    axes[2].set_title("fitted e against impact speed")
+    save_figure(fig, path)
+
+
+def plot_bench(path, data, targets):
+    """Grouped bars of a benchmark's single and batch ratios per law (`data["rows"]`, log
+    scale), the `targets` (`{"single": x, "batch": x}`) as dashed lines, written to `path`
+    (`jaximpact bench`)."""
+    import math
+
+    fig = new_figure(figsize=(1.6 + 1.5 * max(len(data["rows"]), 1), 4.0))
+    ax = fig.add_subplot()
+    names = [r["case"].replace(" (", "\n(") for r in data["rows"]]
+    width = 0.38
+    colors = {"single": "tab:blue", "batch": "tab:orange"}
+    for k, kind in enumerate(("single", "batch")):
+        values = [r[f"ratio_{kind}"] or float("nan") for r in data["rows"]]
+        xs = [i + (k - 0.5) * width for i in range(len(values))]
+        ax.bar(xs, values, width, color=colors[kind], label=f"{kind} (scipy / jaximpact)")
+        for x, value in zip(xs, values, strict=True):
+            if math.isfinite(value):
+                label = f"{value:.0f}x" if value >= 100 else f"{value:.3g}x"
+                ax.annotate(label, (x, value), ha="center", va="bottom", fontsize=7)
+        ax.axhline(
+            targets[kind],
+            color=colors[kind],
+            ls="--",
+            lw=1,
+            label=f"{kind} target {targets[kind]:.0f}x",
+        )
+    ax.set_xticks(range(len(names)), names, fontsize=8)
+    ax.set_yscale("log")
+    ax.set_ylabel("scipy DOP853 time / jaximpact time")
+    machine = data["machine"]
+    ax.set_title(
+        f"jaximpact bench: {machine['cpu_count']} CPUs, {machine['backend']}, "
+        f"load {machine['load_average']}",
+        fontsize=9,
+    )
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    save_figure(fig, path)

@@ -20,9 +20,9 @@ from hypothesis import HealthCheck, example, given, settings, strategies as st
 
 import jaximpact as ji
 from jaximpact._cli import bench as cli_bench, laws as cli_laws
-from jaximpact._cli.common import KEEP_TOGETHER, format_table
 from jaximpact._engines import _stepping
 from jaximpact._engines.export import ENGINES, UnrealisedExport, UnrealisedWarning
+from jaximpact._format import KEEP_TOGETHER, format_table
 from jaximpact._jobs.row_checks import check_rows
 
 FEW = settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -10,8 +10,8 @@ import math
 import sys
 
 from .._bench import LAWS, TARGETS, require_scipy, run_bench, steps
-from .._format import format_number
-from .._plotting import new_figure, save_figure
+from .._format import format_number, format_table, terminal_width, wrap_text
+from .._plotting import plot_bench
 from .._progress import is_terminal, metered
 from .common import (
     CLIError,
@@ -19,9 +19,6 @@ from .common import (
     check_plot_path,
     command_parser,
     emit,
-    format_table,
-    terminal_width,
-    wrap_text,
 )
 
 
@@ -75,7 +72,7 @@ def _run_bench(args):
     with metered(is_terminal(sys.stderr), steps(laws), "bench") as bar:
         data = run_bench(laws, quick=args.quick, on_step=lambda note: bar.update(1, note))
     if args.plot is not None:
-        _plot(data, args.plot)
+        plot_bench(args.plot, data, TARGETS)
         data["plot"] = str(args.plot)
     emit(args, data, lambda: _text(data))
 
@@ -186,39 +183,3 @@ def _text(data, width=None) -> str:
     if "plot" in data:
         out += prose(f"plot written to {data['plot']}")
     return "\n".join(out)
-
-
-def _plot(data, path):
-    """Grouped bars of the single and batch ratios per law (log scale), the targets as
-    dashed lines."""
-    fig = new_figure(figsize=(1.6 + 1.5 * max(len(data["rows"]), 1), 4.0))
-    ax = fig.add_subplot()
-    names = [r["case"].replace(" (", "\n(") for r in data["rows"]]
-    width = 0.38
-    colors = {"single": "tab:blue", "batch": "tab:orange"}
-    for k, kind in enumerate(("single", "batch")):
-        values = [r[f"ratio_{kind}"] or float("nan") for r in data["rows"]]
-        xs = [i + (k - 0.5) * width for i in range(len(values))]
-        ax.bar(xs, values, width, color=colors[kind], label=f"{kind} (scipy / jaximpact)")
-        for x, value in zip(xs, values, strict=True):
-            if math.isfinite(value):
-                label = f"{value:.0f}x" if value >= 100 else f"{value:.3g}x"
-                ax.annotate(label, (x, value), ha="center", va="bottom", fontsize=7)
-        ax.axhline(
-            TARGETS[kind],
-            color=colors[kind],
-            ls="--",
-            lw=1,
-            label=f"{kind} target {TARGETS[kind]:.0f}x",
-        )
-    ax.set_xticks(range(len(names)), names, fontsize=8)
-    ax.set_yscale("log")
-    ax.set_ylabel("scipy DOP853 time / jaximpact time")
-    machine = data["machine"]
-    ax.set_title(
-        f"jaximpact bench: {machine['cpu_count']} CPUs, {machine['backend']}, "
-        f"load {machine['load_average']}",
-        fontsize=9,
-    )
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
-    save_figure(fig, path)

@@ -11,9 +11,10 @@ import math
 from pathlib import Path
 
 from .._choices import unknown_name
-from .._format import format_number, format_quantity
+from .._files import read_table
+from .._format import format_number, format_quantity, wrap_text
 from .._interrupt import check_interrupt, set_note
-from .._plotting import new_figure, plain_log_axis, save_figure
+from .._plotting import plot_fitted_speeds
 from .._progress import metered
 from .common import (
     LAW_HELP,
@@ -31,9 +32,7 @@ from .common import (
     heartbeat_meter,
     is_file_law,
     parse_params,
-    read_table,
     require_mass,
-    wrap_text,
 )
 from .laws import law_title, law_units
 
@@ -768,36 +767,7 @@ def _plot(args, data, fits):
         (v0.min() / 3, v0.max() * 3) if np.ptp(v0) == 0 else (v0.min() / 1.5, v0.max() * 1.5)
     )
     speeds = np.geomspace(low, high, 41)
-    has_T = data["T"] is not None
-    fig = new_figure(figsize=(11.0 if has_T else 5.8, 4.2), layout="constrained")
-    axes = fig.subplots(1, 2 if has_T else 1, squeeze=False)[0]
-    for k, (name, fit) in enumerate(fits):
-        es, Ts = _curve(fit, args, speeds)
-        style = dict(lw=2.0 if k == 0 else 1.2, ls="-" if k == 0 else "--")
-        axes[0].plot(speeds, es, label=f"{name} (fit)", **style)
-        if has_T:
-            axes[1].plot(speeds, 1e3 * np.asarray(Ts), label=f"{name} (fit)", **style)
-    e_err = None if data["sigma_e"] is None else data["sigma_e"]
-    axes[0].errorbar(
-        v0, data["e"], yerr=e_err, fmt="o", color="k", ms=5, capsize=3, label="measured", zorder=5
-    )
-    axes[0].set_ylabel("coefficient of restitution e")
-    if has_T:
-        T = np.asarray(data["T"], dtype=float)
-        T_err = None if data["sigma_T"] is None else 1e3 * np.asarray(data["sigma_T"])
-        if T_err is not None:
-            T_err = np.where(np.isnan(T), 0.0, T_err)
-        axes[1].errorbar(
-            v0, 1e3 * T, yerr=T_err, fmt="o", color="k", ms=5, capsize=3, label="measured", zorder=5
-        )
-        axes[1].set_ylabel("contact duration T [ms]")
-    for ax in axes:
-        ax.set_xscale("log")
-        plain_log_axis(ax.xaxis)
-        ax.set_xlabel("impact speed v0 [m/s]")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
+    curves = [(name, *_curve(fit, args, speeds)) for name, fit in fits]
     names = ", ".join(name for name, _ in fits)
     title = f"{names} fitted; m = {format_number(args.mass)} kg, separation by {args.separation}"
-    fig.suptitle(title, fontsize=10)
-    save_figure(fig, args.plot)
+    plot_fitted_speeds(args.plot, data, speeds, curves, title)

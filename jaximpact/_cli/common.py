@@ -1,8 +1,9 @@
 """What the subcommands share: the one-line error (`CLIError`, `fail`), the parser factory
 and argument groups, reading `--param NAME=VALUE` and a user's law `--law FILE.py:NAME`
-(`file_law`), `--json` output (`emit`) and JAX's set-up (`configure_jax`). `--plot FILE` goes
-through `jaximpact._plotting` (matplotlib's Agg backend, imported only then); anything long
-reports through a meter of `jaximpact._progress` on stderr."""
+(`file_law`, its file loaded by `_laws.custom.load_law_function`), `--json` output (`emit`)
+and JAX's set-up (`configure_jax`). `--plot FILE` goes through `jaximpact._plotting`
+(matplotlib's Agg backend, imported only then); anything long reports through a meter of
+`jaximpact._progress` on stderr."""
 
 import argparse
 import json
@@ -259,52 +260,6 @@ def parse_params(items: Iterable[str], flag: str = "--param") -> dict[str, float
     return params
 
 
-def read_table(path: Path, columns, *, label: str, hint: str, needed=()):
-    """`(header, rows)` of the small CSV file at `path` (`_files.read_text` and `read_csv`:
-    as people save it, `#` comments skipped), its header stripped and checked against
-    `columns` (those in `needed` must be there), each row `(line number, {column: number})`,
-    an empty cell NaN. One-line `CLIError`s that name the file as `label` (e.g. `--data
-    in.csv`) for a file that cannot be read or is not text, is empty, has an unknown column
-    (`hint`: the columns expected, in words), a column named twice or one of `needed`
-    missing, a row with too many or too few cells, or a cell that is not a number."""
-    import math
-
-    from .._files import NotText, cell_number, read_csv, read_text
-
-    try:
-        text = read_text(path)  # as people save it: a byte-order mark, UTF-16, cp1252
-    except OSError as error:
-        raise CLIError(f"cannot read {label}: {error.strerror or error}") from None
-    except NotText:
-        raise CLIError(f"{label} is not a text file (a CSV with columns {hint})") from None
-    header, rows = read_csv(text, comments=True)
-    if not header:
-        raise CLIError(f"{label} is empty")
-    header = [name.strip() for name in header]
-    unknown = [name for name in header if name not in columns]
-    if unknown:
-        raise CLIError(
-            f"{label}: unknown column {', '.join(map(repr, unknown))}; the columns are {hint}"
-        )
-    if len(set(header)) != len(header):
-        raise CLIError(f"{label}: a column is named twice in the header")
-    for name in needed:
-        if name not in header:
-            raise CLIError(f"{label}: no column {name!r} (need {hint})")
-    numbers = []
-    for line, cells in rows:
-        if len(cells) != len(header):
-            raise CLIError(f"{label}, line {line}: {len(cells)} cells for {len(header)} columns")
-        values = {}
-        for column, cell in zip(header, cells, strict=True):
-            try:
-                values[column] = cell_number(cell) if cell.strip() else math.nan
-            except ValueError as error:
-                raise CLIError(f"{label}, line {line}, column {column}: {error}") from None
-        numbers.append((line, values))
-    return header, numbers
-
-
 def check_argument_scales(args):
     """Every number given as an option lies within [1e-150, 1e150] in size (or is 0, or
     is left to the command's own checks: NaN, inf, a sign): a one-line error otherwise,
@@ -424,6 +379,7 @@ def file_law(text: str, params: dict, *, complete: bool = True):
     read, is a one-line `CLIError`; without (`jaximpact batch`, whose table's columns may
     give parameters), the job checks them."""
     from .._laws import CustomLaw, custom_law
+    from .._laws.custom import load_law_function
 
     fn = load_law_function(text)
     law = custom_law(fn, **params) if params else CustomLaw(fn, {}, text)
@@ -438,6 +394,7 @@ def check_file_law(law):
     reads a parameter that `--param` does not give, fails when traced, or is given a
     parameter it does not read."""
     from .._jobs.job_law import MissingParameter, parameters_read
+    from .._laws.custom import first_line, line_in
 
     text = law.name
     try:
@@ -450,7 +407,7 @@ def check_file_law(law):
     except Exception as error:  # the user's function: where it failed, in one line
         raise CLIError(
             f"{text} failed when called as NAME(x, v, params) with numbers ("
-            f"{type(error).__name__}{_line_in(error, law.fn)}: {_first_line(error)})"
+            f"{type(error).__name__}{line_in(error, law.fn)}: {first_line(error)})"
         ) from None
     unread = [k for k in law.params if k not in read]
     if unread:
@@ -459,111 +416,6 @@ def check_file_law(law):
             f"--param {unread[0]}: {text} does not read params["
             f"{json.dumps(unread[0])}] (it reads {reads})"
         )
-
-
-_LOADED: dict = {}  # (file, SHA-256 of its bytes) -> its module: a file loaded once
-
-
-def load_law_function(text: str):
-    """The function NAME of the file FILE.py of `--law FILE.py:NAME`, the file imported once
-    per content (`importlib`); one-line `CLIError`s for a name that is not `FILE.py:NAME`, a
-    file that is missing or not a .py file, a file that raises on import (which exception,
-    at which line), NAME not in the file (with the callables it has) or not callable."""
-    import hashlib
-    import importlib.util
-
-    where, _, name = text.rpartition(":")
-    flag = f"--law {text}"
-    if not where or not name:
-        raise CLIError(
-            f"{flag}: a user's law is FILE.py:NAME, the file and the name of its "
-            "function NAME(x, v, params)"
-        )
-    path = Path(where)
-    if path.suffix != ".py":
-        raise CLIError(
-            f"{flag}: {where} is not a .py file; a user's law is FILE.py:NAME, a "
-            "function NAME(x, v, params) in a Python file"
-        )
-    if not path.exists():
-        raise CLIError(f"{flag}: no such file {where}")
-    if not path.is_file():
-        raise CLIError(f"{flag}: {where} is not a file")
-    try:
-        source = path.read_bytes()
-    except OSError as error:
-        raise CLIError(f"{flag}: cannot read {where} ({error.strerror or error})") from None
-    digest = hashlib.sha256(source).hexdigest()
-    key = (str(path.resolve()), digest)
-    module = _LOADED.get(key)
-    if module is None:
-        module_name = f"_jaximpact_law_{digest[:16]}"
-        spec = importlib.util.spec_from_file_location(module_name, path)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[module_name] = module  # as an import has it (dataclasses look it up)
-        try:
-            spec.loader.exec_module(module)
-        except (Exception, SystemExit) as error:
-            del sys.modules[module_name]
-            line = _line_in(error, path)
-            raise CLIError(
-                f"{flag}: importing {where} raised {type(error).__name__}{line}: "
-                f"{_first_line(error)}"
-            ) from None
-        _LOADED[key] = module
-    if not hasattr(module, name):
-        from .._choices import nearest_names
-
-        own = [
-            k
-            for k, v in vars(module).items()
-            if callable(v)
-            and not k.startswith("_")
-            and getattr(v, "__module__", None) == module.__name__
-        ]
-        near = nearest_names(name, own)
-        hint = f" (did you mean {' or '.join(near)}?)" if near else ""
-        has = f"its callables: {', '.join(own)}" if own else "it defines no function"
-        raise CLIError(f"{flag}: {where} has no {name!r}{hint}; {has}")
-    fn = getattr(module, name)
-    if not callable(fn):
-        raise CLIError(
-            f"{flag}: {name} in {where} is a {type(fn).__name__}, not a function "
-            f"{name}(x, v, params)"
-        )
-    return fn
-
-
-def _first_line(error) -> str:
-    text = str(error).strip()
-    if isinstance(error, SyntaxError):  # its str holds the file and line: said apart
-        text = error.msg or text
-    return (text.splitlines() or [""])[0] or "(no message)"
-
-
-def _line_in(error, where) -> str:
-    """` at line N` of the user's file (`where`: its path, or a function defined in it)
-    where `error` was raised, or `""`."""
-    import traceback
-
-    if isinstance(where, (str, Path)):
-        file = str(Path(where).resolve())
-    else:
-        import inspect
-
-        try:
-            file = str(Path(inspect.getsourcefile(inspect.unwrap(where))).resolve())
-        except TypeError:
-            return ""
-    if isinstance(error, SyntaxError) and error.filename is not None:
-        if str(Path(error.filename).resolve()) == file and error.lineno:
-            return f" at line {error.lineno}"
-    frames = [
-        f
-        for f in traceback.extract_tb(error.__traceback__)
-        if str(Path(f.filename).resolve()) == file
-    ]
-    return f" at line {frames[-1].lineno}" if frames else ""
 
 
 def check_plot_path(path: Path | None, inputs=()):
@@ -627,136 +479,6 @@ def configure_jax():
     enable_cache(min_compile_time_secs=0.0)
 
 
-# --------------------------------------------------------------------------------------
-# Tables that fit the terminal
-# --------------------------------------------------------------------------------------
-
-NARROWEST = 60  # columns: below this a table is not made narrower
-KEEP_TOGETHER = "\xa0"  # a space that `format_table` does not wrap at (printed as a space)
-
-
-def wrap_text(text: str, width: int, *, first: str = "", then: str | None = None) -> list[str]:
-    """`text` in lines of at most `width` characters, broken at spaces only (a longer word,
-    such as a path, on a line of its own): the first after `first`, the others after
-    `then` (default: as many spaces as `first`)."""
-    then = " " * len(first) if then is None else then
-    return textwrap.wrap(
-        text,
-        width,
-        initial_indent=first,
-        subsequent_indent=then,
-        break_long_words=False,
-        break_on_hyphens=False,
-    )
-
-
-def terminal_width(default: int = 88) -> int:
-    """The columns text output may fill: `COLUMNS`, else the terminal's width, else
-    `default` (88) where stdout is not a terminal (a pipe, a file); never below 60."""
-    import shutil
-
-    return max(NARROWEST, shutil.get_terminal_size((default, 24)).columns)
-
-
-def format_table(header, rows, *, width=None, wrap=(), keep=1, notes=None, note_column=1):
-    """`rows` (lists of strings) under `header` as lines of at most `width` characters
-    (default `terminal_width()`), where that can be done without cutting a word.
-
-    The columns are two spaces apart, the header cells wrapped at spaces. A table wider
-    than `width` has the cells of the columns in `wrap` (indices of free text) wrapped
-    at spaces; if it is still too wide, its other columns go to further tables, each
-    repeating the first `keep` columns (the row's names). `notes` (one string or None per
-    row): a line under the row, from column `note_column` on, wrapped alike. Words joined
-    by `KEEP_TOGETHER` (a no-break space) stay on one line.
-
-    **Example**: `format_table(["law", "e"], [["kelvin_voigt", "0.5"]], width=80)`."""
-    width = terminal_width() if width is None else width
-    header = [str(h) for h in header]
-    rows = [[str(c) for c in row] for row in rows]
-    n = len(header)
-
-    def longest_word(text):
-        return max((len(w) for w in text.split()), default=0)
-
-    natural = [max([len(r[i]) for r in rows] + [len(header[i])]) for i in range(n)]
-    # narrowest each column can go: its longest word where it wraps, else its longest cell;
-    # a header wraps at its spaces
-    least = [
-        max(
-            [longest_word(r[i]) if i in wrap else len(r[i]) for r in rows]
-            + [longest_word(header[i])]
-        )
-        for i in range(n)
-    ]
-    widths = list(natural)
-    excess = sum(widths) + 2 * (n - 1) - width
-    cells = [max([len(r[i]) for r in rows] + [least[i]]) for i in range(n)]
-    while excess > 0:  # first wrap the headers wider than their cells, the most so first
-        i = max(range(n), key=lambda k: widths[k] - cells[k])
-        if widths[i] <= cells[i]:
-            break
-        widths[i] -= 1
-        excess -= 1
-    while excess > 0:  # then the free-text columns, the widest first, a character at a time
-        room = [i for i in wrap if widths[i] > least[i]]
-        if not room:
-            break
-        widths[max(room, key=lambda k: widths[k])] -= 1
-        excess -= 1
-    if excess > 0 and n > keep + 1:  # too wide still: further tables of the other columns
-        sections, current = [], []
-        fixed = sum(widths[:keep]) + 2 * keep
-        for i in range(keep, n):
-            if current and fixed + sum(widths[k] + 2 for k in current) + widths[i] > width:
-                sections.append(current)
-                current = []
-            current.append(i)
-        sections.append(current)
-        if len(sections) > 1:
-            out = []
-            for number, section in enumerate(sections):
-                columns = [*range(keep), *section]
-                if number:
-                    out.append("")
-                out += format_table(
-                    [header[i] for i in columns],
-                    [[r[i] for i in columns] for r in rows],
-                    width=width,
-                    wrap=[columns.index(i) for i in wrap if i in columns],
-                    keep=keep,
-                    notes=notes if number == len(sections) - 1 else None,
-                    note_column=min(note_column, len(columns) - 1),
-                )
-            return out
-
-    def cell_lines(text, i):
-        if len(text) <= widths[i]:
-            return [text]
-        return wrap_text(text, widths[i]) or [""]
-
-    def render(cells, wrapped):
-        parts = [cell_lines(c, i) if (i in wrapped) else [c] for i, c in enumerate(cells)]
-        height = max(len(p) for p in parts)
-        lines = []
-        for k in range(height):
-            line = "  ".join(
-                (p[k] if k < len(p) else "").ljust(widths[i]) for i, p in enumerate(parts)
-            )
-            lines.append(line.rstrip())
-        return lines
-
-    out = render(header, range(n))
-    out.append("  ".join("-" * w for w in widths))
-    indent = sum(widths[:note_column]) + 2 * note_column
-    for index, row in enumerate(rows):
-        out += render(row, wrap)
-        note = None if notes is None else notes[index]
-        if note:  # from `note_column`, or further left where a word would not fit there
-            at = max(0, min(indent, width - max(map(len, note.split()))))
-            out += wrap_text(note, width, first=" " * at)
-    return [line.replace(KEEP_TOGETHER, " ") for line in out]
-
-
 def heartbeat_meter(delay=None):
     """A bar redrawn every 0.2 s while a fit runs (a first fit compiles for tens of seconds
     without other sign of life): after 0.5 s on a terminal; elsewhere a line every 10 s,
@@ -777,6 +499,7 @@ def read_fit(path: str, law: str | None = None):
     FILE.py:NAME from its file). A file that is no such fit is a one-line `CLIError` (the
     one reading of a fit's file, for `export --from` and `fit-oblique --from`)."""
     from .._fit.calibrate import Fit
+    from .._laws.custom import LawFileError
 
     where, hint = f"--from {path}", "write it with 'jaximpact calibrate ... --json > FILE'"
     try:
@@ -804,5 +527,7 @@ def read_fit(path: str, law: str | None = None):
     user = (lambda params: file_law(name, params)) if is_file_law(name) else None
     try:
         return data, record, Fit.from_dict(record, law=user)
+    except LawFileError:  # its own one line, as `--law FILE.py:NAME` says it
+        raise
     except ValueError as error:
         raise CLIError(f"{where}: {error}") from None

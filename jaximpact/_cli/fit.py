@@ -15,7 +15,7 @@ import math
 from pathlib import Path
 
 from .._fit.recordings import parse_number, read_recording
-from .._plotting import new_figure, save_figure
+from .._plotting import plot_bounce_fits
 from .calibrate import add_posterior_arguments, posterior_options, sample_posterior
 from .common import (
     CLIError,
@@ -173,48 +173,6 @@ def _fit_one(law, args, recording, name, data, length_scale, y_axis):
     return fit_bounces(law, t=t, y=y, length_scale=length_scale, y_axis=y_axis, **common)
 
 
-def _plot(fits, recording, path):
-    import numpy as np
-
-    fig = new_figure(figsize=(13.5, 4.2), layout="constrained")
-    axes = fig.subplots(1, 3)
-    if recording.kind == "trajectory":
-        name, fit = next(iter(fits.items()))
-        ts = np.linspace(float(np.min(fit.t)), float(np.max(fit.t)), 1500)
-        axes[0].plot(fit.t, fit.y, ".", ms=3, label="measured")
-        axes[0].plot(ts, fit.predict(ts), "-", lw=1.2, label="fitted")
-        if fit.y_sign < 0:
-            axes[0].invert_yaxis()
-        axes[0].set_xlabel("time (s)")
-        axes[0].set_ylabel("height (data units)")
-        axes[0].set_title(f"{name}: measured and fitted")
-        axes[0].legend(fontsize="small")
-        axes[1].plot(fit.t, fit.y - fit.y_fit, ".", ms=3)
-        axes[1].set_xlabel("time (s)")
-        axes[1].set_ylabel("residual (data units)")
-        axes[1].set_title("residuals")
-    else:
-        for name, fit in fits.items():
-            gaps = np.diff(fit.times)
-            whole = np.diff(fit.index) == 1
-            model = np.diff(fit.impact_times)
-            axes[0].plot(fit.index[:-1][whole], gaps[whole], "o", ms=3)
-            axes[0].plot(np.arange(model.size), model, "-", lw=1, color="0.3")
-            axes[1].plot(fit.times, fit.residuals * fit.sigma * 1e3, ".", ms=4, label=name)
-        axes[0].set_xlabel("impact number")
-        axes[0].set_ylabel("interval (s)")
-        axes[0].set_title("intervals: measured (dots), fitted (lines)")
-        axes[1].set_xlabel("time (s)")
-        axes[1].set_ylabel("residual (ms)")
-        axes[1].set_title("impact-time residuals")
-    for fit in fits.values():
-        axes[2].errorbar(fit.impact_speeds, fit.e, yerr=fit.e_stderr, fmt="o-", ms=3, lw=0.8)
-    axes[2].set_xlabel("impact speed (m/s)")
-    axes[2].set_ylabel("restitution e")
-    axes[2].set_title("fitted e against impact speed")
-    save_figure(fig, path)
-
-
 def run_fit(args):
     sampling = posterior_options(args)  # before reading or fitting anything
     check_plot_path(args.plot, inputs=[args.file])
@@ -236,7 +194,7 @@ def run_fit(args):
             bar.update(1, name[:24])
     units = "s" if recording.kind == "impacts" else ("px" if recording.video else "m")
     if args.plot is not None:
-        _plot(fits, recording, args.plot)
+        plot_bounce_fits(args.plot, fits, trajectory=recording.kind == "trajectory")
     payload = {
         "file": str(args.file),
         "kind": recording.kind,

@@ -1,17 +1,20 @@
 """`jaximpact laws`: the force laws, their equations, parameters and units."""
 
 from .._choices import plain_name, unknown_name
-from .._format import concrete_units, format_number
-from .common import (
+from .._format import (
     KEEP_TOGETHER,
+    concrete_units,
+    format_number,
+    format_table,
+    terminal_width,
+    wrap_text,
+)
+from .common import (
     CLIError,
     add_output_arguments,
     command_parser,
     emit,
-    format_table,
     is_file_law,
-    terminal_width,
-    wrap_text,
 )
 
 # --------------------------------------------------------------------------------------

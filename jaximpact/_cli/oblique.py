@@ -15,6 +15,8 @@ import math
 import textwrap
 from pathlib import Path
 
+from .._files import read_table
+from .._plotting import plot_oblique
 from .._progress import metered
 from .._status import Status
 from .common import (
@@ -30,7 +32,6 @@ from .common import (
     heartbeat_meter,
     law_from_args,
     read_fit,
-    read_table,
     tangential_from_args,
     warn_sphere_density,
 )
@@ -249,9 +250,9 @@ _OBLIQUE_LEGEND = (
 def run_oblique_impact(args, law, head: list[str]) -> int:
     """`simulate --tangential`: one oblique impact per `--angle`, printed as text (a line
     per field for one angle, a table for several) or JSON; `head`: the normal law's lines."""
+    from .._format import format_table
     from .._oblique import oblique_impact
     from .._oblique.results import _SHOWN
-    from .common import format_table
 
     tangential = tangential_from_args(args)
     v0 = args.v0[0]
@@ -281,7 +282,7 @@ def run_oblique_impact(args, law, head: list[str]) -> int:
         results.append(result)
     if args.plot is not None:
         series = {k: [math.nan if d[k] is None else d[k] for d in runs] for k in MEASURED}
-        _plot(args.plot, [d["angle_deg"] for d in runs], series)
+        plot_oblique(args.plot, [d["angle_deg"] for d in runs], series)
     conditions = [
         f"sphere     m = {args.mass:g} kg, R = {args.radius:g} m, I = {args.inertia:g} m R^2, "
         f"contact point {args.contact_point}",
@@ -457,7 +458,7 @@ def run_fit_oblique(args):
         )
         bar.update(1, "done")
     if args.plot is not None:
-        _plot(args.plot, rows["theta"], {k: getattr(fit, k) for k in MEASURED}, rows)
+        plot_oblique(args.plot, rows["theta"], {k: getattr(fit, k) for k in MEASURED}, rows)
     check = _sanity(law, args.mass, float(np.max(rows["v_n"])))
     record = {**fit.to_dict(), "check": check, **({"normal": normal} if normal else {})}
     emit(args, record, lambda: _report(fit, rows, check, normal))
@@ -539,25 +540,3 @@ def _report(fit, rows, check, normal=None) -> str:
 
 def _cell(value: float, spec: str) -> str:
     return "-" if math.isnan(value) else format(value, spec)
-
-
-def _plot(path: Path, theta, fitted, measured=None):
-    """e_t and the spin after impact (rad/s) against the incidence (degrees): `fitted`
-    (the fit's, or `simulate`'s runs: `{"e_t": [...], "omega_out": [...]}`) as a line, and
-    where given the `measured` points."""
-    import numpy as np
-
-    from .._plotting import new_figure, save_figure
-
-    fig = new_figure(figsize=(9, 3.6))
-    order = np.argsort(theta)
-    for k, (name, label) in enumerate((("e_t", "e_t"), ("omega_out", "spin after [rad/s]"))):
-        ax = fig.add_subplot(1, 2, k + 1)
-        line = np.asarray(fitted[name], dtype=float)[order]
-        ax.plot(np.asarray(theta)[order], line, "-" if measured else "o-", label="fit")
-        if measured:
-            ax.plot(theta, measured[name], "o", label="measured")
-            ax.legend()
-        ax.set_xlabel("incidence from the normal [deg]")
-        ax.set_ylabel(label)
-    save_figure(fig, path)

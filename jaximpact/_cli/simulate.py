@@ -3,8 +3,8 @@
 import math
 import textwrap
 
-from .._format import format_number, format_quantity
-from .._plotting import new_figure, save_figure
+from .._format import format_number, format_quantity, format_table, terminal_width
+from .._plotting import new_figure, plot_speed_sweep, save_figure
 from .common import (
     MASS_HELP,
     CLIError,
@@ -15,11 +15,9 @@ from .common import (
     check_plot_path,
     command_parser,
     emit,
-    format_table,
     law_from_args,
     parse_params,
     require_mass,
-    terminal_width,
 )
 from .laws import law_title, law_units
 from .oblique import add_oblique_impact_arguments, check_oblique_arguments, run_oblique_impact
@@ -107,7 +105,9 @@ def _run_simulate(args):
         runs.append(data)
     if len(runs) > 1:
         if args.plot is not None:
-            _plot_sweep(law, runs, args.plot)
+            title = f"{law.name}, m = {format_number(runs[0]['m'])} kg"
+            e, T = ([float(r[k]) for r in runs] for k in ("e", "T"))
+            plot_speed_sweep(args.plot, [r["v0"] for r in runs], e, T, title)
             for data in runs:
                 data["plot"] = str(args.plot)
         emit(args, runs, lambda: _sweep_text(law, runs))
@@ -147,7 +147,7 @@ def _head(law, data) -> list[str]:
 
 def _sweep_text(law, runs, width=None) -> str:
     """A sweep: the law and conditions, then one row per speed (SI units in the header),
-    fitted to the terminal (`common.format_table`)."""
+    fitted to the terminal (`_format.format_table`)."""
     first = runs[0]
     lines = [
         *_head(law, first),
@@ -177,21 +177,6 @@ def _sweep_text(law, runs, width=None) -> str:
     if "plot" in first:
         lines.append(f"plot written to {first['plot']}")
     return "\n".join(lines)
-
-
-def _plot_sweep(law, runs, path):
-    """e and T (ms) against the impact speed v0 (m/s), one point per run."""
-    fig = new_figure(figsize=(9.0, 3.6), layout="constrained")
-    v = [r["v0"] for r in runs]
-    ax_e, ax_T = fig.subplots(1, 2)
-    ax_e.plot(v, [float(r["e"]) for r in runs], "o-")
-    ax_e.set_xlabel("impact speed v0 (m/s)")
-    ax_e.set_ylabel("restitution e")
-    ax_T.plot(v, [1e3 * float(r["T"]) for r in runs], "o-")
-    ax_T.set_xlabel("impact speed v0 (m/s)")
-    ax_T.set_ylabel("contact duration T (ms)")
-    fig.suptitle(f"{law.name}, m = {format_number(runs[0]['m'])} kg")
-    save_figure(fig, path)
 
 
 def _simulate_text(law, data) -> str:

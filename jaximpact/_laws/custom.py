@@ -1,7 +1,8 @@
 """The user's own law: `custom_law(fn, **params)` wraps a pure JAX function
-`fn(x, v, params) -> F`."""
+`fn(x, v, params) -> F`; `load_law_function` reads it from a file, `FILE.py:NAME`."""
 
 from collections.abc import Callable
+from pathlib import Path
 from typing import ClassVar
 
 import equinox as eqx
@@ -112,3 +113,118 @@ def _finite_arrays(params):
 
 def _never(array):
     return np.zeros(np.shape(array), bool)
+
+
+# ------------------------------------------------------------ a user's law from a file
+
+
+class LawFileError(ValueError):
+    """A user's law `FILE.py:NAME` that cannot be loaded (`load_law_function`): the file
+    missing, not Python, raising on import, or without a function NAME. Its message is the
+    whole one line (a reader that adds its own context to other `ValueError`s leaves it)."""
+
+
+_LOADED: dict = {}  # (file, SHA-256 of its bytes) -> its module: a file loaded once
+
+
+def load_law_function(text: str):
+    """The function NAME of the file FILE.py of `--law FILE.py:NAME`, the file imported once
+    per content (`importlib`); one-line `LawFileError`s for a name that is not `FILE.py:NAME`, a
+    file that is missing or not a .py file, a file that raises on import (which exception,
+    at which line), NAME not in the file (with the callables it has) or not callable."""
+    import hashlib
+    import importlib.util
+    import sys
+
+    where, _, name = text.rpartition(":")
+    flag = f"--law {text}"
+    if not where or not name:
+        raise LawFileError(
+            f"{flag}: a user's law is FILE.py:NAME, the file and the name of its "
+            "function NAME(x, v, params)"
+        )
+    path = Path(where)
+    if path.suffix != ".py":
+        raise LawFileError(
+            f"{flag}: {where} is not a .py file; a user's law is FILE.py:NAME, a "
+            "function NAME(x, v, params) in a Python file"
+        )
+    if not path.exists():
+        raise LawFileError(f"{flag}: no such file {where}")
+    if not path.is_file():
+        raise LawFileError(f"{flag}: {where} is not a file")
+    try:
+        source = path.read_bytes()
+    except OSError as error:
+        raise LawFileError(f"{flag}: cannot read {where} ({error.strerror or error})") from None
+    digest = hashlib.sha256(source).hexdigest()
+    key = (str(path.resolve()), digest)
+    module = _LOADED.get(key)
+    if module is None:
+        module_name = f"_jaximpact_law_{digest[:16]}"
+        spec = importlib.util.spec_from_file_location(module_name, path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[module_name] = module  # as an import has it (dataclasses look it up)
+        try:
+            spec.loader.exec_module(module)
+        except (Exception, SystemExit) as error:
+            del sys.modules[module_name]
+            line = line_in(error, path)
+            raise LawFileError(
+                f"{flag}: importing {where} raised {type(error).__name__}{line}: "
+                f"{first_line(error)}"
+            ) from None
+        _LOADED[key] = module
+    if not hasattr(module, name):
+        from .._choices import nearest_names
+
+        own = [
+            k
+            for k, v in vars(module).items()
+            if callable(v)
+            and not k.startswith("_")
+            and getattr(v, "__module__", None) == module.__name__
+        ]
+        near = nearest_names(name, own)
+        hint = f" (did you mean {' or '.join(near)}?)" if near else ""
+        has = f"its callables: {', '.join(own)}" if own else "it defines no function"
+        raise LawFileError(f"{flag}: {where} has no {name!r}{hint}; {has}")
+    fn = getattr(module, name)
+    if not callable(fn):
+        raise LawFileError(
+            f"{flag}: {name} in {where} is a {type(fn).__name__}, not a function "
+            f"{name}(x, v, params)"
+        )
+    return fn
+
+
+def first_line(error) -> str:
+    text = str(error).strip()
+    if isinstance(error, SyntaxError):  # its str holds the file and line: said apart
+        text = error.msg or text
+    return (text.splitlines() or [""])[0] or "(no message)"
+
+
+def line_in(error, where) -> str:
+    """` at line N` of the user's file (`where`: its path, or a function defined in it)
+    where `error` was raised, or `""`."""
+    import traceback
+
+    if isinstance(where, (str, Path)):
+        file = str(Path(where).resolve())
+    else:
+        import inspect
+
+        try:
+            file = str(Path(inspect.getsourcefile(inspect.unwrap(where))).resolve())
+        except TypeError:
+            return ""
+    if isinstance(error, SyntaxError) and error.filename is not None:
+        if str(Path(error.filename).resolve()) == file and error.lineno:
+            return f" at line {error.lineno}"
+    frames = [
+        f
+        for f in traceback.extract_tb(error.__traceback__)
+        if str(Path(f.filename).resolve()) == file
+    ]
+    return f" at line {frames[-1].lineno}" if frames else ""

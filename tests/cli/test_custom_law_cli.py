@@ -3,7 +3,7 @@ wherever `--law NAME` goes, named `FILE.py:NAME` in the output; a bad file, name
 parameter is one line, exit status 2, before any work.
 
 Compilation: the law file is written once for the module (`law_file`) and imported once
-(`common.load_law_function` keeps it per content), so `simulate` compiles one program and
+(`_laws.custom.load_law_function` keeps it per content), so `simulate` compiles one program and
 `batch` one more; calibrate, fit and export each compile their own (slow)."""
 
 import json
