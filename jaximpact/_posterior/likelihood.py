@@ -111,7 +111,10 @@ def _forward(model: Model, theta, v0):
     """`calibrate`'s residual function at `theta` (its unbounded coordinates), its
     predictions only. Off the curves the solves are differentiated in forward mode only
     (`calibrate`'s `ForwardMode` adjoint), so every derivative goes through one
-    `jax.jacfwd` (`with_forward_jacobian`); on the curves directly."""
+    `jax.jacfwd` (`with_forward_jacobian`), held: the gradient is exact and a second
+    derivative (the Laplace step's Hessian) is Gauss-Newton's, with no second derivative
+    through the solves (diffrax's event search has none: `nextafter`); on the curves
+    directly."""
     setup = model.setup
     raw = _residual_function(
         model.law,
@@ -135,7 +138,7 @@ def _forward(model: Model, theta, v0):
         _, (e, T, _) = raw(t, d)
         return jnp.concatenate([e, T])
 
-    both = with_forward_jacobian(stacked)(theta, data)
+    both = with_forward_jacobian(stacked, held=True)(theta, data)
     _, (_, _, status) = raw(jax.lax.stop_gradient(theta), data)
     n = v0.shape[0]
     return both[:n], both[n:], status

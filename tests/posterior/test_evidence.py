@@ -72,3 +72,16 @@ def test_the_default_is_the_aic_ranking():
         ji.compare_laws(**data, laws=("hertz_rate",), by="bic")
     with pytest.raises(ValueError, match="prior= is for by='evidence'"):
         ji.compare_laws(**data, laws=("hertz_rate",), prior={"hertz_rate": {}})
+
+
+@pytest.mark.slow
+def test_evidence_of_a_law_whose_impacts_are_searched_for_events():
+    """Bingham-modified's impacts come off its dry-force table or out of diffrax's event
+    search, which has no second derivative (`nextafter`): its Laplace step takes the
+    Gauss-Newton Hessian of the held forward Jacobian, and the evidence is a number (it
+    raised NotImplementedError before)."""
+    rubber = ji.law("hertz_rate", c=2e6, b1=800.0)
+    data = _measured(rubber, 1.0)
+    del data["T"], data["sigma_T"]
+    ranks = ji.compare_laws(**data, laws=("bingham_modified",), by="evidence", progress=False)
+    assert np.isfinite(ranks[0].log_evidence)
