@@ -13,15 +13,10 @@ from .base import (
     Scene as Scene,
     Stepping as Stepping,
 )
-from .export import (
-    ENGINES as ENGINES,
-    Export as Export,
-    engine_response as engine_response,
-    export as export,
-    stepped_response as stepped_response,
-)
+from .export import ENGINES as ENGINES, Export as Export, export as export
 from .materials import (
     effective_mass as effective_mass,
     effective_radius as effective_radius,
     hertz_stiffness as hertz_stiffness,
 )
+from .response import engine_response as engine_response, stepped_response as stepped_response

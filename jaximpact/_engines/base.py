@@ -8,7 +8,7 @@ a normal model's design gives, `Stepping` its time stepping replicated, `Key` on
 its parameters, `Scene` the collision an export is for.
 
 Each engine is one final class (`mujoco/engine.py`, `yade.py`, ...), registered once in
-`export.ENGINES`, which `jaximpact.export`, `engine_response`, `stepped_response` and the
+`registry.ENGINES`, which `jaximpact.export`, `engine_response`, `stepped_response` and the
 command line read: nothing else names an engine (docs/layout.md, "Adding an engine").
 Units are SI throughout; an engine's own parameters keep its own names.
 """

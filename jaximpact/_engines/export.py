@@ -1,6 +1,5 @@
 """`export`: from a law, a fit or target e and T to an engine's own contact parameters, with
-the e and T that the engine will realise; `ENGINES`, the one registry of the engines that
-`export`, `engine_response`, `stepped_response` and the command line read. An export is
+the e and T that the engine will realise (the engines: `registry.ENGINES`). An export is
 the composition of the engine's sub-models, as LAMMPS's `GranularModel::calculate_forces`:
 find the normal model for the law, design it, add the tangential model, make the promise
 (`promise.py`)."""
@@ -8,27 +7,12 @@ find the normal model for the law, design it, add the tangential model, make the
 import dataclasses
 import sys
 
-import numpy as np
-
-from .._choices import unknown_name
-from . import chrono, compose, yade
-from .base import AbstractEngine, contact_mass
-from .drake.engine import Drake
-from .lammps.engine import Lammps
-from .liggghts.engine import Liggghts
-from .materials import check_positive
-from .mujoco.engine import Mujoco
-from .refusal import UnrealisedExport as UnrealisedExport
-from .refusal import UnrealisedWarning as UnrealisedWarning
-from .targets import curve
+from . import compose
+from .base import contact_mass
+from .refusal import UnrealisedExport as UnrealisedExport, UnrealisedWarning as UnrealisedWarning
+from .registry import ENGINES as ENGINES, engine as _engine
 
 BAND_FIELDS = ("e_band", "T_band", "band_draws")
-# The registry, in the order messages list the engines: one final `AbstractEngine` each.
-# A new engine is its module and one line here (docs/layout.md, "Adding an engine").
-ENGINES: dict[str, AbstractEngine] = {
-    engine.NAME: engine
-    for engine in (Mujoco(), Lammps(), Drake(), Liggghts(), chrono.Chrono(), yade.Yade())
-}
 
 
 def missing_mass(engine: str, from_law: bool, how: str) -> str:
@@ -252,43 +236,26 @@ def export(
 
     **Example**: `export(law("hertz_rate", c=2e6, b1=800.0), "mujoco", m=1.0, v0=2.5).parameters`.
     """
+    scene = dict(m=m, v0=v0, timestep=timestep, radius=radius, poisson=poisson)
+    design = dict(limit_damping=limit_damping, geometry=geometry, tangential=tangential)
     if _is_posterior(law_or_fit):
         return _posterior_export(
             law_or_fit,
             engine,
             band_draws=band_draws,
             progress=progress,
-            m=m,
-            v0=v0,
-            timestep=timestep,
-            radius=radius,
-            poisson=poisson,
             e=e,
             T=T,
-            limit_damping=limit_damping,
-            geometry=geometry,
             curves=curves,
             strict=strict,
-            tangential=tangential,
+            **scene,
+            **design,
         )
     chosen = _engine(engine)
     # the normal model, and what is refused without the law's impact (a law's e and T
     # compile), then the law's e and T (or the targets)
     asked = compose.request(
-        chosen,
-        law_or_fit,
-        m=m,
-        v0=v0,
-        timestep=timestep,
-        radius=radius,
-        poisson=poisson,
-        e=e,
-        T=T,
-        limit_damping=limit_damping,
-        geometry=geometry,
-        tangential=tangential,
-        engines=ENGINES,
-        missing_mass=missing_mass,
+        chosen, law_or_fit, e=e, T=T, engines=ENGINES, missing_mass=missing_mass, **scene, **design
     )
     out = compose.design(asked, tangential)  # the normal model designed (and its tie)
     warnings = [*compose.refusal(asked, out, strict=strict), *out.warnings]
@@ -361,71 +328,3 @@ def with_band(x: Export, post, *, band_draws: int = 200, progress=True, **option
         band_draws=band["draws"],
         warnings=tuple(lines),
     )
-
-
-def _normal_for(chosen: AbstractEngine, parameters: dict):
-    """The normal model of `chosen` that an engine's `parameters` are for: of the rows whose
-    needed `KEYS` (beyond those every row needs) the parameters hold, and whose `NAME` is
-    the parameters' `normal` where they name one, the one that holds the most; else the
-    first row (the default design)."""
-    rows = list(chosen.NORMAL.values())
-    needs = [{k.name for k in model.KEYS if k.needed} for model in rows]
-    common = set.intersection(*needs)
-    named = parameters.get("normal")
-    held = [
-        (len(need - common), i)
-        for i, (model, need) in enumerate(zip(rows, needs))
-        if need - common <= set(parameters) and named in (None, model.NAME)
-    ]
-    return rows[max(held, key=lambda h: (h[0], -h[1]), default=(0, 0))[1]]
-
-
-def engine_response(engine: str, parameters: dict, *, m, speeds, radius=None):
-    """The inverse: e(v) and T(v) (continuous law of the engine) that given engine parameters
-    produce, for a body of mass `m` (kg; two-sphere engines: each sphere) at each speed of
-    `speeds` (m/s). Parameters: the names of the engine's `KEYS` (MuJoCo `solref`,
-    `timestep` for refsafe; LAMMPS, LIGGGHTS, Chrono `E` (Pa), `coeff_restitution`,
-    `poisson`, `limit_damping`; Yade `tc` (s), `en`; Drake `point_contact_stiffness` (N/m),
-    `hunt_crossley_dissipation` (s/m)); `"geometry": "wall"` (LAMMPS, LIGGGHTS, Chrono,
-    Yade): one sphere on a wall of its material. The step is not part of this answer:
-    `stepped_response` gives what the stepping realises. Returns `(law, separation, e, T)`."""
-    chosen = _engine(engine)
-    m = check_positive("m", m, "kg")
-    speeds = [check_positive("speed", v, "m/s") for v in np.atleast_1d(speeds)]
-    law, separation = _normal_for(chosen, parameters).response(parameters, m=m, radius=radius)
-    e, T = curve(law, contact_mass(chosen, m, parameters.get("geometry")), speeds, separation)
-    return law, separation, e, T
-
-
-def stepped_response(engine: str, parameters: dict, *, m, speeds, radius=None):
-    """What the engine's own time stepping realises with `parameters` at each speed (m/s):
-    `(timestep, e, T, e_min, e_max)`, e and T the mean over where the first touch falls
-    inside a step and `e_min`, `e_max` their extremes. Modelled (replicas checked against
-    the engines): MuJoCo at its `timestep` (default 0.002 s), LAMMPS and LIGGGHTS with a
-    `timestep` (velocity Verlet), Yade with a `timestep` (leapfrog, and its NewtonIntegrator
-    `damping`, default 0 here), Drake with `time_step > 0` (its implicit discrete step, the
-    Lagged, Similar and TAMSI approximations). `None` where the step does not apply or is
-    not known: a two-sphere engine without a `timestep`, Drake's continuous plant
-    (error-controlled integration: no step error), and Chrono (its stepper not modelled);
-    each engine's `STEPPING` says which."""
-    chosen = _engine(engine)
-    m = check_positive("m", m, "kg")
-    speeds = [check_positive("speed", v, "m/s") for v in np.atleast_1d(speeds)]
-    stepping = _normal_for(chosen, parameters).stepper(parameters, m=m, radius=radius)
-    if stepping is None:
-        return None
-    runs = [stepping.run(v) for v in speeds]
-    return (
-        stepping.timestep,
-        [float(np.mean(es)) for es, _ in runs],
-        [float(np.mean(Ts)) for _, Ts in runs],
-        [float(np.min(es)) for es, _ in runs],
-        [float(np.max(es)) for es, _ in runs],
-    )
-
-
-def _engine(name: str) -> AbstractEngine:
-    """The engine `name` of `ENGINES`, or a one-line ValueError naming the engines."""
-    if name not in ENGINES:
-        raise ValueError(unknown_name("engine", name, list(ENGINES)))
-    return ENGINES[name]

@@ -13,7 +13,8 @@ from jaximpact._engines.drake import normal as drake_engine
 from jaximpact._engines.liggghts import normal as liggghts_engine
 from jaximpact._engines.mujoco import solref as mujoco_engine
 from jaximpact._engines.base import Scene
-from jaximpact._engines.export import ENGINES, engine_response, stepped_response
+from jaximpact._engines.export import ENGINES
+from jaximpact._engines.response import engine_response, stepped_response
 
 SOLREF = ENGINES["mujoco"].NORMAL["kelvin_voigt"]  # MuJoCo's normal model
 UNIT = Scene(m=1.0, v0=1.0, radius=None, geometry="wall")

@@ -13,7 +13,8 @@ import pytest
 import jaximpact as ji
 from jaximpact._engines.lammps import jkr as lammps_jkr
 from jaximpact._engines.lammps import jkr_viscoelastic as lammps_jkr_viscoelastic
-from jaximpact._engines.export import UnrealisedExport, engine_response, stepped_response
+from jaximpact._engines.export import UnrealisedExport
+from jaximpact._engines.response import engine_response, stepped_response
 from jaximpact._laws.jkr import adhesion_group
 
 R, M = 0.005, 0.004  # a 5 mm sphere of 4 g

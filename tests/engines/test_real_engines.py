@@ -22,7 +22,7 @@ from jaximpact._engines import yade as yade_engine
 from jaximpact._engines.drake import normal as drake_engine
 from jaximpact._engines.lammps import hertz as lammps_engine
 from jaximpact._engines.mujoco import solref as mujoco_engine
-from jaximpact._engines.export import engine_response, stepped_response
+from jaximpact._engines.response import engine_response, stepped_response
 
 PHASES = (0.05, 0.3, 0.55, 0.8, 0.95)
 TARGETS = [(0.95, 0.02), (0.75, 0.01), (0.5, 2e-3), (0.2, 5e-3), (0.05, 1e-3)]

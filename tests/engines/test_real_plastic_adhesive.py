@@ -17,7 +17,7 @@ from jaximpact._engines.lammps import dmt as lammps_dmt
 from jaximpact._engines.lammps import jkr as lammps_jkr
 from jaximpact._engines.lammps import jkr_viscoelastic as lammps_jkr_viscoelastic
 from jaximpact._engines.lammps.script import FRICTIONLESS
-from jaximpact._engines.export import stepped_response
+from jaximpact._engines.response import stepped_response
 
 R, M = 0.005, 0.004
 E, NU, W = 1e7, 0.3, 1.0
