@@ -1,6 +1,6 @@
 """`jaximpact export` (a law or target e, T -> an engine's contact parameters and what the
 engine realises) and `jaximpact engine-e` (engine parameters -> e(v), T(v)). The engines, their
-names and what the help says of each come from the one registry, `_engines.export.ENGINES`."""
+names and what the help says of each come from the one registry, `_engines.registry.ENGINES`."""
 
 import json
 

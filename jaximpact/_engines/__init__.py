@@ -2,7 +2,7 @@
 and exports of a law to an engine's own contact parameters with the e and T the engine
 realises (docs/engines.md). `base.AbstractEngine` is what an engine declares, its tables
 of normal and tangential models (`base.AbstractNormalModel`, `base.AbstractTangentialModel`)
-included; `export.ENGINES` is the one registry of them (docs/layout.md, "Adding an engine")."""
+included; `registry.ENGINES` is the one registry of them (docs/layout.md, "Adding an engine")."""
 
 from .base import (
     AbstractEngine as AbstractEngine,
