@@ -31,6 +31,7 @@ OUTPUTS = {  # script -> (arguments, files it must write)
     "oblique_rebounds.py": ([], ["oblique_rebounds.png"]),
     "pick_a_law.py": ([], ["pick_a_law.png"]),
     "plastic_and_sticky.py": ([], ["plastic_and_sticky.png"]),
+    "posterior_to_engine.py": ([], ["posterior.png"]),
     "uncertainty_propagation.py": ([], ["uncertainty.png"]),
 }
 

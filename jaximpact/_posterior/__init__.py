@@ -1,6 +1,7 @@
 """Uncertainty of a fit: priors, the likelihood built from a fit's forward model, the
 Laplace approximation, NUTS (blackjax), the `Posterior` record, prediction bands and the
-next measurement. Imports `_fit`, `_curves` and `_laws`."""
+next measurement, for the results of `calibrate`, `fit_bounces` and `fit_oblique`. Imports
+`_fit`, `_oblique`, `_curves` and `_laws`."""
 
 from .next_measurement import NextMeasurement as NextMeasurement
 from .next_measurement import next_measurement as next_measurement

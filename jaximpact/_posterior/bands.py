@@ -90,8 +90,9 @@ def prediction_bands(post, v0, *, level=0.9, observed=False, max_draws=1000, key
     e, T = (np.asarray(a) for a in draw_predictions(model, jnp.asarray(z), jnp.asarray(v0)))
     if observed:
         key = jax.random.key(1) if key is None else key
-        e = e + noise_scale(post, "e", T, z) * _noise(model, key, e.shape)
-        T = T + noise_scale(post, "T", T, z) * _noise(model, jax.random.fold_in(key, 1), T.shape)
+        e = e + noise_scale(post, "e", T, z) * noise_draws(model, key, e.shape)
+        T_key = jax.random.fold_in(key, 1)
+        T = T + noise_scale(post, "T", T, z) * noise_draws(model, T_key, T.shape)
     lo, hi = (1 - level) / 2, (1 + level) / 2
     q = lambda a: np.nanquantile(a, [0.5, lo, hi], axis=0)  # noqa: E731
     (e_med, e_lo, e_hi), (T_med, T_lo, T_hi) = q(e), q(T)
@@ -99,24 +100,26 @@ def prediction_bands(post, v0, *, level=0.9, observed=False, max_draws=1000, key
 
 
 def noise_scale(post, what: str, T_pred, z) -> np.ndarray:
-    """The noise scale of a new measurement of `what` ("e" or "T"), per draw (rows of `z`)
-    and speed: the sampled scale of each draw, or else the given sigmas' median (for `T`
-    as a fraction of the measured T, times the predicted T)."""
+    """The noise scale `sigma_{what}` of a new measurement of `what` ("e" or "T" of a
+    calibration, "e_t" or "omega" of an oblique fit), per draw (rows of `z`) and speed:
+    the sampled scale of each draw, or else the given sigmas' median (for `T` as a
+    fraction of the measured T, times the predicted T `T_pred`)."""
     model = post.model
     name = f"sigma_{what}"
     if name in model.names:
         i = model.names.index(name)
         return np.asarray(model.priors[i].value(jnp.asarray(z[:, i])))[:, None]
-    given = model.sigma_e if what == "e" else model.sigma_T
+    given = getattr(model, name)
     if given is None:
         return np.zeros((1, 1))
-    if what == "e":
+    if what != "T":
         return np.full((1, 1), float(np.median(given)))
     known = np.isfinite(model.T)
     return float(np.median(given[known] / model.T[known])) * np.asarray(T_pred)
 
 
-def _noise(model, key, shape):
+def noise_draws(model, key, shape):
+    """Standard draws of `model`'s noise (normal, or Student-t of `model.nu`)."""
     if model.noise == "normal":
         return np.asarray(jax.random.normal(key, shape))
     return np.asarray(jax.random.t(key, model.nu, shape))

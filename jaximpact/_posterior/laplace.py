@@ -35,9 +35,16 @@ def laplace(model, z0, max_iter: int = 100, gtol: float = 1e-8) -> Laplace:
     f = model.log_posterior
     d = z0.shape[0]
 
-    def derivatives(z):  # one Hessian in the compiled program, the loop's
-        g, H = jax.grad(f)(z), jax.hessian(f)(z)
-        return g, -0.5 * (H + H.T)
+    def derivatives(z):
+        """`(f, g, -H)` at `z` from one trace (the Hessian's, the value and gradient its
+        by-products): each copy of the forward model costs its compile time."""
+
+        def gradient(zz):
+            value, g = jax.value_and_grad(f)(zz)
+            return g, (value, g)
+
+        H, (value, g) = jax.jacfwd(gradient, has_aux=True)(z)
+        return value, g, -0.5 * (H + H.T)
 
     def step(carry):
         z, value, g, H, k, _ = carry
@@ -45,22 +52,23 @@ def laplace(model, z0, max_iter: int = 100, gtol: float = 1e-8) -> Laplace:
         w = jnp.maximum(jnp.abs(w), 1e-8 * jnp.maximum(jnp.max(jnp.abs(w)), 1.0))
         direction = v @ ((v.T @ g) / w)
 
-        # backtracking: halve until the log density rises (down to 1e-12 of the step)
+        # backtracking: the full step, then halve until the log density rises (down to
+        # 1e-12 of the step); one call of `f` in the program
         def shorter(c):
-            alpha, _, _ = c
+            alpha, _, _, _ = c
             alpha = 0.5 * alpha
             trial = z + alpha * direction
-            return alpha, trial, f(trial)
+            return alpha, trial, f(trial), jnp.asarray(True)
 
         def not_better(c):
-            alpha, _, new = c
-            return (~(new >= value)) & (alpha > 1e-12)
+            alpha, _, new, tried = c
+            return ~tried | ((~(new >= value)) & (alpha > 1e-12))
 
-        trial = z + direction
-        _, trial, new = jax.lax.while_loop(not_better, shorter, (1.0, trial, f(trial)))
+        start = (jnp.asarray(2.0, z.dtype), z, value, jnp.asarray(False))
+        _, trial, new, _ = jax.lax.while_loop(not_better, shorter, start)
         better = new >= value
         z_next = jnp.where(better, trial, z)
-        g_next, H_next = derivatives(z_next)
+        _, g_next, H_next = derivatives(z_next)
         # the Newton decrement g^T H^-1 g: twice the rise a full step would bring
         done = (jnp.abs(g @ direction) < gtol) | ~better
         return z_next, jnp.where(better, new, value), g_next, H_next, k + 1, done
@@ -69,8 +77,8 @@ def laplace(model, z0, max_iter: int = 100, gtol: float = 1e-8) -> Laplace:
         *_, k, done = carry
         return (k < max_iter) & ~done
 
-    g0, H0 = derivatives(z0)
-    carry = (z0, f(z0), g0, H0, jnp.asarray(0), jnp.asarray(False))
+    value0, g0, H0 = derivatives(z0)
+    carry = (z0, value0, g0, H0, jnp.asarray(0), jnp.asarray(False))
     z, value, g, H, k, _ = jax.lax.while_loop(keep_going, step, carry)
     w = jnp.linalg.eigvalsh(H)
     positive = jnp.all(w > 0)

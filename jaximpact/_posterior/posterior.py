@@ -9,11 +9,13 @@ import numpy as np
 from .._checks import is_traced
 from .._fit.bounce_fit import BounceFit
 from .._fit.calibrate import Fit, law_units
+from .._oblique.fit import ObliqueFit
 from .._xla_log import quietly_compiled
 from .bounce import bounce_setup, reproduces
 from .laplace import gaussian_draws, laplace
 from .likelihood import NOISES, build_model
 from .nuts import diagnostics, poor, run_chains
+from .oblique_model import oblique_setup
 from .priors import default_noise_prior, default_prior, parse_prior
 from .result import Posterior
 
@@ -40,11 +42,10 @@ def posterior(
 ) -> Posterior:
     """The posterior of `fit`'s free parameters given its data, `p(theta | y)`.
 
-    `fit`: the result of `calibrate` or of `fit_bounces` (one `BounceFit`: for several
-    drops, one posterior per drop); a `fit_oblique` result is a TypeError (an `ObliqueFit`
-    does not keep the rebounds it was fitted to). The likelihood solves every impact with
-    the fit's own forward model (on the universal curves where they served the fit, else
-    the closed form or the integrated solve), compiled once.
+    `fit`: the result of `calibrate`, of `fit_bounces` (one `BounceFit`: for several
+    drops, one posterior per drop) or of `fit_oblique` (an `ObliqueFit`). The likelihood
+    solves every impact with the fit's own forward model (on the universal curves where
+    they served the fit, else the closed form or the integrated solve), compiled once.
 
     A bounce fit (`_posterior.bounce`): the likelihood is `fit_bounces`'s own chain
     (`bounce_model.chain_residuals`, its default solve options; a `PosteriorWarning` where
@@ -62,6 +63,17 @@ def posterior(
     single impacts at new speeds (the chain's contact solve, the fit's gravity and
     separation); bands of heights, `observed=True` and `next_measurement` are not
     offered for a bounce posterior (ValueError).
+
+    An oblique fit (`_posterior.oblique_model`): the likelihood is `fit_oblique`'s own
+    solve of its rows (the normal law held, forward-mode derivatives through the
+    stick-slip transitions), one term per measured `e_t` and `omega_out`; sampled are the
+    tangential law's free parameters and, for each measured kind whose sigma was not
+    given, its noise scale `sigma_e_t` (default prior loguniform(1e-4, 0.5)) or
+    `sigma_omega` (rad/s; loguniform over 1e-4 to 0.5 times the largest measured
+    `|omega_out|`). Laplace uses the Gauss-Newton Hessian (the fit's standard errors'
+    curvature), NUTS the exact gradient. `predict(angle=...)` gives bands of e_t, the spin
+    and the rebound angle at new incidence angles (rad), `next_measurement(post,
+    angle=...)` ranks candidate angles.
 
     - `prior`: `{name: (kind, a, b)}` with kind `"loguniform"` (lo, hi), `"uniform"`
       (lo, hi), `"normal"` (mean, sd) or `"lognormal"` (mu, sigma of ln x), SI units. A
@@ -93,7 +105,7 @@ def posterior(
     **Example**: `posterior(calibrate(law, m=1.0, v0=v0s, e=es, T=Ts, sigma_e=0.01,
     sigma_T=0.02 * Ts), prior={"c": ("loguniform", 1e5, 1e8)}, key=jax.random.key(0))`.
     """
-    bounce = _check_fit(fit)
+    kind = _check_fit(fit)
     if method not in METHODS:
         raise ValueError(f"method must be 'nuts' or 'laplace', got {method!r}")
     if noise not in NOISES:
@@ -111,7 +123,10 @@ def posterior(
         raise ValueError(f"target_accept must lie in (0, 1), got {target_accept!r}")
     key = jax.random.key(0) if key is None else key
 
-    if bounce:
+    law = fit.tangential if kind == "oblique" else fit.law
+    if kind == "oblique":
+        model, starts, units = oblique_setup(fit, prior, noise=noise, nu=nu)
+    elif kind == "bounce":
         model, starts, units = bounce_setup(fit, prior, noise=noise, nu=nu)
         off = reproduces(model, fit, starts)
         if not off <= REPRODUCED:
@@ -183,7 +198,7 @@ def posterior(
     values = model.values(jnp.asarray(z))
     samples = {k: np.asarray(values[k]) for k in model.names}
     at_mode = model.values(mode.z)
-    if not bounce:
+    if kind == "calibrate":
         units = law_units(fit.law)
         units = {k: units.get(k, "") for k in model.free}
         units.update({k: u for k, u in (("sigma_e", ""), ("sigma_T", "s")) if k in model.names})
@@ -193,7 +208,7 @@ def posterior(
         names=model.names,
         free=model.free,
         method=method,
-        law_name=fit.law.name,
+        law_name=law.name,
         noise=noise,
         nu=float(nu),
         units=units,
@@ -202,7 +217,7 @@ def posterior(
         log_evidence=float(mode.log_evidence),
         diagnostics=diag,
         model=model,
-        law_parameters={k: float(v) for k, v in fit.law.parameters.items()},
+        law_parameters={k: float(v) for k, v in law.parameters.items()},
     )
 
 
@@ -211,11 +226,20 @@ def posterior(
 REPRODUCED = 1e-3
 
 
-def _check_fit(fit) -> bool:
-    """Whether `fit` is a bounce fit (else a calibration); TypeError for what `posterior`
-    does not take, ValueError for a traced or batched calibration."""
+def _check_fit(fit) -> str:
+    """What `fit` is, `"calibrate"`, `"bounce"` or `"oblique"`; TypeError for what
+    `posterior` does not take (an `ObliqueFit` without its data among them), ValueError
+    for a traced or batched calibration."""
     if isinstance(fit, BounceFit):
-        return True
+        return "bounce"
+    if isinstance(fit, ObliqueFit):
+        if getattr(fit, "problem", None) is None:
+            raise TypeError(
+                "this ObliqueFit keeps no rebounds (built by hand, not by fit_oblique): "
+                "fit_oblique results are not supported without the data they were fitted "
+                "to; fit again with ji.fit_oblique(...)"
+            )
+        return "oblique"
     if isinstance(fit, (list, tuple)) and fit and all(isinstance(f, BounceFit) for f in fit):
         raise TypeError(
             "posterior takes one fit; fit_bounces gave a list (one fit per drop): "
@@ -223,18 +247,12 @@ def _check_fit(fit) -> bool:
         )
     if not isinstance(fit, Fit) or fit.setup is None:
         raise TypeError(
-            f"posterior takes the result of calibrate (a Fit) or of fit_bounces (a "
-            f"BounceFit), got {type(fit).__name__}"
-            + (
-                "; fit_oblique results are not supported: an ObliqueFit does not keep the "
-                "rebounds it was fitted to"
-                if type(fit).__name__ == "ObliqueFit"
-                else ""
-            )
+            "posterior takes the result of calibrate (a Fit), of fit_oblique (an "
+            f"ObliqueFit) or of fit_bounces (a BounceFit), got {type(fit).__name__}"
         )
     if is_traced(fit.loss) or np.ndim(fit.loss) != 0:
         raise ValueError("posterior takes one concrete fit, not a traced or vmapped batch")
-    return False
+    return "calibrate"
 
 
 def _priors(fit, prior):

@@ -33,11 +33,13 @@ _HALF_LOG_2PI = 0.5 * math.log(2.0 * math.pi)
 
 class Prior(eqx.Module):
     """One parameter's prior (`kind`, `a`, `b` as in the module's list) and its map to the
-    unbounded coordinate `z`."""
+    unbounded coordinate `z`. `a` and `b` are leaves (numpy floats, traced under `jit`):
+    a posterior of another fit of the same shape, whose default priors differ, reuses the
+    compiled sampler."""
 
     kind: str = eqx.field(static=True)
-    a: float = eqx.field(static=True)
-    b: float = eqx.field(static=True)
+    a: float = eqx.field(converter=np.float64)
+    b: float = eqx.field(converter=np.float64)
 
     @property
     def bounded(self) -> bool:
@@ -46,7 +48,7 @@ class Prior(eqx.Module):
     def value(self, z):
         """The parameter (SI) at `z`."""
         if self.kind == "loguniform":
-            lo, hi = math.log(self.a), math.log(self.b)
+            lo, hi = jnp.log(self.a), jnp.log(self.b)
             return jnp.exp(lo + (hi - lo) * jax.nn.sigmoid(z))
         if self.kind == "uniform":
             return self.a + (self.b - self.a) * jax.nn.sigmoid(z)
@@ -80,7 +82,7 @@ class Prior(eqx.Module):
         return f"{self.kind}({self.a:.4g}, {self.b:.4g})"
 
     def as_tuple(self) -> tuple:
-        return (self.kind, self.a, self.b)
+        return (self.kind, float(self.a), float(self.b))
 
 
 def parse_prior(name: str, spec) -> Prior:

@@ -9,13 +9,16 @@ from .._format import format_fields, format_value, jsonable
 from .._xla_log import quietly_compiled
 from .bands import Bands, prediction_bands
 from .likelihood import Model
+from .oblique_model import ObliqueBands, ObliqueModel, oblique_bands
 
 
 class Posterior(eqx.Module):
     """The posterior of a fit's free parameters (and of its sampled noise scales).
 
     - `samples`: `{name: draws}` in SI units, shape `(chains * num_samples,)`; the law's
-      free parameters (`free`) and, where no sigma was given, `sigma_e` and `sigma_T` (s).
+      free parameters (`free`; an oblique fit's: the tangential law's) and, where no sigma
+      was given, the noise scales: `sigma_e` and `sigma_T` (s) of a calibration, `sigma`
+      of a bounce fit, `sigma_e_t` and `sigma_omega` (rad/s) of an oblique fit.
     - `median`, `interval(0.9)` (the 5 and 95 % quantiles), `mean`, `std`.
     - `map`: the mode (maximum a posteriori) the Laplace approximation is centred on.
     - `diagnostics`: `r_hat` (worst over the parameters; NaN with one chain or for
@@ -28,8 +31,10 @@ class Posterior(eqx.Module):
       `law_name`, `units`; `z`: the draws in the sampler's unbounded coordinates.
     - `law_parameters`: every parameter of the fitted law (SI; the fixed ones as fitted
       with), so that `law_at` builds the law at any draw.
-    - `predict(v0=...)`: bands of e and T at new speeds; `plot(path)`; `summary()`;
-      `to_dict()` and `Posterior.from_dict` (without the forward model).
+    - `predict(v0=...)`: bands of e and T at new speeds (of an oblique fit's posterior,
+      `predict(angle=...)`: bands of e_t, the spin and the rebound angle at incidence
+      angles); `plot(path)`; `summary()`; `to_dict()` and `Posterior.from_dict` (without
+      the forward model).
     - `law_at(values)`, `median_law`, `draw_laws(n)`: the law at given values of the free
       parameters, at the medians, at `n` evenly thinned draws (what `export(post, ...)`
       exports, and over which it gives the engine's band).
@@ -85,14 +90,18 @@ class Posterior(eqx.Module):
 
     def law_at(self, values: dict | None = None):
         """The fitted law with its free parameters set to `values` (`{name: SI value}`;
-        default the medians), the others as fitted with. A posterior read from a dict
-        rebuilds it by name (a law of the table; a user's law needs the fit)."""
+        default the medians), the others as fitted with: the tangential law of an oblique
+        fit. A posterior read from a dict rebuilds it by name (a law of the table; a
+        user's law needs the fit)."""
         values = self.median if values is None else values
         free = {k: float(values[k]) for k in self.free}
         if self.model is not None:
             return self.model.law.replace(**free)
         from .._laws import LAWS, law
+        from .._oblique.tangential import TANGENTIAL_LAWS, tangential_law
 
+        if self.law_parameters is not None and self.law_name in TANGENTIAL_LAWS:
+            return tangential_law(self.law_name, **{**self.law_parameters, **free})
         if self.law_parameters is None or self.law_name not in LAWS:
             raise ValueError(
                 f"this Posterior (read from a dict) cannot rebuild its law {self.law_name!r}: "
@@ -128,25 +137,57 @@ class Posterior(eqx.Module):
 
     @quietly_compiled
     def predict(
-        self, v0, *, level: float = 0.9, observed: bool = False, max_draws: int = 1000, key=None
-    ) -> Bands:
+        self,
+        v0=None,
+        *,
+        angle=None,
+        speed=None,
+        omega=None,
+        level: float = 0.9,
+        observed: bool = False,
+        max_draws: int = 1000,
+        key=None,
+    ) -> Bands | ObliqueBands:
         """Bands of `e` and `T` (s) at the speeds `v0` (m/s): median and the `level`
         quantile band over the draws (at most `max_draws` of them, evenly thinned), each
         draw's law solved by the fit's forward model. `observed=True` adds the
         measurement noise (a band for a new measurement) to the law's band.
 
-        **Example**: `post.predict(v0=[1.0, 2.0, 4.0]).e_hi`."""
-        return prediction_bands(
-            self, v0, level=level, observed=observed, max_draws=max_draws, key=key
-        )
+        The posterior of an oblique fit (`fit_oblique`) takes incidence angles instead:
+        `angle` (rad from the normal, in (0, pi/2)) at `speed` (m/s) with spin `omega`
+        (rad/s) before (both default to the medians of the fit's rows), and gives an
+        `ObliqueBands` of `e_t`, `omega_out` (rad/s) and `angle_out` (rad).
 
-    def plot(self, path=None, *, v0=None, level: float = 0.9):
+        **Example**: `post.predict(v0=[1.0, 2.0, 4.0]).e_hi`;
+        `oblique_post.predict(angle=np.deg2rad([10, 30, 50])).e_t_lo`."""
+        options = dict(level=level, observed=observed, max_draws=max_draws, key=key)
+        if self.model is None:  # read from a dict: no forward model (a one-line error)
+            return prediction_bands(self, v0, **options)
+        if isinstance(self.model, ObliqueModel):
+            if v0 is not None:
+                raise ValueError(
+                    "this posterior is of an oblique fit: it predicts at incidence angles, "
+                    "predict(angle=radians, speed=m/s), not at speeds v0"
+                )
+            return oblique_bands(self, angle, speed=speed, omega=omega, **options)
+        if angle is not None or speed is not None or omega is not None:
+            raise ValueError(
+                "angle=, speed= and omega= are for the posterior of an oblique fit "
+                "(fit_oblique); this one predicts at impact speeds: predict(v0=m/s)"
+            )
+        if v0 is None:
+            raise ValueError("predict needs the impact speeds: predict(v0=m/s)")
+        return prediction_bands(self, v0, **options)
+
+    def plot(self, path=None, *, v0=None, angle=None, level: float = 0.9):
         """A pairs plot of the draws (histograms on the diagonal) and, with a forward
-        model, the `level` bands of e and T over the measured data; written to `path`
-        (PNG, PDF, ... by extension) when given. Returns the matplotlib Figure."""
+        model, the `level` bands over the measured data: of e and T over `v0` (m/s), or
+        for an oblique fit of e_t and the spin over `angle` (rad; default around the
+        data); written to `path` (PNG, PDF, ... by extension) when given. Returns the
+        matplotlib Figure."""
         from .plots import plot_posterior
 
-        return plot_posterior(self, path, v0=v0, level=level)
+        return plot_posterior(self, path, v0=v0, angle=angle, level=level)
 
     # ------------------------------------------------------------------ text, dicts
 
