@@ -57,18 +57,21 @@ def quiet_compiler():
 
 def quietly_compiled(fn):
     """`fn` run inside `quiet_compiler` (for the public entry points that compile fits).
-    The warnings `fn` gives are raised again from here once it returns, so that they name
-    the caller's line as `fn`'s own `stacklevel=2` did, under the user's filters (`error`
-    included)."""
+    The warnings `fn` gives are raised again from here once it returns (or raises), so that
+    they name the caller's line as `fn`'s own `stacklevel=2` did, under the user's filters
+    (`error` included)."""
 
     @functools.wraps(fn)
     def wrapper(*args, **kwargs):
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            with quiet_compiler():
-                result = fn(*args, **kwargs)
-        for warning in caught:
-            warnings.warn(warning.message, warning.category, stacklevel=2)
+        caught = []
+        try:
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                with quiet_compiler():
+                    result = fn(*args, **kwargs)
+        finally:  # raised again if `fn` raises too: a warning before an error is not lost
+            for warning in caught:
+                warnings.warn(warning.message, warning.category, stacklevel=2)
         return result
 
     return wrapper

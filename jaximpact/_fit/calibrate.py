@@ -827,7 +827,17 @@ def calibrate(
     )
     m = jnp.asarray(m, dtype=float) if is_traced(m) else np.float64(m)
     has_sigma = sigma_e is not None or sigma_T is not None
-    free = default_free(law, stiffness=T is not None) if free is None else tuple(free)
+    if free is None:
+        free = default_free(law, stiffness=T is not None)
+        held = [k for k in law.parameters if k not in free]
+        if T is not None and "c" not in law.parameters and held:
+            warnings.warn(
+                f"T is given but the law has no parameter named c, so only {', '.join(free)} "
+                f"is fitted and {', '.join(held)} stays at its start value; name the "
+                f"stiffness among the free parameters to fit it, e.g. free={(*held[:1], *free)}",
+                stacklevel=3,
+            )
+    free = tuple(free)
     unknown = [k for k in free if k not in law.parameters]
     if unknown:
         raise ValueError(

@@ -250,6 +250,19 @@ BAD_INPUTS = [
 ]
 
 
+def test_warns_when_T_is_given_and_no_parameter_is_named_c(monkeypatch):
+    """A user's law whose stiffness is not called c: with T given, the default frees only
+    the damping, and a warning names the parameter held and how to fit it."""
+    reached = []
+    for fitter in ("_fit", "_fit_on_host"):
+        monkeypatch.setattr(_calibrate, fitter, lambda *a: reached.append(a[-1].free) or 1 / 0)
+    law = ji.custom_law(lambda x, v, p: p["k"] * x**1.5 * (1 + p["d"] * v), k=2e6, d=0.3)
+    with pytest.warns(UserWarning, match=r"no parameter named c.*k stays.*free=\('k', 'd'\)"):
+        with pytest.raises(ZeroDivisionError):
+            ji.calibrate(law, m=M, v0=V0, e=0.8, T=5e-3)
+    assert reached == [("d",)]
+
+
 @pytest.mark.parametrize("bad, message", BAD_INPUTS, ids=[m for _, m in BAD_INPUTS])
 def test_refuses_impossible_targets_before_any_work(monkeypatch, bad, message):
     for fitter in ("_fit", "_fit_on_host"):
