@@ -37,7 +37,31 @@ class Parser(argparse.ArgumentParser):
             message += f": {unit_hint(bad.group(1))}"
         elif loose and all(_UNIT.fullmatch(word) for word in loose.group(1).split()):
             message += f": {SI_NUMBERS}"
+        elif loose and all(_is_number(word) for word in loose.group(1).split()):
+            if _takes_data(self):
+                message += (
+                    ": an option takes one number; several impacts go in the rows of a CSV "
+                    "file, --data FILE.csv"
+                )
         fail(f"{message} (see '{self.prog} --help')", status=2)
+
+
+def _takes_data(parser: argparse.ArgumentParser) -> bool:
+    """Whether the command being parsed (`parser` or its subcommand named in `sys.argv`)
+    has a `--data` option."""
+    parsers = [parser]
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            parsers += [action.choices[w] for w in sys.argv[1:] if w in action.choices][:1]
+    return any("--data" in a.option_strings for p in parsers for a in p._actions)
+
+
+def _is_number(word: str) -> bool:
+    try:
+        float(word)
+    except ValueError:
+        return False
+    return True
 
 
 SI_NUMBERS = "numbers are given without a unit, in the units --help gives (SI: kg, m, s, N, Pa)"

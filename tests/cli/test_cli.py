@@ -376,3 +376,15 @@ def test_simulate_asks_for_the_mass(capsys):
     argv = ["simulate", "--law", "hertz_rate", "--param", "c=2e6", "b1=800", "--v0", "2.5"]
     status, out, err = run_cli(capsys, argv)
     assert_one_line_error(status, out, err, contains="--mass is required: the body's mass in kg")
+
+
+def test_several_numbers_for_one_option_point_to_the_data_file(capsys, monkeypatch):
+    """Found as a new user: `calibrate --v0 1 2 3 --e ...` said only `unrecognized
+    arguments: 2 3 ...`; a command that reads a CSV says where several impacts go."""
+    argv = ["calibrate", "--law", "hertz_rate", "--mass", "0.05", "--v0", "1", "2", "--e", "0.9"]
+    monkeypatch.setattr("sys.argv", ["jaximpact", *argv])
+    status, out, err = run_cli(capsys, argv)
+    assert_one_line_error(
+        status, out, err, contains="unrecognized arguments: 2: an option takes one number"
+    )
+    assert "--data FILE.csv" in err
