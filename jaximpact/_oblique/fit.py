@@ -1,5 +1,5 @@
 """Fitting a tangential law to measured oblique rebounds: `fit_oblique`, Levenberg-Marquardt
-(optimistix) on the logarithms of the free parameters from several starts (the given one
+(`_least_squares.levenberg_marquardt`) on the logarithms of the free parameters from several starts (the given one
 and the best minima of a log grid, whose losses are evaluated first in one batch), the
 impacts solved with forward-mode derivatives through every stick-slip transition, standard
 errors from the Jacobian, and the parameters the data do not bound, with their one-sided
@@ -423,7 +423,7 @@ def fit_oblique(
     0.088, where kt = 9.4e7, mu = 0.093 gives 0.0071), so the fit first evaluates the loss
     on a log grid, `start_scan` stiffnesses over two decades either side of the start
     by nine friction coefficients over one decade either side (where free; one batch per
-    16 points, no optimiser), then runs Levenberg-Marquardt (optimistix, to `tol` within
+    16 points, no optimiser), then runs Levenberg-Marquardt (`_least_squares`, to `tol` within
     `max_steps`) from the given start and from the lowest `max_starts - 1` local minima
     of the grid, and keeps the lowest loss. `start_scan=0` starts from `tangential`
     alone. A grid point below the fit's loss (a start that was not refined) makes
