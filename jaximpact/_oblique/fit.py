@@ -1,5 +1,5 @@
 """Fitting a tangential law to measured oblique rebounds: `fit_oblique`, Levenberg-Marquardt
-(`_least_squares.levenberg_marquardt`) on the logarithms of the free parameters from several starts (the given one
+(`_least_squares`) on the logarithms of the free parameters from several starts (the given one
 and the best minima of a log grid, whose losses are evaluated first in one batch), the
 impacts solved with forward-mode derivatives through every stick-slip transition, standard
 errors from the Jacobian, and the parameters the data do not bound, with their one-sided
