@@ -1,5 +1,5 @@
 """Fitting a tangential law to measured oblique rebounds: `fit_oblique`, Levenberg-Marquardt
-(`_least_squares`) on the logarithms of the free parameters from several starts (the given one
+(optimistix) on the logarithms of the free parameters from several starts (the given one
 and the best minima of a log grid, whose losses are evaluated first in one batch), the
 impacts solved with forward-mode derivatives through every stick-slip transition, standard
 errors from the Jacobian, and the parameters the data do not bound, with their one-sided
@@ -12,12 +12,12 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
+import optimistix as optx
 from jaxtyping import Array
 
 from .._checks import check_positive, is_traced
 from .._format import format_fields, format_value, jsonable
 from .._laws import AbstractLaw
-from .._least_squares import levenberg_marquardt
 from .._solve.options import CUSTOM_RTOL, DEFAULT_RTOL
 from .._solve.precision import resolvable_tolerances
 from .._status import Status
@@ -289,33 +289,26 @@ def _evaluate(problem, thetas):
 
 
 @eqx.filter_jit
-def _linearised(problem, theta):
-    """The residuals at `theta`, their forward-mode Jacobian and the impacts: the one
-    program a refinement compiles (the in-graph optimistix solver compiled the solve into
-    its loop besides, 35 s more on a first call)."""
+def _refine(problem, start, max_steps, tol):
+    """Levenberg-Marquardt from `start`: the parameters, whether it met `tol`, its steps,
+    and there the residuals, their Jacobian and the impacts (in the same program: a
+    separate one compiled for 35 s more, this pass costs 5 s)."""
+    solution = optx.least_squares(
+        lambda theta, _: problem.residuals(problem.predict(theta)),
+        optx.LevenbergMarquardt(rtol=tol, atol=tol),
+        start,
+        max_steps=max_steps,
+        throw=False,
+    )
+    ok = solution.result == optx.RESULTS.successful
 
     def with_aux(t):
         result = problem.predict(t)
         r = problem.residuals(result)
         return r, (r, result)
 
-    jacobian, (r, result) = jax.jacfwd(with_aux, has_aux=True)(theta)
-    return r, jacobian, result
-
-
-def _refine(problem, start, max_steps, tol):
-    """Levenberg-Marquardt from `start` (`levenberg_marquardt`, driven from Python around
-    `_linearised`): the parameters, whether it met `tol`, its steps, and there the
-    residuals, their Jacobian and the impacts."""
-
-    def evaluate(theta):
-        r, jacobian, result = _linearised(problem, jnp.asarray(theta))
-        return np.asarray(r), np.asarray(jacobian), result
-
-    fit = levenberg_marquardt(
-        evaluate, np.asarray(start, dtype=float), max_iter=max_steps, tol=tol, max_step=2.0
-    )
-    return fit.theta, fit.converged, fit.iterations, (fit.residuals, fit.jacobian, fit.extra)
+    jacobian, (r, result) = jax.jacfwd(with_aux, has_aux=True)(solution.value)
+    return solution.value, ok, solution.stats["num_steps"], (r, jacobian, result)
 
 
 def _chi2_parts(problem, thetas) -> tuple[np.ndarray, np.ndarray]:
@@ -423,7 +416,7 @@ def fit_oblique(
     0.088, where kt = 9.4e7, mu = 0.093 gives 0.0071), so the fit first evaluates the loss
     on a log grid, `start_scan` stiffnesses over two decades either side of the start
     by nine friction coefficients over one decade either side (where free; one batch per
-    16 points, no optimiser), then runs Levenberg-Marquardt (`_least_squares`, to `tol` within
+    16 points, no optimiser), then runs Levenberg-Marquardt (optimistix, to `tol` within
     `max_steps`) from the given start and from the lowest `max_starts - 1` local minima
     of the grid, and keeps the lowest loss. `start_scan=0` starts from `tangential`
     alone. A grid point below the fit's loss (a start that was not refined) makes
