@@ -34,7 +34,7 @@ from .._oblique.tangential import AbstractTangentialLaw
 from .bands import noise_draws, noise_scale, thinned
 from .bounce import gauss_newton
 from .likelihood import log_noise
-from .priors import default_noise_prior, default_prior, parse_prior
+from .priors import default_prior, noise_prior, parse_prior
 
 
 class Kind(NamedTuple):
@@ -192,12 +192,7 @@ def oblique_setup(fit: ObliqueFit, prior, *, noise: str, nu: float):
         physical = r[i * n : (i + 1) * n] * np.asarray(getattr(problem, kind.scale), float)
         rms = float(np.sqrt(np.mean(physical[known] ** 2)))
         size = float(np.max(np.abs(measured_values[known]))) if kind.unit else 1.0
-        p = parse_prior(name, prior[name]) if name in prior else default_noise_prior(name, size)
-        starts[name] = rms
-        if p.bounded:  # inside the range, away from a bound the RMS of an exact fit meets
-            floor = 10.0 * p.a if p.a > 0 else 0.01 * p.b
-            starts[name] = min(max(rms, floor), 0.5 * p.b)
-        priors[name] = p
+        priors[name], starts[name] = noise_prior(name, prior.get(name), rms, size)
 
     def rows(sigma):
         return None if sigma is None else np.broadcast_to(np.asarray(sigma, float), (n,))

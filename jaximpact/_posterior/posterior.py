@@ -16,7 +16,7 @@ from .laplace import gaussian_draws, laplace
 from .likelihood import NOISES, build_model
 from .nuts import diagnostics, poor, run_chains
 from .oblique_model import oblique_setup
-from .priors import default_noise_prior, default_prior, parse_prior
+from .priors import default_prior, noise_prior, parse_prior
 from .result import Posterior
 
 METHODS = ("nuts", "laplace")
@@ -302,10 +302,5 @@ def _priors(fit, prior):
             known = np.isfinite(T_target)
             scale = float(np.median(T_target[known]))
             rms = float(np.sqrt(np.mean((np.asarray(fit.T)[known] - T_target[known]) ** 2)))
-        p = parse_prior(name, prior[name]) if name in prior else default_noise_prior(name, scale)
-        starts[name] = rms
-        if p.bounded:  # inside the range, away from a bound the RMS of an exact fit meets
-            floor = 10.0 * p.a if p.a > 0 else 0.01 * p.b
-            starts[name] = min(max(rms, floor), 0.5 * p.b)
-        priors[name] = p
+        priors[name], starts[name] = noise_prior(name, prior.get(name), rms, scale)
     return priors, starts

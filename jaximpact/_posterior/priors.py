@@ -131,3 +131,16 @@ def default_noise_prior(name: str, scale: float = 1.0) -> Prior:
     `scale` (1 for `sigma_e`, the median measured T in s for `sigma_T`)."""
     lo, hi = NOISE_RANGE
     return Prior("loguniform", lo * scale, hi * scale)
+
+
+def noise_prior(name: str, given, rms: float, scale: float = 1.0) -> tuple[Prior, float]:
+    """The prior of a sampled noise scale `name` (the user's `given` spec, else
+    `default_noise_prior` of `scale`) and where its sampling starts: the fit's RMS residual
+    `rms`, moved inside a bounded prior's range, away from a bound that the RMS of an exact
+    fit meets (10 times the lower bound, at most half the upper)."""
+    p = parse_prior(name, given) if given is not None else default_noise_prior(name, scale)
+    start = rms
+    if p.bounded:
+        floor = 10.0 * p.a if p.a > 0 else 0.01 * p.b
+        start = min(max(rms, floor), 0.5 * p.b)
+    return p, start
