@@ -758,13 +758,13 @@ def calibrate(
     damping); the others keep the values in `law`. Parameters are fitted in a transformed
     space that keeps them physical (logarithms; a logit for `e_nominal`).
 
-    - `optimizer`: `"auto"` (the default) is `"lm"` for an eager fit whose impacts are
-      integrated, else `"lbfgs"`; `"lbfgs"`: optax L-BFGS with a zoom line search inside
-      the compiled fit; `"lm"`: Levenberg-Marquardt, driven from Python around one compiled
-      program (the residuals, the peaks and the forward-mode Jacobian) for an eager fit of
-      integrated impacts, which compiles the solve once where the in-graph optimisers
-      compile it three times, else optimistix's inside the compiled fit; or any optax
-      `GradientTransformation`. `Fit.optimizer` names the one that ran.
+    - `optimizer`: `"auto"` (the default) is `"lm"` for an eager fit (nothing traced),
+      else `"lbfgs"`; `"lbfgs"`: optax L-BFGS with a zoom line search inside the compiled
+      fit; `"lm"`: Levenberg-Marquardt, for an eager fit driven from Python around one
+      compiled program (the residuals, the peaks and the forward-mode Jacobian), which
+      compiles the solve once where the in-graph optimisers compile it three times, else
+      optimistix's inside the compiled fit; or any optax `GradientTransformation`.
+      `Fit.optimizer` names the one that ran.
     - `init`: `"auto"` starts from the law's nondimensional restitution table (one damping
       group sets `e`, then `T` sets the stiffness) so most fits need a few iterations;
       `"given"` starts from the values in `law`.
@@ -1159,7 +1159,7 @@ def _recorded(law, solved, data, m, g, target_tol, options, *, exact, optimizer)
     )
 
 
-# ------------------------------------------------ an eager integrated fit: one program
+# ----------------------------------------------------------- an eager fit: one program
 
 
 @eqx.filter_jit
