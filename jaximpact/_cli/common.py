@@ -30,6 +30,10 @@ class Parser(argparse.ArgumentParser):
     """An ArgumentParser whose usage errors are one line (`jaximpact: error: ...`); a number
     given with a unit (`--radius 5mm`, `--mass 10 g`) is told to drop it (`unit_hint`)."""
 
+    def parse_known_args(self, args=None, namespace=None):
+        self.argv = sys.argv[1:] if args is None else list(args)  # for `error`'s hints
+        return super().parse_known_args(args, namespace)
+
     def error(self, message):
         bad = re.search(r"invalid float value: '(.*)'$", message)
         loose = re.match(r"unrecognized arguments: (.*)$", message)
@@ -47,12 +51,13 @@ class Parser(argparse.ArgumentParser):
 
 
 def _takes_data(parser: argparse.ArgumentParser) -> bool:
-    """Whether the command being parsed (`parser` or its subcommand named in `sys.argv`)
-    has a `--data` option."""
+    """Whether the command being parsed (`parser` or its subcommand named in the arguments
+    it was given) has a `--data` option."""
     parsers = [parser]
+    words = getattr(parser, "argv", [])
     for action in parser._actions:
         if isinstance(action, argparse._SubParsersAction):
-            parsers += [action.choices[w] for w in sys.argv[1:] if w in action.choices][:1]
+            parsers += [action.choices[w] for w in words if w in action.choices][:1]
     return any("--data" in a.option_strings for p in parsers for a in p._actions)
 
 
