@@ -4,7 +4,6 @@ names and what the help says of each come from the one registry, `_engines.regis
 
 import json
 
-from .._choices import unknown_name
 from .._format import format_number
 from .common import (
     CLIError,
@@ -189,8 +188,13 @@ def _engine_name(args) -> str:
 
 
 def _check_engine(name: str) -> None:
-    if name not in _engines():
-        raise CLIError(unknown_name("engine", name, list(_engines())))
+    """The library's refusal of an unknown engine (`registry.engine`), as a `CLIError`."""
+    from .._engines.registry import engine
+
+    try:
+        engine(name)
+    except ValueError as error:
+        raise CLIError(str(error)) from None
 
 
 def _run_export(args):
@@ -235,28 +239,30 @@ def _run_export(args):
     warn_sphere_density(args.mass, args.radius)
     if source is None and name is not None:
         source = make_law(name, params)
-    tangential = tangential_from_args(args)
+    options = dict(  # export's, and each posterior draw's
+        m=args.mass,
+        v0=args.v0,
+        radius=args.radius,
+        poisson=args.poisson,
+        limit_damping=args.limit_damping,
+        geometry="wall" if args.wall else None,
+        tangential=tangential_from_args(args),
+    )
     try:  # with --no-strict, the refusal comes as a warning (one line on stderr)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", UnrealisedWarning)
             x = export(
                 source,
                 engine,
-                m=args.mass,
-                v0=args.v0,
                 timestep=args.timestep,
-                radius=args.radius,
-                poisson=args.poisson,
                 e=args.e,
                 T=args.T,
-                limit_damping=args.limit_damping,
-                **({"geometry": "wall"} if args.wall else {}),
                 strict=args.strict,
-                tangential=tangential,
+                **options,
             )
         origin = ""
         if posterior is not None:  # the engine's band over the posterior's draws
-            x, origin, why = _band(x, posterior, name, args, tangential)
+            x, origin, why = _band(x, posterior, name, args, options)
             notes += why
     except UnrealisedExport as refusal:
         raise CLIError(refusal.message("--no-strict")) from None
@@ -340,11 +346,11 @@ def _run_export(args):
     emit(args, data, text)
 
 
-def _band(x, posterior: dict, name: str, args, tangential):
+def _band(x, posterior: dict, name: str, args, options: dict):
     """`(x, origin, notes)`: the export `x` with the engine's band over the draws of
     `posterior` (a `Posterior.to_dict` record, as `calibrate --posterior --json` writes
-    it) and the words for its origin, or `x` alone with a note saying why there is no band
-    (no draws in the file, a user's law)."""
+    it), each exported with `options` (`export`'s), and the words for its origin, or `x`
+    alone with a note saying why there is no band (no draws in the file, a user's law)."""
     from .._engines.export import with_band
     from .._posterior import Posterior
 
@@ -367,19 +373,7 @@ def _band(x, posterior: dict, name: str, args, tangential):
             f"--from {args.source}: its posterior is not one that 'jaximpact "
             f"calibrate --posterior --json' writes ({error})"
         ) from None
-    x = with_band(
-        x,
-        post,
-        band_draws=args.band_draws,
-        progress=heartbeat_meter(),
-        m=args.mass,
-        v0=args.v0,
-        radius=args.radius,
-        poisson=args.poisson,
-        limit_damping=args.limit_damping,
-        geometry="wall" if args.wall else None,
-        tangential=tangential,
-    )
+    x = with_band(x, post, band_draws=args.band_draws, progress=heartbeat_meter(), **options)
     thinned = posterior.get("thinned", {})
     of = f", of {thinned['of']}" if isinstance(thinned, dict) and "of" in thinned else ""
     return x, f"{origin} (band over {x.band_draws} of its draws{of})", []

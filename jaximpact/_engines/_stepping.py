@@ -15,7 +15,7 @@ PHASES = (np.arange(16) + 0.5) / 16
 # The export's tolerance (relative): at its recommended step the engine realises e within it
 # of the target wherever the first touch falls inside a step (every start phase), and T (the
 # mean over start phases; each contact is counted in whole steps) within it; a given step
-# that misses it is warned about (`step_and_response`).
+# that misses it is warned about (`replicated`).
 STEP_TOL = 0.005
 _COARSEST_STEPS, MAX_STEPS = 10, 51200  # steps per contact a recommended step searches
 _BISECTIONS = 5  # halvings of log(h) between a step that realises and one twice as coarse
@@ -161,12 +161,18 @@ def describe_step(h: float, T: float | None) -> str:
     return f"{h:.3g} s ({per_contact(h, T)})"
 
 
-def step_and_response(run, e: float, T: float, timestep, *, engine: str, step: str):
-    """`(h, es, Ts, warnings)` for an engine whose stepping `run(h) -> (e, T)` per start phase
-    realises the target `e` and `T` (s): `h` the given `timestep` (s) or, when None,
-    `recommended_step`; what `run` realises at `h`; and a warning (its step called `step` in
-    `engine`'s words) where that misses the export's tolerance (`realises`, `STEP_TOL`),
-    naming the recommended step."""
+def replicated(replica, params: dict, scene, e: float, T: float, timestep, *, engine, step):
+    """`(params, es, Ts, warnings)` for an engine whose stepping `replica(params, m, v0) ->
+    (e, T)` per start phase in `scene` (its `m` kg, `v0` m/s; on a wall, `params` with
+    `geometry` "wall") realises the target `e` and `T` (s): `params` with the `timestep`
+    given (s) or, when None, `recommended_step`; what `replica` realises there; and a
+    warning (its step called `step` in `engine`'s words) where that misses the export's
+    tolerance (`realises`, `STEP_TOL`), naming the recommended step."""
+    params = {**params, **({"geometry": "wall"} if scene.wall else {})}
+
+    def run(h):
+        return replica({**params, "timestep": h}, scene.m, scene.v0)
+
     h = recommended_step(run, T, e) if timestep is None else float(timestep)
     es, Ts = run(h)
     warnings = []
@@ -177,7 +183,7 @@ def step_and_response(run, e: float, T: float, timestep, *, engine: str, step: s
             f"e = {es.min():.4g} to {es.max():.4g}, T = {Ts.mean():.4g} s (asked {e:.4g}, "
             f"{T:.4g} s; {STEP_TOL:.1%} allowed); use {describe_step(coarsest, T)} or less"
         )
-    return h, es, Ts, warnings
+    return {**params, "timestep": h}, es, Ts, warnings
 
 
 def recommended_step(run, T: float, e: float | None = None, tol: float = STEP_TOL) -> float:
@@ -227,19 +233,6 @@ def recommended_step(run, T: float, e: float | None = None, tol: float = STEP_TO
         if ok(h):
             return h
     return nice_down(min(passed) / 2.0)
-
-
-def realised(es, Ts, h: float) -> dict:
-    """What an engine stepping at `h` (s) realises, from its start phases `es`, `Ts`: the
-    means `e` and `T` (s), their ranges and the steps per contact."""
-    return dict(
-        e=float(es.mean()),
-        T=float(Ts.mean()),
-        e_range=(float(es.min()), float(es.max())),
-        T_range=(float(Ts.min()), float(Ts.max())),
-        steps_per_contact=float(Ts.mean() / h),
-        timestep=h,
-    )
 
 
 def unrealised(e, T, *, target_e: float, target_T, steps_per_contact, parameters: dict):

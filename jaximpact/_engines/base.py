@@ -20,6 +20,8 @@ from typing import ClassVar, NamedTuple
 
 import numpy as np
 
+from .materials import check_positive
+
 
 class Key(NamedTuple):
     """One input of an engine's parameters as `engine_response` and `jaximpact engine-e` take
@@ -69,6 +71,24 @@ class Design:
     stepping: dict | None = None
     clause: str | None = None
 
+    @classmethod
+    def stepped(cls, parameters, es, Ts, h, warnings, separation, stepping, **more) -> "Design":
+        """The design whose replicated `stepping` at the step `h` (s) realises `es`, `Ts`
+        (s) per start phase: their means `e`, `T`, their ranges, the steps per contact."""
+        return cls(
+            parameters=parameters,
+            e=float(es.mean()),
+            T=float(Ts.mean()),
+            timestep=h,
+            separation=separation,
+            warnings=tuple(warnings),
+            e_range=(float(es.min()), float(es.max())),
+            T_range=(float(Ts.min()), float(Ts.max())),
+            steps_per_contact=float(Ts.mean() / h),
+            stepping=stepping,
+            **more,
+        )
+
 
 @dataclasses.dataclass(frozen=True)
 class Stepping:
@@ -99,11 +119,12 @@ class Scene:
         return self.geometry == "wall"
 
 
-def _check_declared(cls, base, facts) -> None:
-    """A final class derived from `base` alone, declaring every one of `facts`."""
+def _check_declared(cls, base) -> None:
+    """A final class derived from `base` alone, declaring every fact (`base`'s annotated
+    class attributes)."""
     if cls.__bases__ != (base,):
         raise TypeError(f"{cls.__name__}: a final class derived from {base.__name__} alone")
-    missing = [fact for fact in facts if not hasattr(cls, fact)]
+    missing = [fact for fact in base.__annotations__ if not hasattr(cls, fact)]
     if missing:
         raise TypeError(f"{cls.__name__} does not declare {', '.join(missing)}")
 
@@ -140,7 +161,7 @@ class AbstractNormalModel(abc.ABC):
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
-        _check_declared(cls, AbstractNormalModel, NORMAL_FACTS)
+        _check_declared(cls, AbstractNormalModel)
 
     @abc.abstractmethod
     def design(
@@ -207,7 +228,7 @@ class AbstractTangentialModel(abc.ABC):
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
-        _check_declared(cls, AbstractTangentialModel, TANGENTIAL_FACTS)
+        _check_declared(cls, AbstractTangentialModel)
 
     @abc.abstractmethod
     def check(self, tangential, *, timestep) -> None:
@@ -279,7 +300,7 @@ class AbstractEngine(abc.ABC):
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
-        _check_declared(cls, AbstractEngine, FACTS)
+        _check_declared(cls, AbstractEngine)
 
     @abc.abstractmethod
     def snippet(self, parameters: dict) -> str:
@@ -306,19 +327,20 @@ class AbstractEngine(abc.ABC):
         return f"{type(self).__name__}()"
 
 
-# the facts every final class declares (class attributes), checked when its class is made
-FACTS = ("NAME", "LABEL", "SCENES", "TWO_SPHERES", "CONTINUOUS_PLANT", "NORMAL", "TANGENTIAL")
-NORMAL_FACTS = (
-    "NAME",
-    "LAW",
-    "KEYS",
-    "STEPPING",
-    "MASS_DEPENDS",
-    "ALLOWS_LIMIT_DAMPING",
-    "NEAREST",
-    "SCENES",
+# the tangential laws (`tangential_law` names), all with a Coulomb mu: the rows of an engine
+# whose one tangential model is its friction alone (MuJoCo's, Drake's)
+TANGENTIAL_LAWS = (
+    "linear_history",
+    "mindlin",
+    "mindlin_force",
+    "mindlin_rescale",
+    "mindlin_rescale_force",
 )
-TANGENTIAL_FACTS = ("MODEL", "FRICTION", "CONTACT_POINT")
+# the facts every final class declares (its base's annotated class attributes)
+FACTS, NORMAL_FACTS, TANGENTIAL_FACTS = (
+    tuple(base.__annotations__)
+    for base in (AbstractEngine, AbstractNormalModel, AbstractTangentialModel)
+)
 
 
 def scene_geometry(engine: AbstractEngine, geometry: str | None) -> str:
@@ -330,6 +352,15 @@ def scene_geometry(engine: AbstractEngine, geometry: str | None) -> str:
         kinds = " or ".join(map(repr, engine.SCENES))
         raise ValueError(f"{engine.NAME} exports geometry {kinds}, not {geometry!r}")
     return geometry
+
+
+def sphere_radius(engine: str, radius, geometry: str | None) -> float:
+    """The spheres' `radius` (m) checked, or the one-line ValueError of `engine` (its name)
+    without one (on a wall, `geometry` "wall", the sphere's)."""
+    if radius is None:
+        what = "sphere's" if geometry == "wall" else "spheres'"
+        raise ValueError(f"{engine} needs the {what} radius: pass radius= (m)")
+    return check_positive("radius", radius, "m")
 
 
 def contact_mass(engine: AbstractEngine, m: float, geometry: str | None = None) -> float:

@@ -21,10 +21,8 @@ contactables' masses, so a sphere on a fixed ground body sees the ground's own m
 a large one). (3) `cr_eff` is the smaller of the two materials' restitutions.
 """
 
-import math
-
 from . import _stepping
-from .base import AbstractEngine, AbstractNormalModel, Design, Key, Scene, Stepping
+from .base import AbstractEngine, AbstractNormalModel, Design, Key, Stepping
 from .lammps import hertz
 from .lammps.engine import Lammps
 
@@ -66,26 +64,17 @@ class SMCHertz(AbstractNormalModel):
         "its implicit stepper is not replicated: the continuous law's e and T, at a "
         "recommended step of T/100 or less"
     )
-    MASS_DEPENDS = "its Young's modulus scales with the mass"
+    MASS_DEPENDS = hertz.HertzMaterial.MASS_DEPENDS
     ALLOWS_LIMIT_DAMPING = True
     NEAREST = "its tsuji law"
     SCENES = None
 
-    def design(
-        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
-    ) -> Design:
-        """`ChContactMaterialSMC` inputs for target `e` and `T` (s): two spheres of mass `m`
-        (kg) and radius `radius` (m) at relative speed `v0` (m/s), or with `geometry="wall"`
-        a sphere on a fixed ground box of its material (`E_eff = E/(2 (1 - nu^2))`,
-        `eff_radius = R`, `eff_mass` = m up to the ground's mass, 1e6 m). Its force is
-        always kept non-attractive, whatever `limit_damping`."""
-        m, v0, radius, geometry = scene.m, scene.v0, scene.radius, scene.geometry
-        coefficient = hertz.coefficient_for(e, limit_damping=True)
-        realised_e, tau = hertz.impact_at_unit_scales(coefficient, "force")
-        m_eff, R_eff = hertz.effective(m, radius, geometry)
-        c = m_eff * v0**2 * (tau / (T * v0)) ** 2.5
-        E = c * 3.0 / (4.0 * math.sqrt(R_eff)) * 2.0 * (1.0 - poisson**2)
-        b = hertz.damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
+    def design(self, e, T, scene, *, timestep=None, poisson=0.3, limit_damping=False) -> Design:
+        """`ChContactMaterialSMC` inputs for target `e` and `T` (s) in `scene` (on a wall,
+        `E_eff = E/(2 (1 - nu^2))`, `eff_radius = R`, `eff_mass` = m up to the ground's mass,
+        1e6 m); its force always kept non-attractive, whatever `limit_damping`."""
+        contact = hertz.tsuji_design(e, T, scene, poisson, clamped=True)
+        coefficient, c, R_eff, v0 = contact.coefficient, contact.c, contact.R_eff, scene.v0
         h = _stepping.nice_down(T / 100.0) if timestep is None else float(timestep)
         warnings = [
             f"set the effective curvature radius to {R_eff:.6g} m (the snippet does): "
@@ -98,7 +87,7 @@ class SMCHertz(AbstractNormalModel):
                 f"timestep {h:.3g} s gives {T / h:.0f} steps per contact: use T/100 or less"
             )
         parameters = {
-            "SetYoungModulus": E,
+            "SetYoungModulus": contact.E,
             "SetPoissonRatio": poisson,
             "SetRestitution": coefficient,
             "SetFriction": 0.0,
@@ -107,15 +96,15 @@ class SMCHertz(AbstractNormalModel):
             "time_step": h,
             "effective_curvature_radius": R_eff,
             "k": c,
-            "b": b,
+            "b": contact.b,
         }
-        if geometry == "wall":
+        if scene.wall:
             parameters["geometry"] = "wall"
-            parameters["ground_mass"] = GROUND_MASS_RATIO * m
+            parameters["ground_mass"] = GROUND_MASS_RATIO * scene.m
         return Design(
             parameters=parameters,
-            e=realised_e,
-            T=tau * (m_eff * v0**2 / c) ** 0.4 / v0,
+            e=contact.e,
+            T=contact.tau * (contact.m_eff * v0**2 / c) ** 0.4 / v0,
             timestep=h,
             separation="force",
             warnings=tuple(warnings),

@@ -9,9 +9,16 @@ import dataclasses
 import warnings as _warnings
 
 from . import _stepping
-from .base import AbstractEngine, AbstractNormalModel, Design, Scene, contact_mass
-from .base import scene_geometry
-from .materials import check_positive, hertz_constant, modulus_warnings
+from .base import (
+    AbstractEngine,
+    AbstractNormalModel,
+    Design,
+    Scene,
+    contact_mass,
+    scene_geometry,
+    sphere_radius,
+)
+from .materials import hertz_constant, modulus_warnings
 from .promise import TANGENTIAL_STEPS, tangential_promise
 from .refusal import UnrealisedExport, UnrealisedWarning, unrealised, working_step
 from .targets import (
@@ -53,6 +60,11 @@ class Request:
     @property
     def source(self):
         return self.scene.law
+
+    @property
+    def law_m(self) -> float:
+        """The mass (kg) the contact moves (`base.contact_mass`)."""
+        return contact_mass(self.chosen, self.scene.m, self.scene.geometry)
 
 
 def request(
@@ -174,9 +186,15 @@ def report(asked: Request, out: Design, engine_law, *, curves: bool):
         if out.stepping is None
         else normal.stepper(out.stepping, m=scene.m, radius=scene.radius)
     )
-    law_m = contact_mass(asked.chosen, scene.m, scene.geometry)
     fields, note = responses(
-        engine_law, law_m, out, stepping, scene.law, m=scene.m, v0=scene.v0, speeds=asked.speeds
+        engine_law,
+        asked.law_m,
+        out,
+        stepping,
+        scene.law,
+        m=scene.m,
+        v0=scene.v0,
+        speeds=asked.speeds,
     )
     if asked.lacked and (note or asked.speeds is not None):
         return (
@@ -206,21 +224,10 @@ def tangential(asked: Request, out: Design, engine_law, given):
     if asked.slot is None:
         return out.parameters, {}, []
     scene = asked.scene
-    exported = given.forces_scaled(contact_mass(asked.chosen, scene.m, scene.geometry) / scene.m)
+    exported = given.forces_scaled(asked.law_m / scene.m)
     parameters = asked.slot.parameters(out, exported)
     fields, lines = tangential_promise(
-        asked.chosen,
-        asked.slot,
-        out,
-        parameters,
-        engine_law,
-        exported,
-        scene.law,
-        given,
-        m=scene.m,
-        v0=scene.v0,
-        radius=scene.radius,
-        geometry=scene.geometry,
+        asked.chosen, asked.slot, out, parameters, engine_law, exported, given, scene
     )
     return parameters, fields, lines
 
@@ -231,7 +238,7 @@ def modulus(asked: Request, engine_law, exported) -> list[str]:
     scene = asked.scene
     if scene.radius is None:
         return []
-    law_m = contact_mass(asked.chosen, scene.m, scene.geometry)
+    law_m = asked.law_m
     c = hertz_constant(engine_law, scene.v0)
     if c is None and scene.law is not None:  # the engine's law is not Hertz's: the given law's
         c = hertz_constant(scene.law, scene.v0)
@@ -249,10 +256,7 @@ def _radius(chosen: AbstractEngine, radius, geometry: str, tangential):
     """The spheres' radius (m) checked, or None where the engine takes none; a one-line
     ValueError where a two-sphere engine, or a tangential law, needs it."""
     if chosen.TWO_SPHERES:
-        if radius is None:
-            what = "sphere's" if geometry == "wall" else "spheres'"
-            raise ValueError(f"{chosen.NAME} needs the {what} radius: pass radius= (m)")
-        radius = check_positive("radius", radius, "m")
+        radius = sphere_radius(chosen.NAME, radius, geometry)
     if tangential is not None and radius is None:  # a two-sphere engine asked for it above
         raise ValueError(
             f"{chosen.NAME} with a tangential law needs the sphere's radius (its friction's "

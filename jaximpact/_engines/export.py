@@ -8,7 +8,6 @@ import dataclasses
 import sys
 
 from . import compose
-from .base import contact_mass
 from .refusal import UnrealisedExport as UnrealisedExport, UnrealisedWarning as UnrealisedWarning
 from .registry import ENGINES as ENGINES, engine as _engine
 
@@ -239,18 +238,8 @@ def export(
     scene = dict(m=m, v0=v0, timestep=timestep, radius=radius, poisson=poisson)
     design = dict(limit_damping=limit_damping, geometry=geometry, tangential=tangential)
     if _is_posterior(law_or_fit):
-        return _posterior_export(
-            law_or_fit,
-            engine,
-            band_draws=band_draws,
-            progress=progress,
-            e=e,
-            T=T,
-            curves=curves,
-            strict=strict,
-            **scene,
-            **design,
-        )
+        options = dict(curves=curves, strict=strict, **scene, **design)
+        return _posterior_export(law_or_fit, engine, band_draws, progress, e, T, options)
     chosen = _engine(engine)
     # the normal model, and what is refused without the law's impact (a law's e and T
     # compile), then the law's e and T (or the targets)
@@ -275,7 +264,7 @@ def export(
         m=None if m is None else asked.m,
         v0=asked.scene.v0,
         law=engine_law,
-        law_m=contact_mass(chosen, asked.m, asked.scene.geometry),
+        law_m=asked.law_m,
         **{
             f: getattr(out, f)
             for f in ("e", "T", "timestep", "e_range", "T_range", "steps_per_contact", "separation")
@@ -292,8 +281,9 @@ def _is_posterior(value) -> bool:
     return module is not None and isinstance(value, module.Posterior)
 
 
-def _posterior_export(post, engine: str, *, band_draws, progress, e, T, **options) -> Export:
-    """The export of `post`'s median law, with the engine's band over its draws (`export`)."""
+def _posterior_export(post, engine: str, band_draws, progress, e, T, options) -> Export:
+    """The export of `post`'s median law with `export`'s `options`, and the engine's band
+    over its draws (`band_draws`, `progress`: `export`'s); the targets `e`, `T` refused."""
     if e is not None or T is not None:
         raise ValueError("give either a posterior or the targets e= and T=, not both")
     median = export(post.median_law, engine, **options)

@@ -9,8 +9,6 @@ together by `x` (m) repel with `F = c x^1.5`, `c = (4/3) E* sqrt(R*)`, where
 import math
 import sys
 
-import numpy as np
-
 __all__ = [
     "effective_mass",
     "effective_radius",
@@ -278,7 +276,3 @@ def check_restitution(e, name: str = "e") -> float:
 def check_positive(name: str, value, unit: str) -> float:
     """`value` as a finite float > 0; a one-line ValueError otherwise."""
     return _positive(name, value, unit)
-
-
-def as_float(value) -> float:
-    return float(np.asarray(value))

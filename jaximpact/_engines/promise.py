@@ -17,86 +17,46 @@ E_T_WARN = 0.005
 TURN_WARN = 0.01
 
 
-def tangential_promise(
-    chosen,
-    slot,
-    design,
-    parameters,
-    engine_law,
-    tangential,
-    source,
-    given,
-    *,
-    m,
-    v0,
-    radius,
-    geometry,
-):
+def tangential_promise(chosen, slot, design, parameters, engine_law, tangential, given, scene):
     """`(fields, warnings)`: the `Export` fields of the oblique promise of engine `chosen`
     with its tangential model `slot` (`_oblique_promise`, for the normal `design` and the
     exported `parameters`), and the warnings that go with it: the model's `notes`, what its
     friction makes of the law (`FRICTION`) or how far its e_t departs from the law's, and
     where two spheres turn their line of centres."""
     oblique = _oblique_promise(
-        chosen,
-        slot,
-        parameters,
-        engine_law,
-        design.separation,
-        tangential,
-        source,
-        given,
-        m=m,
-        v0=v0,
-        radius=radius,
-        geometry=geometry,
+        chosen, slot, parameters, engine_law, design.separation, tangential, given, scene
     )
+    geometry = scene.geometry
     warnings = slot.notes(parameters, tangential)
     if slot.FRICTION is not None:
         warnings.append(_friction_note(slot, given, oblique))
-    elif source is not None and (departure := _departure(oblique))[0] > E_T_WARN:
+    elif scene.law is not None and (departure := _departure(oblique))[0] > E_T_WARN:
         warnings.append(departure[1] + _contact_point_note(chosen, slot, geometry))
     if _two_spheres(chosen, geometry):
-        warnings += _turning_note(design.T, v0=v0, radius=radius)
+        warnings += _turning_note(design.T, v0=scene.v0, radius=scene.radius)
     return oblique, warnings
 
 
-def _oblique_promise(
-    chosen,
-    slot,
-    parameters,
-    engine_law,
-    separation,
-    tangential,
-    source,
-    given,
-    *,
-    m,
-    v0,
-    radius,
-    geometry,
-):
-    """The oblique impacts at speed `v0` (m/s) from `OBLIQUE_ANGLES` (no spin before) that
-    the engine realises with `parameters`: its own stepping where it is replicated
+def _oblique_promise(chosen, slot, parameters, engine_law, separation, tangential, given, scene):
+    """The oblique impacts at speed `scene.v0` (m/s) from `OBLIQUE_ANGLES` (no spin before)
+    that the engine realises with `parameters`: its own stepping where it is replicated
     (`slot.oblique`, the mean over first-touch phases), else its continuous laws (its
     normal law `engine_law`, the exported `tangential` law) through `oblique_impact`; and
-    the tangential restitution of the given law `source` with the given tangential law
+    the tangential restitution of the given law `scene.law` with the given tangential law
     `given` (None from targets). A sphere of mass `m` (kg) and radius `radius` (m) on the
     wall, or the pair's effective sphere (`two_spheres`) for two spheres; the given laws
     move it at mass `m` (the normal export's convention: the law's e and T at `m`, realised
     by the pair at `m/2` with its forces halved, the tangential ones too)."""
     from .._oblique import incidence, oblique_impact, two_spheres
 
-    if _two_spheres(chosen, geometry):
-        scene = two_spheres(m, radius, m, radius)
-    else:
-        scene = dict(m=m, R=radius, inertia=0.4)
+    m, v0, radius, geometry, source = scene.m, scene.v0, scene.radius, scene.geometry, scene.law
+    pair = _two_spheres(chosen, geometry)
+    body = two_spheres(m, radius, m, radius) if pair else dict(m=m, R=radius, inertia=0.4)
     v_n, v_t = (np.asarray(v, float) for v in incidence(v0, np.deg2rad(OBLIQUE_ANGLES)))
 
-    def continuous(normal_law, tangential_law, contact_point=0.0, ends=separation, body=None):
+    def continuous(normal_law, tangential_law, contact_point=0.0, ends=separation, body=body):
         # a soft spring sticks and slips many times (throw=False: a solve that still
         # fails is NaN in the promise, not an error of the export)
-        body = scene if body is None else body
         rows = [
             oblique_impact(
                 normal_law,
@@ -121,13 +81,12 @@ def _oblique_promise(
         e_n, e_t, omega = continuous(engine_law, realised, _engine_share(chosen, slot, geometry))
     else:
         e_n, e_t, omega = (np.asarray(a).mean(axis=-1) for a in stepped)
-    if _two_spheres(chosen, geometry):
-        # each sphere's spin: both turn alike, R* W* = R (w1 + w2) for the pair's slip
-        omega = omega * scene["R"] / (2.0 * radius)
+    if pair:  # each sphere's spin: both turn alike, R* W* = R (w1 + w2) for the pair's slip
+        omega = omega * body["R"] / (2.0 * radius)
     # the law's own: under the force criterion, as its e and T (`_targets`), at mass m
     target = None
     if source is not None:
-        at_m = dict(scene, m=m)
+        at_m = dict(body, m=m)
         target = tuple(map(float, continuous(source, given, ends="force", body=at_m)[1]))
     return dict(
         tangential=tangential,

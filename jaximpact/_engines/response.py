@@ -20,10 +20,19 @@ def _normal_for(chosen: AbstractEngine, parameters: dict):
     named = parameters.get("normal")
     held = [
         (len(need - common), i)
-        for i, (model, need) in enumerate(zip(rows, needs))
+        for i, (model, need) in enumerate(zip(rows, needs, strict=True))
         if need - common <= set(parameters) and named in (None, model.NAME)
     ]
     return rows[max(held, key=lambda h: (h[0], -h[1]), default=(0, 0))[1]]
+
+
+def _inputs(engine: str, parameters: dict, m, speeds):
+    """`(chosen, model, m, speeds)`: the engine `engine`, its normal model for `parameters`,
+    the mass (kg) and the speeds (m/s) checked (one-line ValueErrors)."""
+    chosen = _engine(engine)
+    m = check_positive("m", m, "kg")
+    speeds = [check_positive("speed", v, "m/s") for v in np.atleast_1d(speeds)]
+    return chosen, _normal_for(chosen, parameters), m, speeds
 
 
 def engine_response(engine: str, parameters: dict, *, m, speeds, radius=None):
@@ -35,10 +44,8 @@ def engine_response(engine: str, parameters: dict, *, m, speeds, radius=None):
     `hunt_crossley_dissipation` (s/m)); `"geometry": "wall"` (LAMMPS, LIGGGHTS, Chrono,
     Yade): one sphere on a wall of its material. The step is not part of this answer:
     `stepped_response` gives what the stepping realises. Returns `(law, separation, e, T)`."""
-    chosen = _engine(engine)
-    m = check_positive("m", m, "kg")
-    speeds = [check_positive("speed", v, "m/s") for v in np.atleast_1d(speeds)]
-    law, separation = _normal_for(chosen, parameters).response(parameters, m=m, radius=radius)
+    chosen, model, m, speeds = _inputs(engine, parameters, m, speeds)
+    law, separation = model.response(parameters, m=m, radius=radius)
     e, T = curve(law, contact_mass(chosen, m, parameters.get("geometry")), speeds, separation)
     return law, separation, e, T
 
@@ -54,10 +61,8 @@ def stepped_response(engine: str, parameters: dict, *, m, speeds, radius=None):
     not known: a two-sphere engine without a `timestep`, Drake's continuous plant
     (error-controlled integration: no step error), and Chrono (its stepper not modelled);
     each engine's `STEPPING` says which."""
-    chosen = _engine(engine)
-    m = check_positive("m", m, "kg")
-    speeds = [check_positive("speed", v, "m/s") for v in np.atleast_1d(speeds)]
-    stepping = _normal_for(chosen, parameters).stepper(parameters, m=m, radius=radius)
+    _, model, m, speeds = _inputs(engine, parameters, m, speeds)
+    stepping = model.stepper(parameters, m=m, radius=radius)
     if stepping is None:
         return None
     runs = [stepping.run(v) for v in speeds]

@@ -42,10 +42,16 @@ import math
 import numpy as np
 
 from . import _stepping
-from .base import AbstractEngine, AbstractNormalModel, AbstractTangentialModel, Design, Key, Scene
-from .base import Stepping
-from .mujoco.solref import continuous, dampratio_for
+from .base import (
+    AbstractEngine,
+    AbstractNormalModel,
+    AbstractTangentialModel,
+    Design,
+    Key,
+    Stepping,
+)
 from .materials import check_positive, check_restitution
+from .mujoco.solref import continuous, dampratio_for
 
 CUNDALL_DEFAULT = 0.2  # NewtonIntegrator.damping's default (pkg/dem/NewtonIntegrator.hpp)
 
@@ -137,28 +143,23 @@ class ViscElMat(AbstractNormalModel):
     NEAREST = "its kelvin_voigt law"
     SCENES = None
 
-    def design(
-        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
-    ) -> Design:
-        """ViscElMat inputs and O.dt for target `e` and `T` (s), two spheres of mass `m`
-        (kg) and radius `radius` (m) at relative speed `v0` (m/s) or (`geometry="wall"`) one
-        such sphere on a fixed wall of mass 0; `e` and `T` of the design are the replica's
-        mean over start phases. Its force is always kept non-attractive (`limit_damping`
-        does not apply), and it takes no Poisson's ratio."""
+    def design(self, e, T, scene, *, timestep=None, poisson=0.3, limit_damping=False) -> Design:
+        """ViscElMat inputs and O.dt for target `e` and `T` (s) in `scene` (a wall: of mass 0);
+        its force is always kept non-attractive (`limit_damping` does not apply), and it
+        takes no Poisson's ratio."""
         m, v0, radius, wall = scene.m, scene.v0, scene.radius, scene.wall
         en, tc, zeta = inputs_for(e, T, "wall" if wall else "spheres")
-        params = {"tc": tc, "en": en, "damping": 0.0}
-        if wall:
-            params["geometry"] = "wall"
-        h, es, Ts, warnings = _stepping.step_and_response(
-            lambda h: replica({**params, "timestep": h}, m, v0),
+        params, es, Ts, warnings = _stepping.replicated(
+            replica,
+            {"tc": tc, "en": en, "damping": 0.0},
+            scene,
             e,
             T,
             timestep,
             engine="Yade",
             step="O.dt =",
         )
-        params["timestep"] = h
+        h = params["timestep"]
         warnings.append(
             f"en = {en:.6g} is not the e Yade realises: its force is kept non-attractive, so "
             f"en = {en:.4g} and tc = {tc:.4g} s give e = {e:.4g}, T = {T:.4g} s"
@@ -188,13 +189,7 @@ class ViscElMat(AbstractNormalModel):
         if wall:
             parameters["geometry"] = "wall"
             parameters["wall"] = "utils.wall(0.0, axis=2, sense=1, material=mat)"
-        return Design(
-            parameters=parameters,
-            **_stepping.realised(es, Ts, h),
-            warnings=tuple(warnings),
-            separation="force",
-            stepping=parameters,
-        )
+        return Design.stepped(parameters, es, Ts, h, warnings, "force", parameters)
 
     def law_parameters(self, parameters, m):
         """`kelvin_voigt`'s `c` = kn (N/m) and `b` = cn (N s/m) that Yade forms for two
@@ -206,9 +201,7 @@ class ViscElMat(AbstractNormalModel):
     def response(self, parameters, *, m, radius=None):
         """`(law, separation)` that `parameters` (`tc` s > 0, `en` in (0, 1]) give two
         spheres of mass `m` (kg)."""
-        tc = check_positive("tc", parameters["tc"], "s")
-        en = check_restitution(parameters["en"], "en")
-        return self.law({"tc": tc, "en": en}, m), "force"
+        return self.law(_inputs(parameters), m), "force"
 
     def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
         """NewtonIntegrator's leapfrog at `parameters["timestep"]` (s) with its `damping`
@@ -219,16 +212,17 @@ class ViscElMat(AbstractNormalModel):
         damping = float(parameters.get("damping", 0.0))
         if not 0.0 <= damping < 1.0:
             raise ValueError(f"NewtonIntegrator damping must lie in [0, 1), got {damping!r}")
-        tc = check_positive("tc", parameters["tc"], "s")
-        en = check_restitution(parameters["en"], "en")
-        stepping = {
-            "tc": tc,
-            "en": en,
-            "timestep": h,
-            "damping": damping,
-            "geometry": parameters.get("geometry", "spheres"),
-        }
+        geometry = parameters.get("geometry", "spheres")
+        stepping = {**_inputs(parameters), "timestep": h, "damping": damping, "geometry": geometry}
         return Stepping(h, lambda v: replica(stepping, m, v))
+
+
+def _inputs(parameters) -> dict:
+    """`tc` (s, > 0) and `en` (in (0, 1]) of `parameters`, checked (one-line ValueErrors)."""
+    return {
+        "tc": check_positive("tc", parameters["tc"], "s"),
+        "en": check_restitution(parameters["en"], "en"),
+    }
 
 
 class ViscElShear(AbstractTangentialModel):

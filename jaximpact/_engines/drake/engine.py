@@ -1,11 +1,9 @@
 """Drake: point contact in a MultibodyPlant, continuous or discrete (`normal.py`), and its
 friction for every tangential law on the continuous plant (`friction.py`)."""
 
-from ..base import AbstractEngine
+from ..base import TANGENTIAL_LAWS, AbstractEngine
 from .friction import StribeckFriction
 from .normal import PointContact
-
-_FRICTION = StribeckFriction()
 
 
 class Drake(AbstractEngine):
@@ -23,10 +21,7 @@ class Drake(AbstractEngine):
     CONTINUOUS_PLANT = True
     NORMAL = {"point_contact": PointContact()}
     # friction only (its mu), whatever the tangential law
-    TANGENTIAL = dict.fromkeys(
-        ("linear_history", "mindlin", "mindlin_force", "mindlin_rescale", "mindlin_rescale_force"),
-        _FRICTION,
-    )
+    TANGENTIAL = dict.fromkeys(TANGENTIAL_LAWS, StribeckFriction())
 
     def snippet(self, parameters) -> str:
         per = parameters["per_geometry"]

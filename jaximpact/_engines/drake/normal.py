@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from .. import _stepping
-from ..base import AbstractNormalModel, Design, Key, Scene, Stepping
+from ..base import AbstractNormalModel, Design, Key, Stepping
 from ..materials import check_positive
 
 
@@ -141,9 +141,7 @@ class PointContact(AbstractNormalModel):
     NEAREST = "its point_contact law"
     SCENES = None
 
-    def design(
-        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
-    ) -> Design:
+    def design(self, e, T, scene, *, timestep=None, poisson=0.3, limit_damping=False) -> Design:
         """`point_contact_stiffness` k (N/m) and `hunt_crossley_dissipation` d (s/m) that
         realise `e` and `T` (s) for mass `m` (kg) at `v0` (m/s): on the continuous plant
         (`timestep` None or 0: exact, from the closed-form e of `f = k x (1 + d v)`), or on a
@@ -186,13 +184,7 @@ class PointContact(AbstractNormalModel):
             "the promise is for the Lagged (Drake's default), Similar or TAMSI discrete "
             "approximation; kSap ignores hunt_crossley_dissipation (e near 0)"
         )
-        return Design(
-            parameters=params,
-            **_stepping.realised(es, Ts, h),
-            warnings=tuple(warnings),
-            separation="force",
-            stepping=params,
-        )
+        return Design.stepped(params, es, Ts, h, warnings, "force", params)
 
     def law_parameters(self, parameters, m):
         """`point_contact`'s `c` = k (N/m) and `d` (s/m), whatever the mass."""

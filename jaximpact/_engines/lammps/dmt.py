@@ -31,10 +31,8 @@ import math
 import numpy as np
 
 from .. import _stepping
-from ..base import AbstractNormalModel, Design, Key, Scene, Stepping
+from ..base import AbstractNormalModel, Design, Key, Stepping
 from . import script
-from .jkr import emix
-from ..materials import check_poisson, check_positive
 
 
 def normal_force(delta, v, *, c: float, b: float, pull: float):
@@ -51,34 +49,24 @@ def replica(parameters, m: float, v0: float, phases=_stepping.PHASES, max_steps=
     effective mass `m/2`) at impact speed `v0` (m/s). T (s) is the number of steps with a
     force times the step; a body the adhesion holds (its speed turns back in before it
     leaves) gives `e = 0` and T the steps until then (as `impact`'s `captured`)."""
-    h = float(parameters["timestep"])
-    wall = parameters.get("geometry", "spheres") == "wall"
-    m_eff = m if wall else m / 2.0
-    c, b, pull = _contact(parameters, m_eff)
+    c, b, pull = _contact(parameters, m)
     return _stepping.cohesive_verlet(
         lambda x, v: normal_force(x, v, c=c, b=b, pull=pull),
         lambda x, attached: x > 0.0,  # the contact holds while the spheres overlap
-        h,
-        m_eff,
+        float(parameters["timestep"]),
+        script.contact_mass(parameters, m),
         v0,
         phases,
         max_steps,
     )
 
 
-def _contact(parameters, m_eff: float) -> tuple[float, float, float]:
-    """`(c, b, pull)` of the contact `parameters` give (N/m^1.5, N s/m^1.5, N)."""
-    E = check_positive("E", parameters.get("E", parameters.get("youngs_modulus")), "Pa")
-    nu = check_poisson("poisson", parameters.get("poisson", 0.3))
-    cohesion = parameters["cohesion"]
-    if not (math.isfinite(cohesion) and cohesion >= 0):
-        raise ValueError(f"cohesion must be a finite number >= 0 J/m^2, got {cohesion!r}")
-    R_eff = check_positive("R_eff", parameters["R_eff"], "m")
-    damp = parameters["damp"]
-    if not (math.isfinite(damp) and damp >= 0):
-        raise ValueError(f"damp must be a finite number >= 0 (1/(m s)), got {damp!r}")
-    root = math.sqrt(R_eff)
-    return 4.0 / 3.0 * emix(E, nu) * root, damp * m_eff * root, 4.0 * math.pi * cohesion * R_eff
+def _contact(parameters, m: float) -> tuple[float, float, float]:
+    """`(c, b, pull)` of the contact `parameters` give spheres of mass `m` (N/m^1.5,
+    N s/m^1.5, N)."""
+    E, nu, cohesion, damp = script.material(parameters, damped=True, adhesive=False)
+    c, b, R_eff = script.hertz_groups(parameters, m, E, nu, damp)
+    return c, b, 4.0 * math.pi * cohesion * R_eff
 
 
 def model(E: float, damp: float, poisson: float, cohesion: float) -> str:
@@ -96,16 +84,11 @@ class DMT(AbstractNormalModel):
     NAME = "dmt"
     NEAREST = "its dmt law"
     ALLOWS_LIMIT_DAMPING = False
-    SCENES = {
-        "spheres": "two equal spheres, each of mass m and radius `radius`, colliding head-on at "
-        "relative speed v0 (pair_style granular, dmt, damping viscoelastic; no gravity)",
-        "wall": "a sphere of mass m and radius `radius` hitting a fixed flat wall (fix "
-        "wall/gran granular dmt, the sphere's own material) head-on at speed v0 (no gravity)",
-    }
+    SCENES = script.cohesive_scenes("dmt, damping viscoelastic", "dmt")
     MASS_DEPENDS = "its Young's modulus and cohesion scale with the mass"
     KEYS = (
         Key("E", "Pa"),
-        Key("damp", "1/(m s), viscoelastic damping: b = damp meff Reff^0.5"),
+        script.DAMP,
         script.COHESION,
         Key("R_eff", "m, the contact's effective radius (default: from the radius)", needed=False),
         script.POISSON,
@@ -117,62 +100,39 @@ class DMT(AbstractNormalModel):
         "overlap: replicated"
     )
 
-    def design(
-        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
-    ) -> Design:
+    def design(self, e, T, scene, *, timestep=None, poisson=0.3, limit_damping=False) -> Design:
         """`pair_style granular` with `dmt E damp poisson cohesion damping viscoelastic` that
         is the law `scene.law` for the pair (every force scaled by `meff/m`: the module's
-        docstring), two spheres of mass `m` (kg) and radius `radius` (m) or with
-        `geometry="wall"` one on `fix wall/gran`; `e` and `T` (s), the law's at `v0` (m/s),
-        are what the replica's mean over start phases is held to."""
+        docstring); `e` and `T` (s), the law's at `v0` (m/s), are what its stepping is held to."""
         if scene.law is None:
             raise ValueError("LAMMPS's dmt model is exported from a dmt law: pass the law")
-        m, v0, radius, wall = scene.m, scene.v0, scene.radius, scene.wall
-        m_eff, R_eff = (m, radius) if wall else (m / 2.0, radius / 2.0)
-        scale = m_eff / m
+        m_eff, R_eff = script.effective(scene.m, scene.radius, scene.geometry)
+        scale = m_eff / scene.m
         q = {k: float(v) for k, v in scene.law.parameters.items()}
         c, b, pull = scale * q["c"], scale * q["b"], scale * 2.0 * math.pi * q["w"] * q["R"]
         E = 0.75 * c / math.sqrt(R_eff) * 2.0 * (1.0 - poisson) * (1.0 + poisson)
         damp = b / (m_eff * math.sqrt(R_eff))
         cohesion = pull / (4.0 * math.pi * R_eff)
-        stepping, h, es, Ts, warnings = script.cohesive_stepping(
+        shown = dict(damp=damp, cohesion=cohesion)
+        return script.cohesive_design(
             replica,
-            dict(E=E, poisson=poisson, cohesion=cohesion, damp=damp, R_eff=R_eff),
-            wall=wall,
-            m=m,
-            v0=v0,
+            model(E, damp, poisson, cohesion),
+            scene,
+            dict(E=E, poisson=poisson, **shown, R_eff=R_eff),
             e=e,
             T=T,
             timestep=timestep,
-        )
-        text = model(E, damp, poisson, cohesion)
-        parameters = script.granular_parameters(
-            text,
-            h,
-            E=E,
-            poisson=poisson,
-            R_eff=R_eff,
-            wall=wall,
-            damp=damp,
-            cohesion=cohesion,
-            normal="dmt",
-        )
-        return Design(
-            parameters=parameters,
-            **_stepping.realised(es, Ts, h),
-            warnings=tuple(warnings),
             separation="penetration",
-            stepping=stepping,
-            clause=text,
+            note=None,
+            **shown,
+            normal="dmt",
         )
 
     def law_parameters(self, parameters, m):
         """The `dmt` law (c N/m^1.5, b N s/m^1.5, R m, w J/m^2) that is LAMMPS's contact, for
         its effective mass (m/2 for two spheres of mass `m`, kg; `m` on a wall):
         `c = 4/3 Emix Reff^0.5`, `b = damp meff Reff^0.5`, `R = Reff`, `w = 2 cohesion`."""
-        wall = parameters.get("geometry", "spheres") == "wall"
-        m_eff = m if wall else m / 2.0
-        c, b, pull = _contact(parameters, m_eff)
+        c, b, pull = _contact(parameters, m)
         R_eff = float(parameters["R_eff"])
         return {"c": c, "b": b, "R": R_eff, "w": pull / (2.0 * math.pi * R_eff)}
 
@@ -182,9 +142,6 @@ class DMT(AbstractNormalModel):
 
     def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
         """`replica` at `parameters["timestep"]` (s), or None without one."""
-        if parameters.get("timestep") is None:
-            return None
-        h = check_positive("timestep", parameters["timestep"], "s")
-        full = {**script.with_effective_radius(parameters, radius), "timestep": h}
-        _contact(full, m)
-        return Stepping(h, lambda v: replica(full, m, v))
+        return script.cohesive_stepper(
+            replica, lambda p: _contact(p, m), parameters, m=m, radius=radius
+        )

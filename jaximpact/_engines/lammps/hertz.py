@@ -19,25 +19,15 @@ law to one it lacks.
 """
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
 from .. import _stepping
-from ..base import AbstractNormalModel, Design, Key, Scene, Stepping
+from ..base import AbstractNormalModel, Design, Key, Stepping, sphere_radius
 from ..materials import check_poisson, check_positive, check_restitution, hertz_stiffness
 from . import script
-
-
-def effective(m: float, radius: float, geometry: str = "spheres") -> tuple[float, float]:
-    """`(m_eff, R_eff)` of the contact: two equal spheres (`m/2`, `R/2`) or a sphere on a
-    flat wall (`m`, `R`: `fix wall/gran` takes the particle's own mass and radius, the wall's
-    curvature radius being 0 for a plane; src/GRANULAR/fix_wall_gran.cpp). Both have
-    `E_eff = E/(2 (1 - nu^2))`: the pair mixes two spheres of one material, and the wall's
-    `mix_stiffnessE_wall(E, nu)` (src/GRANULAR/gran_sub_mod.cpp) gives the same, i.e. the
-    wall is of the sphere's own material, not rigid."""
-    if geometry == "wall":
-        return m, radius
-    return m / 2.0, radius / 2.0
+from .script import effective
 
 
 def impact_at_unit_scales(e_coefficient: float, separation: str):
@@ -89,11 +79,41 @@ def replica(parameters, m: float, v0: float, phases=_stepping.PHASES):
     """`(e, T)` per start phase of `fix nve/sphere` on the contact `parameters` (`k`, `b`,
     `limit_damping`, `timestep`; `geometry` "wall": the sphere's own mass `m` on a wall,
     else two spheres of mass `m`, effective mass `m/2`)."""
-    wall = parameters.get("geometry", "spheres") == "wall"
-    c, b, m_eff = parameters["k"], parameters["b"], m if wall else m / 2.0
-    return _stepping.velocity_verlet(
-        acceleration(c, b, m_eff, parameters["limit_damping"]), parameters["timestep"], v0, phases
-    )
+    m_eff = script.contact_mass(parameters, m)
+    accel = acceleration(parameters["k"], parameters["b"], m_eff, parameters["limit_damping"])
+    return _stepping.velocity_verlet(accel, parameters["timestep"], v0, phases)
+
+
+class Tsuji(NamedTuple):
+    """A Tsuji-form contact (`tsuji_design`): its `coefficient` (coeff_restitution), the
+    e and duration `tau` (units of `t* = (m_eff v0^2/c)^(2/5) / v0`) of its law, its Hertz
+    constant `c` (N/m^1.5), Young's modulus `E` (Pa), damping `b` (N s/m^1.25), and the
+    contact's effective mass (kg) and radius (m)."""
+
+    coefficient: float
+    e: float
+    tau: float
+    c: float
+    E: float
+    b: float
+    m_eff: float
+    R_eff: float
+
+
+def tsuji_design(e: float, T: float, scene, poisson: float, clamped: bool) -> Tsuji:
+    """The Tsuji-form contact (LAMMPS's hertz/material with damping coeff_restitution;
+    LIGGGHTS's, Chrono's) whose continuous impact in `scene` has restitution `e` and
+    duration `T` (s), its force kept non-attractive or not (`clamped`), at Poisson's ratio
+    `poisson`."""
+    coefficient = coefficient_for(e, clamped)
+    e_law, tau = impact_at_unit_scales(coefficient, "force" if clamped else "penetration")
+    m_eff, R_eff = effective(scene.m, scene.radius, scene.geometry)
+    c = m_eff * scene.v0**2 * (tau / (T * scene.v0)) ** 2.5
+    E = c * 3.0 / (4.0 * math.sqrt(R_eff)) * 2.0 * (1.0 - poisson**2)
+    R2 = None if scene.wall else scene.radius
+    assert abs(hertz_stiffness(E, poisson, scene.radius, R2=R2) / c - 1) < 1e-12
+    b = damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
+    return Tsuji(coefficient, e_law, tau, c, E, b, m_eff, R_eff)
 
 
 def tsuji_response(engine: str, parameters, *, m: float, radius, clamped: bool):
@@ -103,10 +123,7 @@ def tsuji_response(engine: str, parameters, *, m: float, radius, clamped: bool):
     such sphere on a flat wall of its material; `clamped`: the force is kept
     non-attractive."""
     wall = parameters.get("geometry", "spheres") == "wall"
-    if radius is None:
-        what = "sphere's" if wall else "spheres'"
-        raise ValueError(f"{engine} needs the {what} radius: pass radius= (m)")
-    radius = check_positive("radius", radius, "m")
+    radius = sphere_radius(engine, radius, parameters.get("geometry"))
     E = check_positive("E", parameters["E"], "Pa")
     nu = check_poisson("poisson", parameters.get("poisson", 0.3))
     coefficient = check_restitution(parameters["coeff_restitution"], "coeff_restitution")
@@ -149,63 +166,22 @@ class HertzMaterial(AbstractNormalModel):
         "speed; LAMMPS's mdr normal model is elastic-plastic, but another law, not exported)"
     )
 
-    def design(
-        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
-    ) -> Design:
-        """`pair_style granular` with `hertz/material ... damping coeff_restitution` for
-        target `e` and `T` (s), two spheres of mass `m` (kg) and radius `radius` (m) at
-        relative speed `v0` (m/s), or on a wall (`scene.geometry`) one such sphere at speed
-        `v0` (`fix wall/gran granular` with the same model); `e` and `T` of the design are
-        the replica's mean over start phases."""
-        m, v0, radius, wall = scene.m, scene.v0, scene.radius, scene.wall
-        separation = "force" if limit_damping else "penetration"
-        coefficient = coefficient_for(e, limit_damping)
-        _, tau = impact_at_unit_scales(coefficient, separation)
-        m_eff, R_eff = effective(m, radius, scene.geometry)
-        c = m_eff * v0**2 * (tau / (T * v0)) ** 2.5
-        E = c * 3.0 / (4.0 * math.sqrt(R_eff)) * 2.0 * (1.0 - poisson**2)
-        assert abs(hertz_stiffness(E, poisson, radius, R2=None if wall else radius) / c - 1) < 1e-12
-        b = damp_coefficient(coefficient) * math.sqrt(m_eff * c) if coefficient < 1 else 0.0
+    def design(self, e, T, scene, *, timestep=None, poisson=0.3, limit_damping=False) -> Design:
+        """`pair_style granular` with `hertz/material ... damping coeff_restitution` (on a
+        wall, `fix wall/gran granular` with the same model) for target `e` and `T` (s)."""
+        wall, separation = scene.wall, "force" if limit_damping else "penetration"
+        contact = tsuji_design(e, T, scene, poisson, limit_damping)
+        coefficient, c, E, b = contact.coefficient, contact.c, contact.E, contact.b
         params = dict(k=c, b=b, limit_damping=limit_damping)
-        if wall:
-            params["geometry"] = "wall"
-        h, es, Ts, warnings = _stepping.step_and_response(
-            lambda h: replica({**params, "timestep": h}, m, v0),
-            e,
-            T,
-            timestep,
-            engine="LAMMPS",
-            step="timestep",
+        params, es, Ts, warnings = _stepping.replicated(
+            replica, params, scene, e, T, timestep, engine="LAMMPS", step="timestep"
         )
-        text = clause(E, coefficient, poisson)
-        parameters = script.granular_parameters(
-            text,
-            h,
-            E=E,
-            poisson=poisson,
-            wall=wall,
-            coeff_restitution=coefficient,
-            k=c,
-            b=b,
-            limit_damping=limit_damping,
-        )
-        stepping = dict(
-            E=E,
-            coeff_restitution=coefficient,
-            poisson=poisson,
-            limit_damping=limit_damping,
-            timestep=h,
-        )
-        if wall:  # the wall at z = 0, the sphere above it: the pair's model (one material)
-            stepping["geometry"] = "wall"
-        return Design(
-            parameters=parameters,
-            **_stepping.realised(es, Ts, h),
-            warnings=tuple(warnings),
-            separation=separation,
-            stepping=stepping,
-            clause=text,
-        )
+        h, text = params["timestep"], clause(E, coefficient, poisson)
+        shown = dict(coeff_restitution=coefficient, k=c, b=b, limit_damping=limit_damping)
+        parameters = script.granular_parameters(text, h, E=E, poisson=poisson, wall=wall, **shown)
+        # `stepper`'s parameters: the pair's model (one material), or the wall at z = 0
+        stepping = dict(E=E, coeff_restitution=coefficient, poisson=poisson, **params)
+        return Design.stepped(parameters, es, Ts, h, warnings, separation, stepping, clause=text)
 
     def law_parameters(self, parameters, m):
         """`tsuji`'s `c` = k (N/m^1.5) and `b` (N s/m^1.25) between the two spheres

@@ -51,7 +51,7 @@ import numpy as np
 from .. import _stepping
 from ..base import AbstractNormalModel, Design, Key, Scene, Stepping
 from . import script
-from ..materials import check_poisson, check_positive
+from .script import emix
 
 # src/GRANULAR/gran_sub_mod_normal.cpp (22Jul2025): the constants of the contact radius
 _PI27SQ = 27.0 * math.pi**2
@@ -76,11 +76,6 @@ C_JKR = _loss(0.25 ** (1.0 / 3.0))  # 0.24862: JKR's pull-off at the least overl
 C_LAMMPS = _loss(0.75 ** (1.0 / 3.0))  # 0.12278: LAMMPS's, at the least force
 ENERGY_RATIO = C_LAMMPS / C_JKR  # 0.4938: the energy LAMMPS takes over JKR's
 STICKING_RATIO = math.sqrt(ENERGY_RATIO)  # 0.7027: its sticking speed over JKR's
-
-
-def emix(E: float, poisson: float) -> float:
-    """LAMMPS's `Emix` (Pa) of one material, `E / (2 (1 - nu^2))`, pair and wall alike."""
-    return E / (2.0 * (1.0 - poisson) * (1.0 + poisson))
 
 
 def pulloff_distance(R_eff: float, cohesion: float, E_mix: float) -> float:
@@ -161,7 +156,9 @@ def literal_restitution(e: float) -> float:
     return math.sqrt(1.0 - ENERGY_RATIO * (1.0 - e * e))
 
 
-def replica(parameters, m: float, v0: float, phases=_stepping.PHASES, max_steps=10_000_000):
+def replica(
+    parameters, m: float, v0: float, phases=_stepping.PHASES, max_steps=10_000_000, damped=False
+):
     """`(e, T)` per start phase of `fix nve/sphere` on LAMMPS's JKR contact `parameters`
     (`E` Pa, `poisson`, `cohesion` J/m^2, `timestep` s, `R_eff` m; `geometry` "wall": the
     sphere's own mass `m` on a wall, else two spheres of mass `m`, effective mass `m/2`) at
@@ -169,32 +166,57 @@ def replica(parameters, m: float, v0: float, phases=_stepping.PHASES, max_steps=
     `delta > -pulloff_distance`; T (s) is the number of steps with a non-zero force times
     the step. A body the neck holds (below the sticking speed) gives `e = 0` and T the
     time to where it turns back in (as `jaximpact.impact`'s `captured`)."""
-    h = float(parameters["timestep"])
-    wall = parameters.get("geometry", "spheres") == "wall"
-    m_eff = m if wall else m / 2.0
-    R_eff, cohesion = float(parameters["R_eff"]), float(parameters["cohesion"])
-    E, nu, _ = _check(parameters)
-    E_mix = emix(E, nu)
-    pull = pulloff_distance(R_eff, cohesion, E_mix)
     return _stepping.cohesive_verlet(
-        lambda x, v: normal_force(x, R_eff, cohesion, E_mix),
-        # a neck forms at zero overlap and holds down to the pull-off distance
-        lambda x, attached: np.where(attached, x > -pull, x > 0.0),
-        h,
-        m_eff,
+        jkr_force(parameters, m, damped),
+        attached_rule(parameters),
+        float(parameters["timestep"]),
+        script.contact_mass(parameters, m),
         v0,
         phases,
         max_steps,
     )
 
 
-def _check(parameters) -> tuple[float, float, float]:
-    """`(E, poisson, cohesion)` of jkr `parameters` (`E` or an export's `youngs_modulus`),
-    checked (one-line ValueErrors)."""
-    E = check_positive("E", parameters.get("E", parameters.get("youngs_modulus")), "Pa")
-    nu = check_poisson("poisson", parameters.get("poisson", 0.3))
-    cohesion = check_positive("cohesion", parameters["cohesion"], "J/m^2")
-    return E, nu, cohesion
+def jkr_force(parameters, m: float, damped: bool = False):
+    """LAMMPS's JKR force `force(x, v)` (N, pushing apart) of `parameters` (`E` Pa,
+    `poisson`, `cohesion` J/m^2, `R_eff` m; with `damped`, `damp` 1/(m s): plus `damp meff a
+    v`, `a` the contact radius) between spheres of mass `m` (kg)."""
+    E, nu, cohesion, *damp = script.material(parameters, damped=damped)
+    R_eff, E_mix, m_eff = (
+        float(parameters["R_eff"]),
+        emix(E, nu),
+        script.contact_mass(parameters, m),
+    )
+    if not damped:
+        return lambda x, v: normal_force(x, R_eff, cohesion, E_mix)
+
+    def force(x, v):
+        a = contact_radius(x * R_eff, R_eff, cohesion, E_mix)
+        return normal_force(x, R_eff, cohesion, E_mix) + damp[0] * m_eff * a * v
+
+    return force
+
+
+def attached_rule(parameters):
+    """LAMMPS's JKR touch rule `holds(x, attached)` of `parameters`: a neck forms at zero
+    overlap and holds down to the pull-off distance."""
+    E, nu, cohesion = script.material(parameters, damped=False)
+    pull = pulloff_distance(float(parameters["R_eff"]), cohesion, emix(E, nu))
+    return lambda x, attached: np.where(attached, x > -pull, x > 0.0)
+
+
+def design_scales(T, q: float, tau: float, scene: Scene, poisson: float):
+    """`(E, cohesion, E_mix, R_eff, x_star)`: LAMMPS's Young's modulus (Pa), cohesion
+    (J/m^2), `Emix` (Pa), effective radius (m) and Hertz length `x*` (m) whose JKR impact in
+    `scene`, of adhesion group `q` and duration `tau` (units of `t*`), lasts `T` (s), with
+    Poisson's ratio `poisson`."""
+    m_eff, R_eff = script.effective(scene.m, scene.radius, scene.geometry)
+    x_star = scene.v0 * T / tau  # t* = T / tau
+    c = m_eff * scene.v0**2 / x_star**2.5
+    E_mix = 0.75 * c / math.sqrt(R_eff)
+    E = E_mix * 2.0 * (1.0 - poisson) * (1.0 + poisson)
+    cohesion = 0.5 * q**2 * x_star**1.5 * E_mix / (2.0 * math.pi * math.sqrt(R_eff))
+    return E, cohesion, E_mix, R_eff, x_star
 
 
 def model(E: float, cohesion: float, poisson: float) -> str:
@@ -213,83 +235,42 @@ class JKR(AbstractNormalModel):
     NAME = "jkr"
     NEAREST = "its jkr law"
     ALLOWS_LIMIT_DAMPING = False
-    SCENES = {
-        "spheres": "two equal spheres, each of mass m and radius `radius`, colliding head-on at "
-        "relative speed v0 (pair_style granular, jkr; no gravity, no damping)",
-        "wall": "a sphere of mass m and radius `radius` hitting a fixed flat wall (fix "
-        "wall/gran granular jkr, the sphere's own material) head-on at speed v0 (no gravity, "
-        "no damping)",
-    }
+    SCENES = script.cohesive_scenes("jkr", "jkr", ", no damping")
     MASS_DEPENDS = "its Young's modulus and cohesion scale with the mass"
-    KEYS = (
-        Key("E", "Pa"),
-        script.COHESION,
-        script.POISSON,
-        script.TIMESTEP,
-    )
+    KEYS = (Key("E", "Pa"), script.COHESION, script.POISSON, script.TIMESTEP)
     LAW = "jkr"
     STEPPING = (
         "with a timestep, fix nve/sphere's velocity Verlet and the jkr touch rule (form at "
         "zero overlap, break at the least force): replicated"
     )
 
-    def design(
-        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
-    ) -> Design:
+    def design(self, e, T, scene, *, timestep=None, poisson=0.3, limit_damping=False) -> Design:
         """`pair_style granular` with `jkr E 0 poisson cohesion damping velocity` whose
-        impact at `v0` (m/s) has restitution `e` and duration `T` (s) (a JKR law's): two
-        spheres of mass `m` (kg) and radius `radius` (m), or with `geometry="wall"` one
-        such sphere on `fix wall/gran`. `cohesion` from `e` (LAMMPS's energy loss
-        `C_LAMMPS q^(10/3) m_eff v0^2`), `E` from `T` (its continuous impact's duration);
-        `e` and `T` of the design are the replica's mean over start phases."""
+        impact has restitution `e` and duration `T` (s) (a JKR law's): `cohesion` from `e`
+        (LAMMPS's energy loss `C_LAMMPS q^(10/3) m_eff v0^2`), `E` from `T` (its continuous
+        impact's duration)."""
         if not 0.0 < e < 1.0:
             raise ValueError(f"a JKR impact has 0 < e < 1; got e = {e:g}")
-        m, v0, radius, wall = scene.m, scene.v0, scene.radius, scene.wall
-        m_eff, R_eff = (m, radius) if wall else (m / 2.0, radius / 2.0)
         q = group_for(e)
-        _, tau = lammps_impact(q)
-        x_star = v0 * T / tau  # t* = T / tau
-        c = m_eff * v0**2 / x_star**2.5
-        E_mix = 0.75 * c / math.sqrt(R_eff)
-        E = E_mix * 2.0 * (1.0 - poisson) * (1.0 + poisson)
-        cohesion = 0.5 * q**2 * x_star**1.5 * E_mix / (2.0 * math.pi * math.sqrt(R_eff))
-        stepping, h, es, Ts, warnings = script.cohesive_stepping(
+        E, cohesion, E_mix, R_eff, _ = design_scales(T, q, lammps_impact(q)[1], scene, poisson)
+        return script.cohesive_design(
             replica,
+            model(E, cohesion, poisson),
+            scene,
             dict(E=E, poisson=poisson, cohesion=cohesion, R_eff=R_eff),
-            wall=wall,
-            m=m,
-            v0=v0,
             e=e,
             T=T,
             timestep=timestep,
-        )
-        warnings.append(
-            f"LAMMPS's jkr breaks the neck at the least force (-F_c), before JKR's pull-off "
+            separation="force",
+            note=f"LAMMPS's jkr breaks the neck at the least force (-F_c), before JKR's pull-off "
             f"(the least overlap): it takes {ENERGY_RATIO:.1%} of the energy, so with a law's "
             f"own E and w = 2 cohesion it would give e = {literal_restitution(e):.4g} here "
             f"(not {e:.4g}) and stick below {STICKING_RATIO:.3f} of the sticking speed; this "
             f"cohesion ({cohesion:.4g} J/m^2) takes the law's energy (its e(v) the law's at "
-            "every speed) and E the law's T at v0"
-        )
-        text = model(E, cohesion, poisson)
-        parameters = script.granular_parameters(
-            text,
-            h,
-            E=E,
-            poisson=poisson,
-            R_eff=R_eff,
-            wall=wall,
+            "every speed) and E the law's T at v0",
             cohesion=cohesion,
             damping=0.0,
             pulloff_distance=float(pulloff_distance(R_eff, cohesion, E_mix)),
-        )
-        return Design(
-            parameters=parameters,
-            **_stepping.realised(es, Ts, h),
-            warnings=tuple(warnings),
-            separation="force",
-            stepping=stepping,
-            clause=text,
         )
 
     def law_parameters(self, parameters, m):
@@ -299,9 +280,8 @@ class JKR(AbstractNormalModel):
         continuous one at every speed; its T is not (LAMMPS's neck breaks earlier): the
         law's contact lasts longer, by 0.3 % at e = 0.95, 1.5 % at 0.8, 4 % at 0.5 and 7 %
         at 0.2 (measured against `lammps_impact`)."""
-        E, nu, cohesion = _check(parameters)
-        R_eff = check_positive("R_eff", parameters["R_eff"], "m")
-        c = 4.0 / 3.0 * emix(E, nu) * math.sqrt(R_eff)
+        E, nu, cohesion = script.material(parameters, damped=False)
+        c, _, R_eff = script.hertz_groups(parameters, m, E, nu)
         return {"c": c, "R": R_eff, "w": 2.0 * cohesion * ENERGY_RATIO**0.6}
 
     def response(self, parameters, *, m, radius=None):
@@ -311,9 +291,5 @@ class JKR(AbstractNormalModel):
 
     def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
         """`replica` at `parameters["timestep"]` (s), or None without one."""
-        if parameters.get("timestep") is None:
-            return None
-        h = check_positive("timestep", parameters["timestep"], "s")
-        _check(parameters)
-        full = {**script.with_effective_radius(parameters, radius), "timestep": h}
-        return Stepping(h, lambda v: replica(full, m, v))
+        check = lambda p: script.material(p, damped=False)  # noqa: E731
+        return script.cohesive_stepper(replica, check, parameters, m=m, radius=radius)

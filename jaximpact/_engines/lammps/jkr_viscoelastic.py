@@ -24,16 +24,9 @@ import math
 import numpy as np
 
 from .. import _stepping
-from ..base import AbstractNormalModel, Design, Key, Scene, Stepping
-from . import script
-from .jkr import (
-    ENERGY_RATIO,
-    contact_radius,
-    emix,
-    normal_force,
-    pulloff_distance,
-)
-from ..materials import check_poisson, check_positive
+from ..base import AbstractNormalModel, Design, Key, Stepping
+from . import jkr, script
+from .jkr import ENERGY_RATIO, design_scales, pulloff_distance
 
 
 def _radius(X: float, q: float) -> float:
@@ -112,38 +105,12 @@ def replica(parameters, m: float, v0: float, phases=_stepping.PHASES, max_steps=
     `timestep` s; `geometry` "wall": the sphere's own mass `m` on a wall, else two spheres of
     mass `m`, effective mass `m/2`) at impact speed `v0` (m/s): the neck as
     `jkr.replica`, the damping `damp meff a v` at the half-step speed."""
-    h = float(parameters["timestep"])
-    wall = parameters.get("geometry", "spheres") == "wall"
-    m_eff = m if wall else m / 2.0
-    E, nu, cohesion, damp = _check(parameters)
-    R_eff = float(parameters["R_eff"])
-    E_mix = emix(E, nu)
-    pull = pulloff_distance(R_eff, cohesion, E_mix)
-
-    def force(x, v):
-        a = contact_radius(x * R_eff, R_eff, cohesion, E_mix)
-        return normal_force(x, R_eff, cohesion, E_mix) + damp * m_eff * a * v
-
-    return _stepping.cohesive_verlet(
-        force,
-        lambda x, attached: np.where(attached, x > -pull, x > 0.0),
-        h,
-        m_eff,
-        v0,
-        phases,
-        max_steps,
-    )
+    return jkr.replica(parameters, m, v0, phases, max_steps, damped=True)
 
 
 def _check(parameters) -> tuple[float, float, float, float]:
     """`(E, poisson, cohesion, damp)` of damped jkr `parameters`, checked (one line)."""
-    E = check_positive("E", parameters.get("E", parameters.get("youngs_modulus")), "Pa")
-    nu = check_poisson("poisson", parameters.get("poisson", 0.3))
-    cohesion = check_positive("cohesion", parameters["cohesion"], "J/m^2")
-    damp = parameters["damp"]
-    if not (math.isfinite(damp) and damp >= 0):
-        raise ValueError(f"damp must be a finite number >= 0 (1/(m s)), got {damp!r}")
-    return E, nu, cohesion, float(damp)
+    return script.material(parameters, damped=True)
 
 
 def model(E: float, damp: float, poisson: float, cohesion: float) -> str:
@@ -161,36 +128,20 @@ class JKRViscoelastic(AbstractNormalModel):
     NAME = "jkr"
     NEAREST = "its jkr_viscoelastic law"
     ALLOWS_LIMIT_DAMPING = False
-    SCENES = {
-        "spheres": "two equal spheres, each of mass m and radius `radius`, colliding head-on at "
-        "relative speed v0 (pair_style granular, jkr, damping viscoelastic; no gravity)",
-        "wall": "a sphere of mass m and radius `radius` hitting a fixed flat wall (fix "
-        "wall/gran granular jkr, damping viscoelastic, the sphere's own material) head-on "
-        "at speed v0 (no gravity)",
-    }
+    SCENES = script.cohesive_scenes("jkr, damping viscoelastic", "jkr, damping viscoelastic")
     MASS_DEPENDS = "its Young's modulus, damping and cohesion scale with the mass"
-    KEYS = (
-        Key("E", "Pa"),
-        Key("damp", "1/(m s), viscoelastic damping: b = damp meff Reff^0.5"),
-        script.COHESION,
-        script.POISSON,
-        script.TIMESTEP,
-    )
+    KEYS = (Key("E", "Pa"), script.DAMP, script.COHESION, script.POISSON, script.TIMESTEP)
     LAW = "jkr_viscoelastic"
     STEPPING = (
         "with a timestep, fix nve/sphere's velocity Verlet, the jkr touch rule (form at zero "
         "overlap, break at the least force) and the damping at the half-step speed: replicated"
     )
 
-    def design(
-        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
-    ) -> Design:
+    def design(self, e, T, scene, *, timestep=None, poisson=0.3, limit_damping=False) -> Design:
         """`pair_style granular` with `jkr E damp poisson cohesion damping viscoelastic`
-        whose impact at `v0` (m/s) keeps the law `scene.law`'s damping group there and has its
-        restitution `e` and duration `T` (s) (the module's docstring): two spheres of mass
-        `m` (kg) and radius `radius` (m), or with `geometry="wall"` one on `fix wall/gran`;
-        `e` and `T` of the design are the replica's mean over start phases."""
-        m, v0, radius, wall = scene.m, scene.v0, scene.radius, scene.wall
+        whose impact at `v0` (m/s) keeps the law `scene.law`'s damping group there and has
+        its restitution `e` and duration `T` (s) (the module's docstring)."""
+        m, v0 = scene.m, scene.v0
         if scene.law is None:
             raise ValueError(
                 "LAMMPS's damped jkr model is exported from a jkr_viscoelastic law: pass the law"
@@ -200,51 +151,28 @@ class JKRViscoelastic(AbstractNormalModel):
         p = {k: float(v) for k, v in scene.law.parameters.items()}
         x_law = (m * v0**2 / p["c"]) ** 0.4
         beta = p["b"] * x_law**1.5 / (m * v0)  # the law's damping group at v0
-        m_eff, R_eff = (m, radius) if wall else (m / 2.0, radius / 2.0)
         q = group_for(e, beta)
-        _, tau = lammps_impact(q, beta)
-        x_star = v0 * T / tau  # t* = T / tau
-        c = m_eff * v0**2 / x_star**2.5
-        E_mix = 0.75 * c / math.sqrt(R_eff)
-        E = E_mix * 2.0 * (1.0 - poisson) * (1.0 + poisson)
-        cohesion = 0.5 * q**2 * x_star**1.5 * E_mix / (2.0 * math.pi * math.sqrt(R_eff))
+        E, cohesion, E_mix, R_eff, x_star = design_scales(
+            T, q, lammps_impact(q, beta)[1], scene, poisson
+        )
         damp = beta * v0 / (x_star**1.5 * math.sqrt(R_eff))  # b = beta meff v0 / x*^1.5
-        stepping, h, es, Ts, warnings = script.cohesive_stepping(
+        return script.cohesive_design(
             replica,
+            model(E, damp, poisson, cohesion),
+            scene,
             dict(E=E, poisson=poisson, cohesion=cohesion, damp=damp, R_eff=R_eff),
-            wall=wall,
-            m=m,
-            v0=v0,
             e=e,
             T=T,
             timestep=timestep,
-        )
-        warnings.append(
-            "LAMMPS's jkr breaks the neck at the least force (-F_c), before JKR's pull-off "
+            separation="force",
+            note="LAMMPS's jkr breaks the neck at the least force (-F_c), before JKR's pull-off "
             f"(the least overlap): this cohesion ({cohesion:.4g} J/m^2) gives the law's e at "
             f"v0 with its damping group there ({beta:.4g}), E the law's T; at other speeds "
-            "the export's e(v) is the replica's, beside the law's"
-        )
-        text = model(E, damp, poisson, cohesion)
-        parameters = script.granular_parameters(
-            text,
-            h,
-            E=E,
-            poisson=poisson,
-            R_eff=R_eff,
-            wall=wall,
+            "the export's e(v) is the replica's, beside the law's",
             cohesion=cohesion,
             damp=damp,
             normal="jkr",
             pulloff_distance=float(pulloff_distance(R_eff, cohesion, E_mix)),
-        )
-        return Design(
-            parameters=parameters,
-            **_stepping.realised(es, Ts, h),
-            warnings=tuple(warnings),
-            separation="force",
-            stepping=stepping,
-            clause=text,
         )
 
     def law_parameters(self, parameters, m):
@@ -257,15 +185,8 @@ class JKRViscoelastic(AbstractNormalModel):
         cohesion` its e was 2.7 % below). The replica, `stepper`, is what the export
         measures."""
         E, nu, cohesion, damp = _check(parameters)
-        R_eff = check_positive("R_eff", parameters["R_eff"], "m")
-        m_eff = m if parameters.get("geometry", "spheres") == "wall" else m / 2.0
-        root = math.sqrt(R_eff)
-        return {
-            "c": 4.0 / 3.0 * emix(E, nu) * root,
-            "b": damp * m_eff * root,
-            "R": R_eff,
-            "w": 2.0 * cohesion * ENERGY_RATIO**0.6,
-        }
+        c, b, R_eff = script.hertz_groups(parameters, m, E, nu, damp)
+        return {"c": c, "b": b, "R": R_eff, "w": 2.0 * cohesion * ENERGY_RATIO**0.6}
 
     def response(self, parameters, *, m, radius=None):
         """`(law, "force")`: `law_parameters`' `jkr_viscoelastic` law for `parameters` of
@@ -274,9 +195,4 @@ class JKRViscoelastic(AbstractNormalModel):
 
     def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
         """`replica` at `parameters["timestep"]` (s), or None without one."""
-        if parameters.get("timestep") is None:
-            return None
-        h = check_positive("timestep", parameters["timestep"], "s")
-        full = {**script.with_effective_radius(parameters, radius), "timestep": h}
-        _check(full)
-        return Stepping(h, lambda v: replica(full, m, v))
+        return script.cohesive_stepper(replica, _check, parameters, m=m, radius=radius)

@@ -21,7 +21,7 @@ Sanity checks (`global_properties.cpp`): `0.05 < coefficientRestitution <= 1`,
 
 import dataclasses
 
-from ..base import AbstractNormalModel, Design, Scene, Stepping
+from ..base import AbstractNormalModel, Design, Stepping
 from ..lammps import hertz
 
 MIN_COEFFICIENT = 0.05  # createCoeffRest: "0.05 < coefficientRestitution <= 1 required"
@@ -107,9 +107,7 @@ class Hertz(AbstractNormalModel):
     NEAREST = "its tsuji law"
     SCENES = None
 
-    def design(
-        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
-    ) -> Design:
+    def design(self, e, T, scene, *, timestep=None, poisson=0.3, limit_damping=False) -> Design:
         """LAMMPS's design in LIGGGHTS's names. `geometry="wall"`: a sphere on a primitive
         `fix wall/gran` of its own material (atom type 1). Its contact, `fix_wall_gran.cpp`
         and `normal_model_hertz.h`: the particle's own mass and radius (`reff = radi` on a

@@ -17,8 +17,8 @@ So LIGGGHTS realises a `mindlin` law with `G*` and `beta` that come from its nor
 for two like spheres (and a sphere on a primitive wall of its own type) `G* / Y* =
 (1 - nu) / (2 (2 - nu))`, `Y* = Y / (2 (1 - nu^2))`, from 1/4 at `nu = 0` to 1/6 at
 `nu = 0.5`. Since the normal contact fixes `Y*` alone, the export designs it again at the
-Poisson's ratio that gives the law's `G*` (`tied_poisson`; the modulus follows), within
-LIGGGHTS's `0 <= nu <= 0.5` (0.4999 at most here); the damper is on with the normal
+Poisson's ratio that gives the law's `G*` (`TangentialHistory.poisson`; the modulus
+follows), within LIGGGHTS's `0 <= nu <= 0.5` (0.4999 at most here); the damper is on with the normal
 contact's `beta` or off (`tangential_damping off`) for `beta = 0`. Outside those, LIGGGHTS
 realises the nearest `mindlin` law, which the export names. LIGGGHTS applies the
 tangential force halfway through the overlap (`surface_model_default.h`: `cri = radi -
@@ -53,12 +53,6 @@ def y_star(p: dict) -> float:
     return p["youngs_modulus"] / (2.0 * (1.0 - nu * nu))
 
 
-def tied_poisson(p: dict, tangential) -> float:
-    """The Poisson's ratio (within [0, 0.5]) at which LIGGGHTS's `G*` is `tangential`'s with
-    the normal contact's `Y*` of the design values `p`."""
-    return poisson_for(float(tangential.params["G_star"]) / y_star(p))
-
-
 def tangential_values(p: dict, tangential) -> dict:
     """The design values `p` (`youngs_modulus`, `poisson`, `coeff_restitution`) with what
     LIGGGHTS's tangential history then realises for `tangential` (a `mindlin` law):
@@ -74,18 +68,6 @@ def tangential_values(p: dict, tangential) -> dict:
         G_star=y_star(p) * shear_ratio(float(p["poisson"])),
         tangential_beta=beta,
         tangential_damping=damped,
-    )
-
-
-def realised(parameters: dict, tangential):
-    """The `mindlin` law LIGGGHTS realises with the exported `parameters`."""
-    from ..._oblique import tangential_law
-
-    return tangential_law(
-        "mindlin",
-        G_star=parameters["G_star"],
-        mu=parameters["friction"],
-        beta=parameters["tangential_beta"],
     )
 
 
@@ -124,8 +106,9 @@ class TangentialHistory(AbstractTangentialModel):
         """LIGGGHTS takes any `mindlin` law (the nearest where its G* or damper cannot be)."""
 
     def poisson(self, design: Design, tangential) -> float:
-        """The Poisson's ratio at which LIGGGHTS's G* is the law's (`tied_poisson`)."""
-        return tied_poisson(design.parameters, tangential)
+        """The Poisson's ratio (within [0, 0.5]) at which LIGGGHTS's G* is the law's with the
+        normal contact's Y* of the `design`."""
+        return poisson_for(float(tangential.params["G_star"]) / y_star(design.parameters))
 
     def parameters(self, design: Design, tangential) -> dict:
         """The design's parameters (designed at `poisson`'s ratio) with `tangential` (a
@@ -141,7 +124,12 @@ class TangentialHistory(AbstractTangentialModel):
 
     def realised(self, parameters, tangential):
         """The `mindlin` law LIGGGHTS realises (its G* and damper tied to E, nu, e)."""
-        return realised(parameters, tangential)
+        from ..._oblique import tangential_law
+
+        beta = parameters["tangential_beta"]
+        return tangential_law(
+            "mindlin", G_star=parameters["G_star"], mu=parameters["friction"], beta=beta
+        )
 
     def notes(self, parameters, tangential) -> list[str]:
         """Poisson's ratio set for G*, and where LIGGGHTS's `mindlin` law is the nearest."""

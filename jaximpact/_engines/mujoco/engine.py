@@ -2,11 +2,9 @@
 MuJoCo's time stepping realises: one normal model (`normal.py`) and its friction for every
 tangential law (`friction.py`)."""
 
-from ..base import AbstractEngine
+from ..base import TANGENTIAL_LAWS, AbstractEngine
 from .friction import PyramidalFriction
 from .normal import Solref
-
-_FRICTION = PyramidalFriction()
 
 
 class Mujoco(AbstractEngine):
@@ -22,10 +20,7 @@ class Mujoco(AbstractEngine):
     CONTINUOUS_PLANT = False
     NORMAL = {"kelvin_voigt": Solref()}
     # friction only (its mu), whatever the tangential law: the table's names are the laws'
-    TANGENTIAL = dict.fromkeys(
-        ("linear_history", "mindlin", "mindlin_force", "mindlin_rescale", "mindlin_rescale_force"),
-        _FRICTION,
-    )
+    TANGENTIAL = dict.fromkeys(TANGENTIAL_LAWS, PyramidalFriction())
 
     def snippet(self, parameters) -> str:
         solref = " ".join(f"{v:.10g}" for v in parameters["solref"])

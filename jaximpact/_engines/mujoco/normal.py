@@ -4,7 +4,7 @@ realises a target e and T (its bias corrected), through `solref.replica`."""
 import math
 
 from .. import _stepping
-from ..base import AbstractNormalModel, Design, Key, Scene, Stepping
+from ..base import AbstractNormalModel, Design, Key, Stepping
 from ..materials import check_positive
 from .solref import (
     DEFAULT_TIMECONST,
@@ -101,9 +101,7 @@ class Solref(AbstractNormalModel):
     NEAREST = "its kelvin_voigt law"
     SCENES = None
 
-    def design(
-        self, e, T, scene: Scene, *, timestep=None, poisson=0.3, limit_damping=False
-    ) -> Design:
+    def design(self, e, T, scene, *, timestep=None, poisson=0.3, limit_damping=False) -> Design:
         """solref, solimp and time step that realise `e` and `T` (s; None: MuJoCo's default
         timeconst) at `v0` (m/s) in MuJoCo, and what MuJoCo realises with them. The contact
         per unit mass does not depend on the mass `m`; the other options do not apply."""
@@ -148,14 +146,7 @@ class Solref(AbstractNormalModel):
             "natural_frequency": w0,
             "dampratio": zeta,
         }
-        return Design(
-            parameters=parameters,
-            **_stepping.realised(es, Ts, h),
-            warnings=tuple(warnings),
-            separation="force",
-            target_T=T,
-            stepping=parameters,
-        )
+        return Design.stepped(parameters, es, Ts, h, warnings, "force", parameters, target_T=T)
 
     def law_parameters(self, parameters, m):
         """`kelvin_voigt`'s `c` (N/m) and `b` (N s/m) for a body of mass `m` (kg), to be
