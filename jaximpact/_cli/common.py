@@ -327,40 +327,6 @@ def warn_sphere_density(m, R) -> None:
         )
 
 
-def check_contact_scales(law_name: str, params: dict, m: float, v0: float):
-    """The scales of an impact of the law `law_name` (parameters `params`), mass `m` (kg)
-    and speed `v0` (m/s): the energy `m v0^2` (J) and, for the family `F = c x^n + ...`,
-    the penetration `x* = (m v0^2 / c)^(1/(n+1))` (m), the duration `x*/v0` (s) and the
-    force `c x*^n` (N) must each lie within [1e-150, 1e150] (`_checks.check_scale`), so
-    that no result under- or overflows float64 (a one-line `ValueError` otherwise)."""
-    import math
-
-    from .._checks import check_scale
-    from .._laws import LAWS
-
-    energy = m * v0 * v0
-    if not (math.isfinite(m) and math.isfinite(v0) and m > 0 and v0 > 0):
-        return  # the library's own checks say what is wrong
-    what = f"for m = {m:g} kg and v0 = {v0:g} m/s, the contact's"
-    check_scale(f"{what} energy m v0^2", energy, "J")
-    spec = LAWS.get(law_name)
-    if not (spec and spec.shape):  # a user's law, or one outside the family (no x* scale)
-        return
-    try:
-        c, n = (float(a) for a in spec.coefficients({**spec.defaults, **params}, v0)[:2])
-    except (KeyError, TypeError, ValueError):
-        return  # a parameter missing or wrong: the law's own checks say so
-    if not (c > 0 and n > 0 and math.isfinite(c)):
-        return
-    log_x = (math.log(energy) - math.log(c)) / (n + 1)  # logs: no overflow on the way
-    for name, log_value, unit in (
-        ("penetration scale (m v0^2/c)^(1/(n+1))", log_x, "m"),
-        ("duration scale x*/v0", log_x - math.log(v0), "s"),
-        ("force scale c x*^n", math.log(c) + n * log_x, "N"),
-    ):
-        check_scale(f"{what} {name}", math.exp(max(min(log_value, 700.0), -700.0)), unit)
-
-
 def free_names(items) -> tuple[str, ...] | None:
     """`--free c,b1` or `--free c b1` -> `("c", "b1")`; None when not given."""
     if not items:
@@ -527,8 +493,7 @@ def read_fit(path: str, law: str | None = None):
     its best, or the law `law` names) and that fit read back (`Fit.from_dict`; a user's law
     FILE.py:NAME from its file). A file that is no such fit is a one-line `CLIError` (the
     one reading of a fit's file, for `export --from` and `fit-oblique --from`)."""
-    from .._fit.calibrate import Fit
-    from .._laws.custom import LawFileError
+    from .._fit.report import fit_from_json
 
     where, hint = f"--from {path}", "write it with 'jaximpact calibrate ... --json > FILE'"
     try:
@@ -539,24 +504,8 @@ def read_fit(path: str, law: str | None = None):
         raise CLIError(f"{where}: not JSON ({error.reason}); {hint}") from None
     except json.JSONDecodeError as error:
         raise CLIError(f"{where}: not JSON ({error.msg}, line {error.lineno}); {hint}") from None
-    if not isinstance(data, dict):
-        raise CLIError(f"{where}: expected the JSON object of 'jaximpact calibrate --json'")
-    record = data
-    if isinstance(data.get("ranking"), list):  # calibrate --law all: its m, g, separation
-        ranked = {r.get("law"): {**data, **r} for r in data["ranking"] if isinstance(r, dict)}
-        wanted = law if law is not None else data.get("best", next(iter(ranked), None))
-        if wanted not in ranked:
-            raise CLIError(
-                f"{where}: its ranking has no law {wanted!r}; it has {', '.join(map(str, ranked))}"
-            )
-        record = ranked[wanted]
-    name = record.get("law")
-    if law is not None and law != name and isinstance(name, str):
-        raise CLIError(f"--law {law} but {path} holds a fit of {name}")
-    user = (lambda params: file_law(name, params)) if is_file_law(name) else None
-    try:
-        return data, record, Fit.from_dict(record, law=user)
-    except LawFileError:  # its own one line, as `--law FILE.py:NAME` says it
-        raise
-    except ValueError as error:
-        raise CLIError(f"{where}: {error}") from None
+
+    def user_law(name):  # a user's law FILE.py:NAME, from its file
+        return (lambda params: file_law(name, params)) if is_file_law(name) else None
+
+    return (data, *fit_from_json(data, law, source=path, user_law=user_law))

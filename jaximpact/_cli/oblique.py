@@ -12,10 +12,8 @@ Or a video track of the ball bouncing across a floor, one row per frame: `t` (s)
 """
 
 import math
-import textwrap
 from pathlib import Path
 
-from .._files import read_table
 from .._plotting import plot_oblique
 from .._progress import metered
 from .._status import Status
@@ -35,11 +33,6 @@ from .common import (
     tangential_from_args,
     warn_sphere_density,
 )
-
-INCIDENCE = ("theta_deg", "v_n", "v_t", "omega")
-MEASURED = ("e_t", "omega_out")
-COLUMNS = INCIDENCE + MEASURED
-TRACK = ("t", "x", "y", "phi")
 
 
 def add_fit_oblique(subparsers):
@@ -172,21 +165,6 @@ def add_oblique_impact_arguments(parser):
     _add_sphere_arguments(parser, "as the engine you export to", "with --tangential: ")
 
 
-# the fields of `simulate`'s table of oblique impacts, one row per angle (their units the
-# result's own, `ObliqueResult`'s `_SHOWN`; angles in degrees)
-_TABLE = (
-    "e",
-    "e_t",
-    "e_t_contact",
-    "v_t_out",
-    "omega_out",
-    "angle_out",
-    "angle_out_contact",
-    "T",
-    "num_switches",
-)
-
-
 def check_oblique_arguments(args) -> None:
     """`--radius`, `--angle` and the rest of an oblique impact, or a one-line `CLIError`:
     asked without `--tangential`, missing, or out of range (before any work)."""
@@ -239,20 +217,11 @@ def _warn_unlikely_spin(omega: float, R: float, v0: float) -> None:
         )
 
 
-# what the oblique fields mean, printed under them
-_OBLIQUE_LEGEND = (
-    "e_t = v_t_out / v_t (the centre's), e_t_contact = u_out / u (the contact point's slip, "
-    "u = v_t - R omega; Chung & Ooi's beta = -e_t_contact); angle_out from the normal: the "
-    "centre's rebound, angle_out_contact the contact point's"
-)
-
-
 def run_oblique_impact(args, law, head: list[str]) -> int:
     """`simulate --tangential`: one oblique impact per `--angle`, printed as text (a line
     per field for one angle, a table for several) or JSON; `head`: the normal law's lines."""
-    from .._format import format_table
     from .._oblique import oblique_impact
-    from .._oblique.results import _SHOWN
+    from .._oblique.report import MEASURED, oblique_runs_text
 
     tangential = tangential_from_args(args)
     v0 = args.v0[0]
@@ -290,17 +259,7 @@ def run_oblique_impact(args, law, head: list[str]) -> int:
         f"separation by {args.separation}",
     ]
     lines = [*head, f"tangential {tangential!r}", *conditions, ""]
-    if len(runs) == 1:  # the result as it prints itself, after its incidence
-        lines += [f"{'angle':<17} = {runs[0]['angle_deg']:g} deg", results[0].summary()]
-    else:
-        units = {name: "deg" if unit == "rad" else unit for name, unit in _SHOWN}
-        header = [f"{n} ({units[n]})" if units[n] else n for n in _TABLE]
-        rows = [
-            [f"{d['angle_deg']:g}", *(_table_cell(d, n, units[n]) for n in _TABLE), d["status"]]
-            for d in runs
-        ]
-        lines += format_table(["angle (deg)", *header, "status"], rows)
-    lines += ["", *textwrap.wrap(_OBLIQUE_LEGEND, 92)]
+    lines += oblique_runs_text(runs, results)
     if args.plot is not None:
         lines.append(f"plot written to {args.plot}")
     failed = [d for d in runs if Status[d["status"]].is_failure]
@@ -320,94 +279,11 @@ def run_oblique_impact(args, law, head: list[str]) -> int:
     return 1 if failed else 0
 
 
-def _table_cell(data: dict, name: str, unit: str | None) -> str:
-    """One field of an oblique run in the table: a plain number (angles in degrees), a
-    count, or `-` where missing (NaN)."""
-    value = data[f"{name}_deg"] if unit == "deg" else data[name]
-    if value is None:
-        return "-"
-    return str(int(value)) if unit is None else f"{value:.4g}" if unit == "deg" else f"{value:.5g}"
-
-
-def read_track(path: Path, header, rows, g: float) -> dict:
-    """The rebounds (as `read_rebounds`, with `sigma_e_t` and `sigma_omega`) of the video
-    track in the CSV at `path` (`t, x, y, phi`), through `track_rebounds`."""
-    import numpy as np
-
-    from .._oblique import track_rebounds
-
-    if set(header) != set(TRACK):
-        raise CLIError(f"{path}: a track has the columns {', '.join(TRACK)} (one row per frame)")
-    for line, values in rows:
-        for name in header:
-            if math.isnan(values[name]):
-                raise CLIError(f"{path}, line {line}: no {name}; drop frames not tracked")
-    try:
-        track = track_rebounds(*(np.asarray([v[k] for _, v in rows]) for k in TRACK), g=g)
-        inputs = track.fit_inputs()
-    except ValueError as error:
-        raise CLIError(f"{path}: {error}") from None
-    out = {k: list(map(float, v)) for k, v in inputs.items()}
-    pairs = zip(out["v_n"], out["v_t"], strict=True)
-    out["theta"] = [math.degrees(math.atan2(t, n)) for n, t in pairs]
-    return out
-
-
-def read_rebounds(path: Path, speed: float | None, g: float = 9.81) -> dict:
-    """`{v_n, v_t, omega, e_t, omega_out, theta}` (lists; NaN where not measured) from the
-    CSV at `path`, rebounds or a video track (`read_track`, gravity `g` in m/s^2);
-    one-line `CLIError`s for what is missing or not a number."""
-    hint = f"{', '.join(COLUMNS)} (rebounds) or {', '.join(TRACK)} (a track)"
-    header, rows = read_table(path, COLUMNS + TRACK, label=str(path), hint=hint)
-    if "t" in header:
-        if speed is not None:
-            raise CLIError(f"{path} is a video track: --speed is not used; leave it out")
-        return read_track(path, header, rows, g)
-    by_angle = "theta_deg" in header
-    if by_angle == ("v_n" in header or "v_t" in header) or (
-        not by_angle and not {"v_n", "v_t"} <= set(header)
-    ):
-        raise CLIError(f"{path}: give the incidence as theta_deg or as v_n,v_t (not both)")
-    if by_angle and speed is None:
-        raise CLIError(f"{path} gives theta_deg: pass the impact speed --speed (m/s)")
-    if not by_angle and speed is not None:
-        raise CLIError(f"{path} gives v_n,v_t: --speed is not used; leave it out")
-    if not set(MEASURED) & set(header):
-        raise CLIError(f"{path}: no measured column (e_t and/or omega_out)")
-    columns = {name: [] for name in COLUMNS}
-    for number, given in rows:
-        values = dict.fromkeys(COLUMNS, math.nan) | {"omega": 0.0} | given
-        if by_angle:
-            theta = values["theta_deg"]
-            if not 0.0 <= theta < 90.0:
-                raise CLIError(
-                    f"{path}, line {number}: theta_deg = {theta:g} must lie in [0, 90) degrees "
-                    "from the normal"
-                )
-            values["v_n"] = speed * math.cos(math.radians(theta))
-            values["v_t"] = speed * math.sin(math.radians(theta))
-        for name in ("v_n", "v_t", "omega"):
-            if math.isnan(values[name]):
-                raise CLIError(f"{path}, line {number}: no {name}; every row needs its incidence")
-        if all(math.isnan(values[name]) for name in MEASURED):
-            raise CLIError(f"{path}, line {number}: neither e_t nor omega_out is given")
-        values["theta"] = math.degrees(math.atan2(values["v_t"], values["v_n"]))
-        for name in (*COLUMNS, "theta"):
-            columns.setdefault(name, []).append(values[name])
-    if not columns["v_n"]:
-        raise CLIError(f"{path} has no rows")
-    if by_angle and len(columns["v_n"]) > 1 and max(columns["theta_deg"]) <= math.pi / 2:
-        raise CLIError(
-            f"{path}: every theta_deg is at most {math.pi / 2:.4f}: radians? the column "
-            "takes degrees from the normal"
-        )
-    return columns
-
-
 def run_fit_oblique(args):
     import numpy as np
 
     from .._oblique import fit_oblique
+    from .._oblique.report import COLUMNS, MEASURED, fit_oblique_text, normal_check, read_rebounds
 
     check_plot_path(args.plot, inputs=(args.file,))
     warn_sphere_density(args.mass, args.radius)
@@ -459,9 +335,9 @@ def run_fit_oblique(args):
         bar.update(1, "done")
     if args.plot is not None:
         plot_oblique(args.plot, rows["theta"], {k: getattr(fit, k) for k in MEASURED}, rows)
-    check = _sanity(law, args.mass, float(np.max(rows["v_n"])))
+    check = normal_check(law, args.mass, float(np.max(rows["v_n"])))
     record = {**fit.to_dict(), "check": check, **({"normal": normal} if normal else {})}
-    emit(args, record, lambda: _report(fit, rows, check, normal))
+    emit(args, record, lambda: fit_oblique_text(fit, rows, check, normal))
     return 0
 
 
@@ -491,52 +367,3 @@ def normal_law_from_fit(path: Path, name: str | None, mass: float):
         "separation": separation,
         "from": str(path),
     }
-
-
-def _sanity(law, m: float, v_n: float) -> dict:
-    """What the normal law implies for mass `m` (kg) at the largest normal speed `v_n`
-    (m/s): contact time, penetration and peak force, so that a mass in the wrong unit shows
-    (e_t and the spin do not depend on it: both springs scale alike)."""
-    from .._solve.impact import impact
-
-    r = impact(law, m=m, v0=v_n)
-    return {"v_n": v_n, "T": float(r.T), "x_max": float(r.x_max), "F_max": float(r.F_max)}
-
-
-def _report(fit, rows, check, normal=None) -> str:
-    import numpy as np
-
-    from .._format import format_quantity
-
-    lines = [
-        *(
-            [
-                f"normal law {normal['law']} from {normal['from']} ("
-                + ", ".join(f"{k} = {v:g}" for k, v in normal["params"].items())
-                + f"; separation by {normal['separation']})"
-            ]
-            if normal
-            else []
-        ),
-        fit.summary(),
-        f"check: at v_n = {check['v_n']:.4g} m/s the normal law with this mass gives a contact "
-        f"time of {format_quantity(check['T'], 's')}, x_max {format_quantity(check['x_max'], 'm')}"
-        f", F_max {format_quantity(check['F_max'], 'N')}: if these look wrong, check the units "
-        "(--mass in kg; e_t and the spin do not depend on the mass)",
-        "",
-        "  theta [deg]   e_t meas   e_t fit   omega_out meas   fit [rad/s]",
-    ]
-    for i, theta in enumerate(rows["theta"]):
-        e_m, w_m = rows["e_t"][i], rows["omega_out"][i]
-        e_f, w_f = float(np.asarray(fit.e_t)[i]), float(np.asarray(fit.omega_out)[i])
-        lines.append(
-            f"  {theta:11.2f}   {_cell(e_m, '.3f'):>8}   {e_f:7.3f}   {_cell(w_m, '.1f'):>14}"
-            f"   {w_f:11.1f}"
-        )
-    if not bool(fit.converged):
-        lines.append("the fit did not converge (see the notes): try other start values (--tparam)")
-    return "\n".join(lines)
-
-
-def _cell(value: float, spec: str) -> str:
-    return "-" if math.isnan(value) else format(value, spec)

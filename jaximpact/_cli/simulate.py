@@ -3,7 +3,7 @@
 import math
 import textwrap
 
-from .._format import format_number, format_quantity, format_table, terminal_width
+from .._format import format_number, format_table, terminal_width
 from .._plotting import new_figure, plot_speed_sweep, save_figure
 from .common import (
     MASS_HELP,
@@ -11,7 +11,6 @@ from .common import (
     add_contact_arguments,
     add_law_arguments,
     add_output_arguments,
-    check_contact_scales,
     check_plot_path,
     command_parser,
     emit,
@@ -19,7 +18,6 @@ from .common import (
     parse_params,
     require_mass,
 )
-from .laws import law_title, law_units
 from .oblique import add_oblique_impact_arguments, check_oblique_arguments, run_oblique_impact
 
 # --------------------------------------------------------------------------------------
@@ -74,6 +72,7 @@ def _run_simulate(args):
     check_plot_path(args.plot)
     import numpy as np
 
+    from .._laws.scales import check_contact_scales
     from .._solve.impact import impact
 
     check_oblique_arguments(args)
@@ -86,8 +85,7 @@ def _run_simulate(args):
     for v0 in speeds:
         check_contact_scales(args.law, parse_params(args.param), args.mass, v0)
     if args.tangential is not None:
-        params = {k: float(v) for k, v in law.parameters.items()}
-        return run_oblique_impact(args, law, _head(law, {"params": params}))
+        return run_oblique_impact(args, law, _head(law))
     runs = []
     for v0 in speeds:
         conditions = dict(m=args.mass, v0=v0, separation=args.separation, g=args.gravity)
@@ -123,7 +121,7 @@ def _run_simulate(args):
         plot_impact(history, law, fig=fig)
         save_figure(fig, args.plot)
         data["plot"] = str(args.plot)
-    emit(args, data, lambda: _simulate_text(law, data))
+    emit(args, data, lambda: _simulate_text(law, data, result))
     return 0
 
 
@@ -135,12 +133,15 @@ def _result_units() -> dict[str, str]:
     return {name: unit for name, unit in _SHOWN if unit is not None}
 
 
-def _head(law, data) -> list[str]:
-    """The law, its parameters with units and the impact's conditions (`data`: one run)."""
-    units = law_units(law.name, data["params"])
+def _head(law) -> list[str]:
+    """The law with its equation, and its parameters with their units."""
+    from .._fit.calibrate import law_units
+    from .._fit.report import law_title
+
+    units = law_units(law)
     params = ", ".join(
-        f"{k} = {format_number(v)}" + (f" {units[k]}" if units.get(k, "-") != "-" else "")
-        for k, v in data["params"].items()
+        f"{k} = {format_number(v)}" + (f" {units[k]}" if units.get(k) else "")
+        for k, v in law.parameters.items()
     )
     return [f"law        {law_title(law.name)}", f"params     {params}"]
 
@@ -150,7 +151,7 @@ def _sweep_text(law, runs, width=None) -> str:
     fitted to the terminal (`_format.format_table`)."""
     first = runs[0]
     lines = [
-        *_head(law, first),
+        *_head(law),
         f"impact     m = {format_number(first['m'])} kg, g = {format_number(first['g'])} "
         f"m/s^2, separation by {first['separation']}",
         "",
@@ -179,22 +180,18 @@ def _sweep_text(law, runs, width=None) -> str:
     return "\n".join(lines)
 
 
-def _simulate_text(law, data) -> str:
+def _simulate_text(law, data, result) -> str:
+    """The law and the impact's conditions, then the result's fields as it prints them."""
+    _, *fields = result.summary().splitlines()  # below its title
     lines = [
-        *_head(law, data),
+        *_head(law),
         f"impact     m = {format_number(data['m'])} kg, v0 = {format_number(data['v0'])} m/s, "
         f"g = {format_number(data['g'])} m/s^2, separation by {data['separation']}",
         "",
+        textwrap.dedent("\n".join(fields)),
     ]
-    for key, unit in _result_units().items():
-        value = data[key]
-        if value is None:
-            continue
-        shown = f"{float(value):.4f}" if not unit else format_quantity(value, unit)
-        lines.append(f"{key:<10} = {shown}")
-    note = _STATUS_NOTES.get(data["status"])
-    lines.append(f"{'status':<10} = {data['status']}" + (f"  ({note})" if note else ""))
-    lines.append(f"{'path':<10} = {data['path']} ({int(data['num_steps'])} solver steps)")
+    if data["status"] in _STATUS_NOTES:
+        lines.append(f"{data['status']}: {_STATUS_NOTES[data['status']]}")
     if "plot" in data:
         lines.append(f"plot written to {data['plot']}")
     return "\n".join(lines)
