@@ -443,3 +443,113 @@ def run_bench(
 def steps(laws=LAWS) -> int:
     """How many times `run_bench(laws)` calls `on_step`."""
     return sum(name in laws for name, _, _ in CASES.values()) + 1
+
+
+def _us(seconds) -> str:
+    """Seconds as microseconds, 3 significant digits (integers from 100 up); `-` for None."""
+    if seconds is None:
+        return "-"
+    value = seconds * 1e6
+    return f"{value:.0f}" if value >= 100 else f"{value:.3g}"
+
+
+def _error(value) -> str:
+    if value is None or not math.isfinite(value):
+        return "-"
+    return "0" if value == 0 else f"{value:.1e}"
+
+
+def _ratio(row, kind) -> str:
+    ratio = row[f"ratio_{kind}"]
+    if ratio is None:
+        return "-"
+    verdict = "met" if row[f"target_{kind}_met"] else "MISSED"
+    return f"{ratio:.0f}x {verdict}" if ratio >= 100 else f"{ratio:.3g}x {verdict}"
+
+
+def bench_text(data: dict, width=None) -> str:
+    """The report of `run_bench`'s `data`, fitted to `width` columns (default: the
+    terminal's, 88 when stdout is not one): prose wrapped, the table's headers wrapped and,
+    where it is still too wide, its columns in two tables that each repeat the law."""
+    from ._format import format_number, format_table, terminal_width, wrap_text
+
+    width = terminal_width() if width is None else width
+    machine, cond = data["machine"], data["conditions"]
+    batch = data["rows"][0]["batch_size"] if data["rows"] else 0
+    rounds = data["rows"][0]["rounds"] if data["rows"] else 0
+    cache = machine["compilation_cache"]
+
+    def prose(*paragraphs) -> list[str]:  # each wrapped to the width
+        return [
+            line for p in paragraphs for line in (wrap_text(p, width, then="  ") if p else [""])
+        ]
+
+    out = prose(
+        f"jaximpact bench{' --quick' if cond['quick'] else ''}: default impact() against scipy "
+        f"solve_ivp DOP853 with an event; m = {format_number(cond['m'])} kg, "
+        f"v0 = {format_number(cond['v0'])} m/s, separation at zero force, float64",
+        f"machine: {machine['cpu_count']} CPUs ({machine['processor']}), jax {machine['jax']} "
+        f"({machine['backend']} backend), scipy {machine['scipy']}, python {machine['python']}",
+        f"load average (1, 5, 15 min): {machine['load_average']} at start, "
+        f"{machine['load_average_end']} at end",
+        f"compilation cache: {cache if cache else 'off'}",
+        "",
+    )
+    header = [
+        "law",
+        "path",
+        "err e",
+        "err T",
+        "jit us",
+        "compile s",
+        f"batch us ({batch})",
+        "batch compile s",
+        "scipy rtol",
+        "scipy err e",
+        "scipy us",
+        f"single (>= {TARGETS['single']:.0f}x)",
+        f"batch (>= {TARGETS['batch']:.0f}x)",
+    ]
+    rows = [
+        [
+            r["case"],
+            r["path"],
+            _error(r["err_e"]),
+            _error(r["err_T"]),
+            _us(r["single_s"]),
+            f"{r['compile_s']:.2g}",
+            _us(r["batch_s"]),
+            f"{r['batch_compile_s']:.2g}",
+            "-" if r["scipy_rtol"] is None else f"{r['scipy_rtol']:.1e}",
+            _error(r["scipy_err_e"]),
+            _us(r["scipy_s"]),
+            _ratio(r, "single"),
+            _ratio(r, "batch"),
+        ]
+        for r in data["rows"]
+    ]
+    out += format_table(header, rows, width=width)
+    limit = data["targets"]["error_e"]
+    loose = [r for r in data["rows"] if not (r["err_e"] is not None and r["err_e"] <= limit)]
+    if loose:
+        out += prose(
+            f"note: the default impact's error in e is above the {limit:.0e} that scipy is "
+            "held to for: " + ", ".join(f"{r['case']} ({_error(r['err_e'])})" for r in loose)
+        )
+    eu = data["euler"]
+    out += prose(
+        "",
+        f"seed paper's explicit Euler (scheme as printed), dt = {format_number(eu['dt'])} s, "
+        f"{eu['law']}: e = {eu['e']:.6f} against {eu['e_ref']:.6f} (contact until x = 0, "
+        f"scipy DOP853 1e-13): err e {_error(eu['err_e'])}, err T {_error(eu['err_T'])}, "
+        f"{_us(eu['single_s'])} us per impact (eager call)",
+        "",
+        "err: relative error against the reference (closed form where one exists, else scipy "
+        "DOP853 at rtol 1e-13); us: microseconds per impact after compilation (batch: per "
+        f"member of a jax.vmap over {batch} impact speeds in v0 x [0.8, 1.25]); compile s: "
+        "first call (tracing, compilation or the cache's load); ratios: scipy time / "
+        f"jaximpact time, median over {rounds} alternated rounds.",
+    )
+    if "plot" in data:
+        out += prose(f"plot written to {data['plot']}")
+    return "\n".join(out)

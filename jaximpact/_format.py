@@ -1,9 +1,11 @@
 """Numbers and quantities as people read them, and values as JSON can hold them: shared by
 the library's tables and reports, the results' `repr`, `summary()` and `to_dict()`
 (`ImpactResult`, `Fit`, `Ranking`) and the command line; and tables that fit the terminal
-(`format_table`, `wrap_text`, `terminal_width`)."""
+(`format_table`, `wrap_text`, `terminal_width`); and what to give instead of a number
+written with a unit (`unit_hint`)."""
 
 import math
+import re
 import textwrap
 
 _MULTIPLE_UNITS = {"N", "Pa", "W"}
@@ -309,3 +311,37 @@ def format_table(header, rows, *, width=None, wrap=(), keep=1, notes=None, note_
             at = max(0, min(indent, width - max(map(len, note.split()))))
             out += wrap_text(note, width, first=" " * at)
     return [line.replace(KEEP_TOGETHER, " ") for line in out]
+
+
+# a number written with a unit on the command line (`--radius 5mm`): what to give instead
+SI_NUMBERS = "numbers are given without a unit, in the units --help gives (SI: kg, m, s, N, Pa)"
+UNIT_WORD = re.compile(r"(?:[GMkcmuµn]?(?:m|g|s|N|Pa)|m/s|N/m(?:\^?1\.5)?|deg|rad(?:/s)?)")
+_SI_PREFIX = {
+    "G": 1e9,
+    "M": 1e6,
+    "k": 1e3,
+    "": 1.0,
+    "c": 1e-2,
+    "m": 1e-3,
+    "u": 1e-6,
+    "µ": 1e-6,
+    "n": 1e-9,
+}
+
+
+def unit_hint(text: str) -> str | None:
+    """For a number written with a unit (`"5mm"`, `"2.5 m/s"`, `"10g"`), what to give
+    instead (`"... 5mm is 0.005 (m)"`, converted where the unit is a prefixed kg, m, s, N or
+    Pa); None for text that is no such number."""
+    match = re.fullmatch(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S+)\s*", text)
+    if match is None or not UNIT_WORD.fullmatch(match.group(2)):
+        return None
+    number, unit = float(match.group(1)), match.group(2)
+    simple = re.fullmatch(r"([GMkcmuµn]?)(m|g|s|N|Pa)", unit)
+    if simple and unit not in ("ms", "mm", "mg", "cm") and simple.group(1) == "m":
+        simple = None  # a prefix m is milli only in the units above ("mN": no guess)
+    if simple is None:
+        return f"{SI_NUMBERS}: give {match.group(1)} if it is in that unit"
+    prefix, base = simple.groups()
+    scale, base = (_SI_PREFIX[prefix] * 1e-3, "kg") if base == "g" else (_SI_PREFIX[prefix], base)
+    return f"{SI_NUMBERS}: {text.strip()} is {number * scale:.6g} ({base})"

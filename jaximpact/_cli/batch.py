@@ -8,8 +8,6 @@ from .common import (
     add_law_arguments,
     command_parser,
     emit,
-    file_law,
-    is_file_law,
     parse_params,
 )
 
@@ -139,6 +137,7 @@ def _start_processes(args):
 
 def run_batch_command(args):
     from .._jobs import batch_file, check_output_file
+    from .._jobs.file_law import file_law, is_file_law
 
     if args.chunk_rows < 1:
         raise CLIError("--chunk-rows must be at least 1")

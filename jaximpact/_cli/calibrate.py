@@ -22,13 +22,12 @@ from .common import (
     add_free_argument,
     add_law_arguments,
     add_output_arguments,
+    add_words_argument,
     check_plot_path,
     command_parser,
     emit,
-    file_law,
     free_names,
     heartbeat_meter,
-    is_file_law,
     parse_params,
     require_mass,
 )
@@ -144,13 +143,11 @@ def add_posterior_arguments(parser):
         metavar="N",
         help="with --posterior: the random seed (default 0)",
     )
-    parser.add_argument(
+    add_words_argument(
+        parser,
         "--prior",
-        action="extend",
-        nargs="+",
-        default=[],
-        metavar="NAME=KIND:A:B",
-        help="with --posterior: a parameter's prior, SI units, KIND one of loguniform "
+        "NAME=KIND:A:B",
+        "with --posterior: a parameter's prior, SI units, KIND one of loguniform "
         "(A, B: the range), uniform, normal (mean, sd), lognormal (mu, sigma of ln x), e.g. "
         "--prior c=loguniform:1e5:1e8 (default: loguniform over three decades either side "
         "of the fitted value)",
@@ -159,69 +156,35 @@ def add_posterior_arguments(parser):
 
 def posterior_options(args) -> dict | None:
     """The checked `--posterior` options (None without `--posterior`), before any fit:
-    `method`, `draws`, `seed`, `prior` ({name: (kind, a, b)})."""
-    from .._posterior.priors import parse_prior
+    `posterior`'s `method`, `num_samples` and `prior` ({name: (kind, a, b)}, or None), and
+    the random `seed`."""
+    from .._posterior.command import priors_from_words
 
     if args.posterior is None:
-        given = [
-            f
-            for f, v in (
-                ("--prior", args.prior),
-                ("--draws", args.draws != 2000),
-                ("--seed", args.seed != 0),
-            )
-            if v
-        ]
+        flags = {"--prior": args.prior, "--draws": args.draws != 2000, "--seed": args.seed != 0}
+        given = [flag for flag, v in flags.items() if v]
         if given:
             raise CLIError(f"{' and '.join(given)} need --posterior")
         return None
     if args.draws < 1:
         raise CLIError(f"--draws must be at least 1, got {args.draws}")
-    prior = {}
-    for item in args.prior:
-        name, sep, spec = item.partition("=")
-        parts = spec.split(":")
-        if not sep or not name.strip() or len(parts) != 3:
-            raise CLIError(f"--prior {item!r} must be NAME=KIND:A:B, e.g. c=loguniform:1e5:1e8")
-        name = name.strip()
-        if name in prior:
-            raise CLIError(f"--prior {name} is given twice")
-        try:
-            prior[name] = parse_prior(name, (parts[0], parts[1], parts[2])).as_tuple()
-        except ValueError as error:
-            raise CLIError(f"--prior {item!r}: {error}") from None
-    return dict(method=args.posterior, draws=args.draws, seed=args.seed, prior=prior)
+    prior = priors_from_words(args.prior)  # checked before any fit
+    return dict(method=args.posterior, num_samples=args.draws, seed=args.seed, prior=prior or None)
 
 
-# the draws the JSON of a posterior holds: enough for the engine's band of `export --from`
-JSON_DRAWS = 200
-
-
-def sample_posterior(fit, options):
+def sample_posterior(fit, sampling):
     """`(posterior, record)`: the posterior of `fit` (`jaximpact.posterior`) and its JSON
-    record, `Posterior.to_dict(samples=False)` with `JSON_DRAWS` evenly thinned draws
-    (`samples`, `z`) and `thinned` (how many, of how many); the statistics are those of
-    all the draws."""
+    record with its draws thinned (`_posterior.command.thinned_record`)."""
     import jax
 
     from .._posterior import posterior
+    from .._posterior.command import thinned_record
 
-    with metered(heartbeat_meter(), 1, f"posterior ({options['method']})") as bar:
-        key = jax.random.key(options["seed"])
-        post = posterior(
-            fit,
-            prior=options["prior"] or None,
-            method=options["method"],
-            num_samples=options["draws"],
-            key=key,
-        )
+    with metered(heartbeat_meter(), 1, f"posterior ({sampling['method']})") as bar:
+        options = {k: v for k, v in sampling.items() if k != "seed"}
+        post = posterior(fit, **options, key=jax.random.key(sampling["seed"]))
         bar.update(1, "done")
-    record = post.to_dict(samples=False)
-    rows = post.draw_indices(JSON_DRAWS)
-    record["samples"] = {k: [float(x) for x in v[rows]] for k, v in post.samples.items()}
-    record["z"] = [[float(x) for x in row] for row in post.z[rows]]
-    record["thinned"] = {"draws": int(len(rows)), "of": post.num_draws}
-    return post, record
+    return post, thinned_record(post)
 
 
 # --------------------------------------------------------------------------- the data
@@ -320,6 +283,7 @@ def _run_one(args, data, sampling=None):
     from .._fit.model_choice import starting_law
     from .._fit.parameters import default_free
     from .._fit.report import fit_record, fit_text
+    from .._jobs.file_law import file_law, is_file_law
     from .._laws import LAW_NAMES, LAWS
 
     given = parse_params(args.param)

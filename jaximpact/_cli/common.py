@@ -1,7 +1,8 @@
 """What the subcommands share: the one-line error (`CLIError`, `fail`), the parser factory
-and argument groups, reading `--param NAME=VALUE` and a user's law `--law FILE.py:NAME`
-(`file_law`, its file loaded by `_laws.custom.load_law_function`), `--json` output (`emit`)
-and JAX's set-up (`configure_jax`). `--plot FILE` goes through `jaximpact._plotting`
+and argument groups, reading `--param NAME=VALUE` (a user's law `--law FILE.py:NAME` is
+`_jobs.file_law`'s, a fit's file `_fit.fit_file`'s), `--json` output (`emit`) and JAX's
+set-up (`configure_jax`). They import nothing heavy when they load: JAX loads after
+`console_environment`. `--plot FILE` goes through `jaximpact._plotting`
 (matplotlib's Agg backend, imported only then); anything long reports through a meter of
 `jaximpact._progress` on stderr."""
 
@@ -15,7 +16,7 @@ from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 
 from .._cache import enable_cache
-from .._format import jsonable
+from .._format import SI_NUMBERS, UNIT_WORD, jsonable, unit_hint
 from .._interrupt import stop_at_once
 
 PROG = "jaximpact"
@@ -39,7 +40,7 @@ class Parser(argparse.ArgumentParser):
         loose = re.match(r"unrecognized arguments: (.*)$", message)
         if bad and unit_hint(bad.group(1)):
             message += f": {unit_hint(bad.group(1))}"
-        elif loose and all(_UNIT.fullmatch(word) for word in loose.group(1).split()):
+        elif loose and all(UNIT_WORD.fullmatch(word) for word in loose.group(1).split()):
             message += f": {SI_NUMBERS}"
         elif loose and all(_is_number(word) for word in loose.group(1).split()):
             if _takes_data(self):
@@ -67,39 +68,6 @@ def _is_number(word: str) -> bool:
     except ValueError:
         return False
     return True
-
-
-SI_NUMBERS = "numbers are given without a unit, in the units --help gives (SI: kg, m, s, N, Pa)"
-_UNIT = re.compile(r"(?:[GMkcmuµn]?(?:m|g|s|N|Pa)|m/s|N/m(?:\^?1\.5)?|deg|rad(?:/s)?)")
-_PREFIX = {
-    "G": 1e9,
-    "M": 1e6,
-    "k": 1e3,
-    "": 1.0,
-    "c": 1e-2,
-    "m": 1e-3,
-    "u": 1e-6,
-    "µ": 1e-6,
-    "n": 1e-9,
-}
-
-
-def unit_hint(text: str) -> str | None:
-    """For a number written with a unit (`"5mm"`, `"2.5 m/s"`, `"10g"`), what to give
-    instead (`"... 5mm is 0.005 (m)"`, converted where the unit is a prefixed kg, m, s, N or
-    Pa); None for text that is no such number."""
-    match = re.fullmatch(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S+)\s*", text)
-    if match is None or not _UNIT.fullmatch(match.group(2)):
-        return None
-    number, unit = float(match.group(1)), match.group(2)
-    simple = re.fullmatch(r"([GMkcmuµn]?)(m|g|s|N|Pa)", unit)
-    if simple and unit not in ("ms", "mm", "mg", "cm") and simple.group(1) == "m":
-        simple = None  # a prefix m is milli only in the units above ("mN": no guess)
-    if simple is None:
-        return f"{SI_NUMBERS}: give {match.group(1)} if it is in that unit"
-    prefix, base = simple.groups()
-    scale, base = (_PREFIX[prefix] * 1e-3, "kg") if base == "g" else (_PREFIX[prefix], base)
-    return f"{SI_NUMBERS}: {text.strip()} is {number * scale:.6g} ({base})"
 
 
 def fail(message: str, status: int):
@@ -152,9 +120,13 @@ def add_law_arguments(parser, *, required: bool = True, law=LAW_HELP, param=PARA
     """`--law NAME` (or `FILE.py:NAME`) and `--param NAME=VALUE` (repeatable), with the
     helps `law` and `param`; read them with `law_from_args`."""
     parser.add_argument("--law", required=required, metavar="NAME", help=law)
-    parser.add_argument(
-        "--param", action="extend", nargs="+", default=[], metavar="NAME=VALUE", help=param
-    )
+    add_words_argument(parser, "--param", "NAME=VALUE", param)
+
+
+def add_words_argument(parser, flag: str, metavar: str, help: str):
+    """`flag WORD ...`, repeatable (`--param c=2e6 b1=800`, or `--param c=2e6 --param
+    b1=800`): the list of the words, empty when not given."""
+    parser.add_argument(flag, action="extend", nargs="+", default=[], metavar=metavar, help=help)
 
 
 def add_free_argument(parser, help: str):
@@ -189,14 +161,7 @@ def add_tangential_arguments(parser, *, required: bool, help: str, tparam_help: 
         metavar="NAME",
         help=f"{help} (one of %(choices)s)",
     )
-    parser.add_argument(
-        "--tparam",
-        action="extend",
-        nargs="+",
-        default=[],
-        metavar="NAME=VALUE",
-        help=tparam_help,
-    )
+    add_words_argument(parser, "--tparam", "NAME=VALUE", tparam_help)
 
 
 def tangential_from_args(args):
@@ -301,32 +266,6 @@ def check_argument_scales(args):
                 check_scale(f"--{dest.replace('_', '-')}", number)
 
 
-# the mean densities (kg/m^3) a sphere of a command's --mass and --radius plausibly has: a
-# thin hollow ball (a ping-pong ball: 80) to osmium (22,590); a radius in mm given as m
-# moves it by 1e-9, a mass in g given as kg by 1e3
-PLAUSIBLE_DENSITY = (1.0, 3e4)
-
-
-def warn_sphere_density(m, R) -> None:
-    """A warning (one line on the command line) where a sphere of mass `m` (kg) and
-    radius `R` (m) would have a mean density outside `PLAUSIBLE_DENSITY`: a unit is
-    likely wrong. Nothing for values the commands' own checks refuse."""
-    import math
-    import warnings
-
-    if m is None or R is None or not (math.isfinite(m) and math.isfinite(R) and m > 0 and R > 0):
-        return
-    density = m / (4.0 / 3.0 * math.pi * R**3)
-    low, high = PLAUSIBLE_DENSITY
-    if not low <= density <= high:
-        warnings.warn(
-            f"a sphere of --mass {m:g} kg and --radius {R:g} m has a mean density of "
-            f"{density:.3g} kg/m^3, outside {low:g} to {high:g} (a ping-pong ball's is 80, "
-            "steel's 7800): check the units (--mass in kg, --radius in m)",
-            stacklevel=2,
-        )
-
-
 def free_names(items) -> tuple[str, ...] | None:
     """`--free c,b1` or `--free c b1` -> `("c", "b1")`; None when not given."""
     if not items:
@@ -342,75 +281,9 @@ def free_names(items) -> tuple[str, ...] | None:
 def law_from_args(args):
     """The law of `--law` and `--param` (the library checks the name and the values): a law
     of the table, or a user's law `FILE.py:NAME` (`file_law`)."""
+    from .._jobs.file_law import make_law
+
     return make_law(args.law, parse_params(args.param))
-
-
-def make_law(name: str, params: dict):
-    """The law `name` (of the table, or a user's `FILE.py:NAME`) with `params`."""
-    if is_file_law(name):
-        return file_law(name, params)
-    from .._laws import law
-
-    return law(name, **params)
-
-
-# --------------------------------------------------------------------------------------
-# A user's law on the command line: --law FILE.py:NAME
-# --------------------------------------------------------------------------------------
-
-
-def is_file_law(name) -> bool:
-    """Whether `--law name` names a user's law, `FILE.py:NAME` (a table name has no colon;
-    a name ending in `.py` is a file whose function is not named: `load_law_function` says
-    so)."""
-    return isinstance(name, str) and (":" in name or name.endswith(".py"))
-
-
-def file_law(text: str, params: dict, *, complete: bool = True):
-    """The user's law `FILE.py:NAME` (`text`, its name in all output) with the parameters
-    `params` (`--param`): `custom_law(fn, **params)` of the function NAME of the file.
-    With `complete`, its function is traced once (no numbers, no compilation): a
-    parameter it reads that `params` lacks (its `KeyError`), or one of `params` it does not
-    read, is a one-line `CLIError`; without (`jaximpact batch`, whose table's columns may
-    give parameters), the job checks them."""
-    from .._laws import CustomLaw, custom_law
-    from .._laws.custom import load_law_function
-
-    fn = load_law_function(text)
-    law = custom_law(fn, **params) if params else CustomLaw(fn, {}, text)
-    law = CustomLaw(law.fn, law.params, text)
-    if complete:
-        check_file_law(law)
-    return law
-
-
-def check_file_law(law):
-    """One-line `CLIError`s for a user's law of the command line (`file_law`) whose function
-    reads a parameter that `--param` does not give, fails when traced, or is given a
-    parameter it does not read."""
-    from .._jobs.job_law import MissingParameter, parameters_read
-    from .._laws.custom import first_line, line_in
-
-    text = law.name
-    try:
-        read = parameters_read(law.fn, law.params)
-    except MissingParameter as error:
-        key = error.args[0]
-        raise CLIError(
-            f"{text} reads params[{json.dumps(key)}]: give it with --param {key}=..."
-        ) from None
-    except Exception as error:  # the user's function: where it failed, in one line
-        raise CLIError(
-            f"{text} failed when called as NAME(x, v, params) with numbers ("
-            f"{type(error).__name__}{line_in(error, law.fn)}: {first_line(error)})"
-        ) from None
-    unread = [k for k in law.params if k not in read]
-    if unread:
-        reads = ", ".join(read) or "no parameter"
-        raise CLIError(
-            f"--param {unread[0]}: {text} does not read params["
-            f"{json.dumps(unread[0])}] (it reads {reads})"
-        )
 
 
 def check_plot_path(path: Path | None, inputs=()):
@@ -488,24 +361,13 @@ def heartbeat_meter(delay=None):
 
 
 def read_fit(path: str, law: str | None = None):
-    """`(data, record, fit)` of the JSON file `path` ('-': stdin) that `jaximpact calibrate
-    --json` writes: the whole object, the one fit in it (one law; of `--law all`'s ranking
-    its best, or the law `law` names) and that fit read back (`Fit.from_dict`; a user's law
-    FILE.py:NAME from its file). A file that is no such fit is a one-line `CLIError` (the
-    one reading of a fit's file, for `export --from` and `fit-oblique --from`)."""
-    from .._fit.report import fit_from_json
-
-    where, hint = f"--from {path}", "write it with 'jaximpact calibrate ... --json > FILE'"
-    try:
-        data = json.loads(sys.stdin.read() if path == "-" else Path(path).read_bytes())
-    except OSError as error:
-        raise CLIError(f"{where}: cannot read it ({error.strerror or error})") from None
-    except UnicodeDecodeError as error:
-        raise CLIError(f"{where}: not JSON ({error.reason}); {hint}") from None
-    except json.JSONDecodeError as error:
-        raise CLIError(f"{where}: not JSON ({error.msg}, line {error.lineno}); {hint}") from None
+    """`(data, record, fit)` of the fit's JSON file `path` ('-': stdin) that `jaximpact
+    calibrate --json` writes (`_fit.fit_file.read_fit_file`), a user's law FILE.py:NAME
+    read from its file."""
+    from .._fit.fit_file import read_fit_file
+    from .._jobs.file_law import file_law, is_file_law
 
     def user_law(name):  # a user's law FILE.py:NAME, from its file
         return (lambda params: file_law(name, params)) if is_file_law(name) else None
 
-    return (data, *fit_from_json(data, law, source=path, user_law=user_law))
+    return read_fit_file(path, law, user_law=user_law)

@@ -7,7 +7,6 @@ from .common import (
     add_output_arguments,
     command_parser,
     emit,
-    is_file_law,
 )
 
 # --------------------------------------------------------------------------------------
@@ -60,6 +59,8 @@ def _laws_text(rows, width=None, tangential=()) -> str:
 def _chosen(rows, tangential, names):
     """The rows of both tables whose names begin with one of `names` (a name as people
     write it: any case, `-` for `_`), or a one-line `CLIError` naming the nearest laws."""
+    from .._jobs.file_law import is_file_law
+
     everything = [r["name"] for r in (*rows, *tangential)]
     wanted = set()
     for name in names:

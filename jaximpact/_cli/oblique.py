@@ -31,7 +31,6 @@ from .common import (
     law_from_args,
     read_fit,
     tangential_from_args,
-    warn_sphere_density,
 )
 
 
@@ -168,6 +167,8 @@ def add_oblique_impact_arguments(parser):
 def check_oblique_arguments(args) -> None:
     """`--radius`, `--angle` and the rest of an oblique impact, or a one-line `CLIError`:
     asked without `--tangential`, missing, or out of range (before any work)."""
+    from .._engines.materials import warn_sphere_density
+
     oblique = {"--radius": args.radius, "--angle": args.angle}
     if args.tangential is None:
         given = [flag for flag, value in oblique.items() if value is not None]
@@ -282,6 +283,7 @@ def run_oblique_impact(args, law, head: list[str]) -> int:
 def run_fit_oblique(args):
     import numpy as np
 
+    from .._engines.materials import warn_sphere_density
     from .._oblique import fit_oblique
     from .._oblique.report import COLUMNS, MEASURED, fit_oblique_text, normal_check, read_rebounds
 

@@ -40,6 +40,7 @@ def _run_paper(args):
     import sys
 
     from .._paper.cases import select_cases
+    from .._paper.report import paper_text
     from .._paper.reproduce import reproduce_paper
 
     if args.out.exists() and not args.out.is_dir():
@@ -50,23 +51,4 @@ def _run_paper(args):
     result = reproduce_paper(
         args.out, only=args.figures, figures=not args.no_plots, progress=sys.stderr.isatty()
     )
-    emit(args, dict(out=str(args.out), **result), lambda: _paper_text(result))
-
-
-def _paper_text(result) -> str:
-    from .._paper.cases import COLUMNS
-
-    lines = [
-        "fig.   law                      printed  Euler(paper)  converged(force)  "
-        "converged(pen.)  nearest"
-    ]
-    for row in result["rows"]:
-        printed = "-" if row["printed"] is None else f"{row['printed']:.2f}"
-        lines.append(
-            f"{row['figure']:<6} {row['law']:<24} {printed:>7}  {row['e_paper']:>12.4f}  "
-            f"{row['e_force']:>15.4f}  {row['e_penetration']:>15.4f}  "
-            f"{COLUMNS.get(row['nearest'], '-')}"
-        )
-    lines.append("")
-    lines += [f"wrote {path}" for path in result["files"]]
-    return "\n".join(lines)
+    emit(args, dict(out=str(args.out), **result), lambda: paper_text(result))

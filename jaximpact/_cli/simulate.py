@@ -1,9 +1,8 @@
 """`jaximpact simulate`: one impact, its e, T, x_max, F_max, ... and a figure."""
 
 import math
-import textwrap
 
-from .._format import format_number, format_table, terminal_width
+from .._format import format_number
 from .._plotting import new_figure, plot_speed_sweep, save_figure
 from .common import (
     MASS_HELP,
@@ -19,17 +18,6 @@ from .common import (
     require_mass,
 )
 from .oblique import add_oblique_impact_arguments, check_oblique_arguments, run_oblique_impact
-
-# --------------------------------------------------------------------------------------
-# jaximpact simulate
-# --------------------------------------------------------------------------------------
-
-_STATUS_NOTES = {
-    "stuck": "a dry force held the body at rest inside the surface (e = 0); T is when it stopped",
-    "captured": "the body never left the surface (e = 0); T is when the solve gave up",
-    "out_of_steps": "the solver ran out of steps before the contact ended; "
-    "the numbers are not to be trusted",
-}
 
 
 def add_simulate(subparsers):
@@ -74,6 +62,7 @@ def _run_simulate(args):
 
     from .._laws.scales import check_contact_scales
     from .._solve.impact import impact
+    from .._solve.results import impact_record, impact_text, sweep_text
 
     check_oblique_arguments(args)
     law = law_from_args(args)
@@ -90,17 +79,7 @@ def _run_simulate(args):
     for v0 in speeds:
         conditions = dict(m=args.mass, v0=v0, separation=args.separation, g=args.gravity)
         result = impact(law, **conditions)
-        data = {
-            "law": law.name,
-            "params": {k: float(v) for k, v in law.parameters.items()},
-            "m": args.mass,
-            "v0": v0,
-            "separation": args.separation,
-            "g": args.gravity,
-            **result.to_dict(),
-        }
-        data["units"] = {k: u or "-" for k, u in _result_units().items()}
-        runs.append(data)
+        runs.append(impact_record(law, result, **conditions))
     if len(runs) > 1:
         if args.plot is not None:
             title = f"{law.name}, m = {format_number(runs[0]['m'])} kg"
@@ -108,29 +87,20 @@ def _run_simulate(args):
             plot_speed_sweep(args.plot, [r["v0"] for r in runs], e, T, title)
             for data in runs:
                 data["plot"] = str(args.plot)
-        emit(args, runs, lambda: _sweep_text(law, runs))
+        emit(args, runs, lambda: sweep_text(runs, _head(law)))
         return 0
     (data,) = runs
     if args.plot is not None:
         from .._plotting import plot_impact
 
-        conditions = dict(m=args.mass, v0=data["v0"], separation=args.separation, g=args.gravity)
         ts = np.linspace(0.0, 1.05 * float(data["T"]), 600)
-        history = impact(law, **conditions, ts=ts)
+        history = impact(law, **conditions, ts=ts)  # the one speed's
         fig = new_figure(figsize=(13.5, 4.2), layout="constrained")
         plot_impact(history, law, fig=fig)
         save_figure(fig, args.plot)
         data["plot"] = str(args.plot)
-    emit(args, data, lambda: _simulate_text(law, data, result))
+    emit(args, data, lambda: impact_text(result, data, _head(law)))
     return 0
-
-
-def _result_units() -> dict[str, str]:
-    """The impact's fields and their units as `ImpactResult` shows them (its `_SHOWN`),
-    in its order; the solver's steps are said with the path."""
-    from .._solve.results import _SHOWN
-
-    return {name: unit for name, unit in _SHOWN if unit is not None}
 
 
 def _head(law) -> list[str]:
@@ -144,54 +114,3 @@ def _head(law) -> list[str]:
         for k, v in law.parameters.items()
     )
     return [f"law        {law_title(law.name)}", f"params     {params}"]
-
-
-def _sweep_text(law, runs, width=None) -> str:
-    """A sweep: the law and conditions, then one row per speed (SI units in the header),
-    fitted to the terminal (`_format.format_table`)."""
-    first = runs[0]
-    lines = [
-        *_head(law),
-        f"impact     m = {format_number(first['m'])} kg, g = {format_number(first['g'])} "
-        f"m/s^2, separation by {first['separation']}",
-        "",
-    ]
-    units = _result_units()
-    keys = [k for k in units if first[k] is not None and k != "v_out"]  # v_out = -e v0
-    header = ["v0 (m/s)", *(f"{k} ({units[k]})" if units[k] else k for k in keys)]
-    # status and path as columns where they change with the speed, else said once
-    varying = [k for k in ("status", "path") if len({r[k] for r in runs}) > 1]
-    header += varying
-    rows = [
-        [format_number(r["v0"]), *(f"{float(r[k]):.5g}" for k in keys), *(r[k] for k in varying)]
-        for r in runs
-    ]
-    lines += format_table(header, rows, width=width)
-    same = [f"{k} {first[k]}" for k in ("status", "path") if k not in varying]
-    if same:
-        lines.append(f"at every speed: {', '.join(same)}")
-    notes = {r["status"] for r in runs} & set(_STATUS_NOTES)
-    for status in sorted(notes):
-        lines += textwrap.wrap(
-            f"{status}: {_STATUS_NOTES[status]}", width or terminal_width(), subsequent_indent="  "
-        )
-    if "plot" in first:
-        lines.append(f"plot written to {first['plot']}")
-    return "\n".join(lines)
-
-
-def _simulate_text(law, data, result) -> str:
-    """The law and the impact's conditions, then the result's fields as it prints them."""
-    _, *fields = result.summary().splitlines()  # below its title
-    lines = [
-        *_head(law),
-        f"impact     m = {format_number(data['m'])} kg, v0 = {format_number(data['v0'])} m/s, "
-        f"g = {format_number(data['g'])} m/s^2, separation by {data['separation']}",
-        "",
-        textwrap.dedent("\n".join(fields)),
-    ]
-    if data["status"] in _STATUS_NOTES:
-        lines.append(f"{data['status']}: {_STATUS_NOTES[data['status']]}")
-    if "plot" in data:
-        lines.append(f"plot written to {data['plot']}")
-    return "\n".join(lines)

@@ -185,6 +185,31 @@ PLAUSIBLE_MODULUS = (1e5, 1e12)
 SHEAR_FACTOR = 100.0
 
 
+# the mean densities (kg/m^3) a sphere of a command's --mass and --radius plausibly has: a
+# thin hollow ball (a ping-pong ball: 80) to osmium (22,590); a radius in mm given as m
+# moves it by 1e-9, a mass in g given as kg by 1e3
+PLAUSIBLE_DENSITY = (1.0, 3e4)
+
+
+def warn_sphere_density(m, R) -> None:
+    """A warning (one line on the command line) where a sphere of mass `m` (kg) and
+    radius `R` (m) would have a mean density outside `PLAUSIBLE_DENSITY`: a unit is
+    likely wrong. Nothing for values the commands' own checks refuse."""
+    import warnings
+
+    if m is None or R is None or not (math.isfinite(m) and math.isfinite(R) and m > 0 and R > 0):
+        return
+    density = m / (4.0 / 3.0 * math.pi * R**3)
+    low, high = PLAUSIBLE_DENSITY
+    if not low <= density <= high:
+        warnings.warn(
+            f"a sphere of --mass {m:g} kg and --radius {R:g} m has a mean density of "
+            f"{density:.3g} kg/m^3, outside {low:g} to {high:g} (a ping-pong ball's is 80, "
+            "steel's 7800): check the units (--mass in kg, --radius in m)",
+            stacklevel=2,
+        )
+
+
 def hertz_constant(law, v0: float) -> float | None:
     """The Hertz constant `c` (N/m^1.5) of `law`'s elastic force `c x^1.5` (a family law
     with `n = 1.5` at speed `v0`, m/s, or a law whose `c` is in N/m^1.5: JKR's, Thornton's),

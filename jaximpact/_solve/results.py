@@ -133,3 +133,89 @@ def status_names(status, kinds=Status):
     if codes.ndim == 0:
         return names.get(int(codes), int(codes))
     return [names.get(int(c), int(c)) for c in codes.ravel()]
+
+
+# what `jaximpact simulate` says below an impact that ended so
+STATUS_NOTES = {
+    "stuck": "a dry force held the body at rest inside the surface (e = 0); T is when it stopped",
+    "captured": "the body never left the surface (e = 0); T is when the solve gave up",
+    "out_of_steps": "the solver ran out of steps before the contact ended; "
+    "the numbers are not to be trusted",
+}
+# the fields with a unit, as `summary()` shows them, in its order
+UNITS = {name: unit for name, unit in _SHOWN if unit is not None}
+
+
+def impact_record(law, result: ImpactResult, **conditions) -> dict:
+    """One impact as `jaximpact simulate --json` prints it: the law by its name and
+    parameters, the `conditions` (`m`, `v0`, `separation`, `g`), `result.to_dict()` and
+    the units of its fields."""
+    params = {k: float(v) for k, v in law.parameters.items()}
+    units = {k: u or "-" for k, u in UNITS.items()}
+    return {"law": law.name, "params": params, **conditions, **result.to_dict(), "units": units}
+
+
+def _closing(records, width=None, *, wrap: bool = True) -> list[str]:
+    """The notes on the statuses of `records` (with `wrap`, wrapped to `width` columns,
+    default the terminal's) and the line of the plot written."""
+    import textwrap
+
+    from .._format import terminal_width
+
+    lines = []
+    for name in sorted({r["status"] for r in records} & set(STATUS_NOTES)):
+        note = f"{name}: {STATUS_NOTES[name]}"
+        lines += (
+            textwrap.wrap(note, width or terminal_width(), subsequent_indent="  ")
+            if wrap
+            else [note]
+        )
+    if "plot" in records[0]:
+        lines.append(f"plot written to {records[0]['plot']}")
+    return lines
+
+
+def impact_text(result: ImpactResult, record: dict, head: list[str]) -> str:
+    """An `impact_record` as text: the `head` lines (the law), the conditions, then the
+    result's fields as `summary()` prints them and a note on how it ended."""
+    import textwrap
+
+    from .._format import format_number
+
+    _, *fields = result.summary().splitlines()  # below its title
+    lines = [
+        *head,
+        f"impact     m = {format_number(record['m'])} kg, v0 = {format_number(record['v0'])} "
+        f"m/s, g = {format_number(record['g'])} m/s^2, separation by {record['separation']}",
+        "",
+        textwrap.dedent("\n".join(fields)),
+    ]
+    return "\n".join(lines + _closing([record], wrap=False))
+
+
+def sweep_text(records: list[dict], head: list[str], width=None) -> str:
+    """A sweep of `impact_record`s over the speed: the `head` lines and the conditions,
+    then one row per speed (SI units in the header) fitted to `width` columns (default the
+    terminal's; `_format.format_table`)."""
+    from .._format import format_number, format_table
+
+    first = records[0]
+    lines = [
+        *head,
+        f"impact     m = {format_number(first['m'])} kg, g = {format_number(first['g'])} "
+        f"m/s^2, separation by {first['separation']}",
+        "",
+    ]
+    keys = [k for k in UNITS if first[k] is not None and k != "v_out"]  # v_out = -e v0
+    header = ["v0 (m/s)", *(f"{k} ({UNITS[k]})" if UNITS[k] else k for k in keys)]
+    # status and path as columns where they change with the speed, else said once
+    varying = [k for k in ("status", "path") if len({r[k] for r in records}) > 1]
+    rows = [
+        [format_number(r["v0"]), *(f"{float(r[k]):.5g}" for k in keys), *(r[k] for k in varying)]
+        for r in records
+    ]
+    lines += format_table([*header, *varying], rows, width=width)
+    same = [f"{k} {first[k]}" for k in ("status", "path") if k not in varying]
+    if same:
+        lines.append(f"at every speed: {', '.join(same)}")
+    return "\n".join(lines + _closing(records, width))
