@@ -4,8 +4,10 @@ Marquardt in numpy around a compiled `evaluate(theta) -> (residuals, Jacobian, e
 numpy drives it, not optimistix, because each fit needs what optimistix's least-squares
 solvers do not give: a mask of components held fixed between stages, a model that may fail at
 a trial point (a NaN residual is a rejected step, not an error), and the `extra` outputs of the
-accepted point. `calibrate` runs inside one compiled program and uses optimistix's
-Levenberg-Marquardt there.
+accepted point. An eager `calibrate` runs it too (`optimizer="auto"`); a traced one keeps
+optimistix's or optax's inside its program, and `fit_oblique` runs optimistix's
+Levenberg-Marquardt around a host callback (its loss has kinks where impacts change between
+sticking and slipping, and this driver stopped short on one).
 """
 
 import dataclasses

@@ -1,10 +1,14 @@
 """Fitting a tangential law to measured oblique rebounds: `fit_oblique`, Levenberg-Marquardt
 (optimistix) on the logarithms of the free parameters from several starts (the given one
-and the best minima of a log grid, whose losses are evaluated first in one batch), the
-impacts solved with forward-mode derivatives through every stick-slip transition, standard
-errors from the Jacobian, and the parameters the data do not bound, with their one-sided
-bounds, found by probing the loss."""
+and the best minima of a log grid, whose losses are evaluated first), the impacts solved
+with forward-mode derivatives through every stick-slip transition, standard errors from the
+Jacobian, and the parameters the data do not bound, with their one-sided bounds, found by
+probing the loss. One compiled program (`_evaluated`: residuals, Jacobian, impacts) serves
+the grid, the optimiser (by a host callback from its loop) and the probes."""
 
+import concurrent.futures
+import itertools
+import os
 import warnings
 
 import diffrax as dfx
@@ -262,9 +266,6 @@ class _Problem(eqx.Module):
         return jnp.concatenate(parts)
 
 
-# thetas per call of `_evaluate` (one compiled batch shape serves the grid, the refined
-# starts and the probes)
-_CHUNK = 16
 # the grid of starts: the stiffness over two decades either side of the start, `mu` over
 # one decade either side (9 values); the best `max_starts - 1` of the grid's local minima
 # are refined beside the given start
@@ -277,59 +278,119 @@ _CHI2_BOUND = 2.705543454095404
 _NEAR = 2.0
 
 
-@eqx.filter_jit
 def _evaluate(problem, thetas):
-    """The residuals at each theta (rows of `thetas`) and whether every impact separated."""
+    """The residuals at each theta (rows of `thetas`) and whether every impact separated:
+    `_evaluated` row by row, so that a fit compiles its solves once (a batched program of
+    its own, values only, compiled for 30 s more), the rows after the first in threads,
+    one per core."""
+    x64 = jnp.result_type(float) == jnp.float64  # the caller's, for the threads
 
-    def at(theta):
-        result = problem.predict(theta)
-        return problem.residuals(result), jnp.all(result.status == Status.separated)
+    def one(theta):
+        with jax.enable_x64(x64):
+            r, _, result = _evaluated(problem, jnp.asarray(theta))
+        return np.asarray(r), bool(np.all(np.asarray(result.status) == Status.separated))
 
-    return jax.vmap(at)(thetas)
+    thetas = np.asarray(thetas, dtype=float)
+    done = [one(thetas[0])]  # compiles `_evaluated` once, before the threads
+    if len(thetas) > 1:
+        workers = min(len(thetas) - 1, os.cpu_count() or 1)
+        with concurrent.futures.ThreadPoolExecutor(max_workers=workers) as pool:
+            done += list(pool.map(one, thetas[1:]))
+    return np.stack([r for r, _ in done]), np.array([ok for _, ok in done])
 
 
 @eqx.filter_jit
-def _refine(problem, start, max_steps, tol):
-    """Levenberg-Marquardt from `start`: the parameters, whether it met `tol`, its steps,
-    and there the residuals, their Jacobian and the impacts (in the same program: a
-    separate one compiled for 35 s more, this pass costs 5 s)."""
-    solution = optx.least_squares(
-        lambda theta, _: problem.residuals(problem.predict(theta)),
-        optx.LevenbergMarquardt(rtol=tol, atol=tol),
-        start,
-        max_steps=max_steps,
-        throw=False,
-    )
-    ok = solution.result == optx.RESULTS.successful
+def _evaluated(problem, theta):
+    """The residuals at `theta`, their Jacobian (forward mode, exact across the stick-slip
+    transitions) and the impacts: the one compiled program of a refinement."""
 
     def with_aux(t):
         result = problem.predict(t)
         r = problem.residuals(result)
         return r, (r, result)
 
-    jacobian, (r, result) = jax.jacfwd(with_aux, has_aux=True)(solution.value)
-    return solution.value, ok, solution.stats["num_steps"], (r, jacobian, result)
+    jacobian, (r, result) = jax.jacfwd(with_aux, has_aux=True)(theta)
+    return r, jacobian, result
+
+
+# the problems a refinement's compiled loop calls back for, by token (`_refine`)
+_PROBLEMS: dict[int, _Problem] = {}
+_TOKENS = itertools.count()
+
+
+def _residuals_and_jacobian(token, theta):
+    """Host side of the callback: `_evaluated`'s residuals and Jacobian (numpy). A callback
+    runs with the default device set, which would key a second trace and compile of
+    `_evaluated` apart from the calls outside it: it is unset here."""
+    with jax.default_device(None):
+        r, jacobian, _ = _evaluated(_PROBLEMS[int(token)], jnp.asarray(np.asarray(theta)))
+    return np.asarray(r), np.asarray(jacobian)
+
+
+@eqx.filter_jit
+def _levenberg_marquardt(token, start, n_residuals: int, max_steps: int, tol):
+    """optimistix's Levenberg-Marquardt from `start`, each evaluation of the residuals and
+    their Jacobian a host callback to `_evaluated`: this loop compiles in a moment, and
+    the solves compile once, in `_evaluated` (inside the loop they compiled twice)."""
+    shapes = (
+        jax.ShapeDtypeStruct((n_residuals,), start.dtype),
+        jax.ShapeDtypeStruct((n_residuals, start.size), start.dtype),
+    )
+
+    @jax.custom_jvp
+    def residuals(theta):
+        return jax.pure_callback(_residuals_and_jacobian, shapes, token, theta)[0]
+
+    @residuals.defjvp
+    def _jvp(primals, tangents):
+        r, jacobian = jax.pure_callback(_residuals_and_jacobian, shapes, token, primals[0])
+        return r, jacobian @ tangents[0]
+
+    solution = optx.least_squares(
+        lambda theta, _: residuals(theta),
+        optx.LevenbergMarquardt(rtol=tol, atol=tol),
+        start,
+        max_steps=max_steps,
+        throw=False,
+    )
+    ok = solution.result == optx.RESULTS.successful
+    return solution.value, ok, solution.stats["num_steps"]
+
+
+def _refine(problem, start, max_steps, tol):
+    """Levenberg-Marquardt from `start`: the parameters, whether it met `tol`, its steps,
+    and there the residuals, their Jacobian and the impacts."""
+    token = next(_TOKENS)
+    _PROBLEMS[token] = problem
+    try:
+        theta, ok, steps = _levenberg_marquardt(
+            jnp.asarray(token, dtype=jnp.int32),
+            jnp.asarray(start),
+            _residual_count(problem),
+            max_steps,
+            tol,
+        )
+    finally:
+        del _PROBLEMS[token]
+    theta = np.asarray(theta)
+    r, jacobian, result = _evaluated(problem, jnp.asarray(theta))
+    return theta, ok, steps, (r, jacobian, result)
+
+
+def _residual_count(problem) -> int:
+    return (int(problem.has_e) + int(problem.has_w)) * int(problem.v_n.shape[0])
 
 
 def _chi2_parts(problem, thetas) -> tuple[np.ndarray, np.ndarray]:
     """For each row of `thetas` (numpy, any count): the sum of squared residuals of each
     kind, shape (count, kinds), inf where an impact did not separate or a residual is not
-    finite; batched by `_CHUNK` through one compiled program."""
+    finite."""
     thetas = np.atleast_2d(np.asarray(thetas, dtype=float))
-    count = thetas.shape[0]
-    padded = -(-count // _CHUNK) * _CHUNK
-    thetas = np.concatenate([thetas, np.repeat(thetas[:1], padded - count, axis=0)])
     kinds = int(problem.has_e) + int(problem.has_w)
-    n = problem.v_n.shape[0]
-    out = []
-    for start in range(0, padded, _CHUNK):
-        r, separated = _evaluate(problem, jnp.asarray(thetas[start : start + _CHUNK]))
-        r = np.asarray(r).reshape(_CHUNK, kinds, n)
-        chi2 = np.sum(r**2, axis=-1)
-        bad = ~np.asarray(separated) | ~np.all(np.isfinite(chi2), axis=-1)
-        chi2[bad] = np.inf
-        out.append(chi2)
-    return np.concatenate(out)[:count]
+    r, separated = _evaluate(problem, thetas)
+    chi2 = np.sum(np.asarray(r).reshape(thetas.shape[0], kinds, -1) ** 2, axis=-1)
+    chi2[~np.asarray(separated) | ~np.all(np.isfinite(chi2), axis=-1)] = np.inf
+    return chi2
 
 
 def _final_chi2(r, result) -> float:
@@ -415,8 +476,8 @@ def fit_oblique(
     Ooi's Test 4 e_t from kt = 3e6, mu = 0.2 stopped at kt = 6.3e6, mu = 0.114, rms e_t
     0.088, where kt = 9.4e7, mu = 0.093 gives 0.0071), so the fit first evaluates the loss
     on a log grid, `start_scan` stiffnesses over two decades either side of the start
-    by nine friction coefficients over one decade either side (where free; one batch per
-    16 points, no optimiser), then runs Levenberg-Marquardt (optimistix, to `tol` within
+    by nine friction coefficients over one decade either side (where free; no
+    optimiser), then runs Levenberg-Marquardt (optimistix, to `tol` within
     `max_steps`) from the given start and from the lowest `max_starts - 1` local minima
     of the grid, and keeps the lowest loss. `start_scan=0` starts from `tangential`
     alone. A grid point below the fit's loss (a start that was not refined) makes
@@ -523,7 +584,7 @@ def fit_oblique(
         grid_losses = np.sum(_chi2_parts(problem, points), axis=-1)
         minima = [i for i in _local_minima(grid_losses, shape) if np.any(points[i] != theta0)]
         starts += [points[i] for i in minima[: max(max_starts - 1, 0)]]
-    found = [_refine(problem, jnp.asarray(s), max_steps, tol) for s in starts]
+    found = [_refine(problem, np.asarray(s), max_steps, tol) for s in starts]
     values = np.stack([np.asarray(v) for v, _, _, _ in found])
     finals = np.array([_final_chi2(r, result) for _, _, _, (r, _, result) in found])
     pick = int(np.argmin(finals))
