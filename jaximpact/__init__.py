@@ -90,6 +90,7 @@ _PUBLIC.update(
             "LinearHistoryLaw",
             "MindlinLaw",
             "oblique_impact",
+            "oblique_impact_batch",
             "ObliqueResult",
             "rigid_oblique",
             "incidence",

@@ -2,6 +2,7 @@
 impact on a plane with its normal law's contact and the sphere's spin, the rigid-body
 impulse theory, and fitting the tangential law to measured rebounds (issue 27)."""
 
+from .batch import oblique_impact_batch as oblique_impact_batch
 from .fit import ObliqueFit as ObliqueFit, fit_oblique as fit_oblique
 from .impact import (
     ObliqueOptions as ObliqueOptions,

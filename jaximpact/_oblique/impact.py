@@ -181,7 +181,14 @@ def _land(dyn, conditions, masks, term, tau, y, tau_event, args, options, contro
 
 
 def _first_mode(dyn: ObliqueDynamics, y0, compressing):
-    """The tangential mode at first touch, and its sense.
+    """The tangential mode at first touch, and its sense (`_first_touch`)."""
+    mode, sense, _ = _first_touch(dyn, y0, compressing)
+    return mode, sense
+
+
+def _first_touch(dyn: ObliqueDynamics, y0, compressing):
+    """The tangential mode at first touch, its sense, and the ratio of the tested force to
+    the limit that decided it (above 1: it slides).
 
     Limit and trial force both start from their values at first touch (0 for Hertz) and
     grow as powers of the time, which decide: the contact is integrated sticking over a
@@ -210,7 +217,9 @@ def _first_mode(dyn: ObliqueDynamics, y0, compressing):
     holds = dyn_.cap(stuck, compressing) >= jnp.abs(trial)
     sense = jnp.where(trial != 0, -jnp.sign(trial), jnp.sign(u0))
     slides = (u0 != 0) & ~holds
-    return jnp.where(slides, SLIP, STICK).astype(jnp.int32), sense
+    cap = dyn_.cap(stuck, compressing)
+    ratio = jnp.abs(trial) / jnp.where(cap > 0, cap, 1.0)
+    return jnp.where(slides, SLIP, STICK).astype(jnp.int32), sense, ratio
 
 
 class _Setup(NamedTuple):
@@ -454,14 +463,52 @@ def solve_oblique(law, tangential, m, R, v_n, v_t, omega, inertia, g, options: O
     y_n = y[: dyn.size]
     separated = status == Status.separated
     v_n_out = jnp.where(separated, -normal.velocity(y_n) * v_n, 0.0)
-    v_t_out = y[dyn.size + 1] * v_n
-    omega_out = y[dyn.size + 2] * v_n / R
+    x_end = normal.position(y_n) * normal.x_star
+    return oblique_result(
+        m=m,
+        R=R,
+        v_n=v_n,
+        v_t=v_t,
+        omega=omega,
+        inertia=inertia,
+        g=g,
+        v_n_out=v_n_out,
+        v_t_out=y[dyn.size + 1] * v_n,
+        omega_out=y[dyn.size + 2] * v_n / R,
+        x_end=x_end,
+        T=tau * normal.t_star,
+        status=status,
+        switches=switches,
+        steps=steps,
+    )
+
+
+def oblique_result(
+    *,
+    m,
+    R,
+    v_n,
+    v_t,
+    omega,
+    inertia,
+    g,
+    v_n_out,
+    v_t_out,
+    omega_out,
+    x_end,
+    T,
+    status,
+    switches,
+    steps,
+    path="integrated",
+) -> ObliqueResult:
+    """The `ObliqueResult` of a solve's outcome (SI units; every path's): the fields that
+    follow from the outgoing velocities, NaN where the solve failed."""
     u_in = v_t - R * omega
     u_out = v_t_out - R * omega_out
     moment = inertia * m * R**2
     energy_in = 0.5 * m * (v_n**2 + v_t**2) + 0.5 * moment * omega**2
     energy_out = 0.5 * m * (v_n_out**2 + v_t_out**2) + 0.5 * moment * omega_out**2
-    x_end = normal.position(y_n) * normal.x_star
     fields = dict(
         e=v_n_out / v_n,
         e_t=_safe_ratio(v_t_out, v_t),
@@ -474,7 +521,7 @@ def solve_oblique(law, tangential, m, R, v_n, v_t, omega, inertia, g, options: O
         angle_out=_safe_angle(v_t_out, v_n_out),
         angle_in_contact=_safe_angle(u_in, v_n),
         angle_out_contact=_safe_angle(u_out, v_n_out),
-        T=tau * normal.t_star,
+        T=T,
         impulse_n=m * (v_n_out + v_n),
         impulse_t=m * (v_t_out - v_t),
         dissipated=energy_in - energy_out + m * g * x_end,
@@ -486,7 +533,7 @@ def solve_oblique(law, tangential, m, R, v_n, v_t, omega, inertia, g, options: O
     for key, value in fields.items():
         if key not in _NOT_RESULTS:
             fields[key] = jnp.where(failure, jnp.nan, value)
-    return ObliqueResult(**fields)
+    return ObliqueResult(**fields, path=path)
 
 
 def _differentiated(*trees) -> bool:

@@ -67,6 +67,10 @@ class ObliqueResult(eqx.Module):
       sliding more than `max_segments - 1` times, `failed`); a failed solve has NaN in
       every result field. `num_switches`: how many times the contact changed between
       sticking and sliding; `num_steps`: solver steps.
+    - `path`: the path that served (DESIGN.md, "Off the curves"): `"integrated"` (the
+      event-terminated diffrax solve, `oblique_impact`'s), or for a batch of
+      `oblique_impact_batch` a tuple with one name per row, `"grid"` where the
+      phase-angle grid served it (`_oblique/grid.py`).
     """
 
     e: Array
@@ -87,6 +91,7 @@ class ObliqueResult(eqx.Module):
     status: Array
     num_switches: Array
     num_steps: Array
+    path: str | tuple[str, ...] = eqx.field(static=True, default="integrated")
 
     @property
     def separated(self) -> Array:

@@ -1,0 +1,165 @@
+"""A batch of oblique impacts at batch speed: `oblique_impact_batch`, every row on the
+phase-angle grid first (`grid.py`, one batched pass with no event search), then the rows
+the grid did not serve in a second batched pass of `oblique_impact`'s event-terminated
+solve (gathered on the host, in chunks of `CHUNK` rows, the last one padded to a power
+of two, so that a few compiled shapes serve every count and no more than a chunk's
+padding is solved for nothing)."""
+
+import dataclasses
+
+import diffrax as dfx
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .._checks import check_nonnegative, check_positive
+from .._solve.options import CUSTOM_RTOL, DEFAULT_RTOL
+from .._solve.precision import resolvable_tolerances
+from .grid import grid_applies, solve_oblique_grid
+from .impact import SEPARATIONS, ObliqueOptions, _check_laws, lever_share, solve_oblique
+from .results import ObliqueResult
+
+METHODS = ("auto", "integrate")
+# rows per call of the second pass: one compiled shape for every count above it, and the
+# padding of the last chunk below it
+CHUNK = 16
+
+
+@eqx.filter_jit
+def _on_grid(law, tangential, m, R, v_n, v_t, omega, inertia, options):
+    def one(*row):
+        return solve_oblique_grid(law, tangential, *row, options)
+
+    return jax.vmap(one)(m, R, v_n, v_t, omega, inertia)
+
+
+@eqx.filter_jit
+def _integrated(law, tangential, m, R, v_n, v_t, omega, inertia, g, options):
+    def one(*row):
+        return solve_oblique(law, tangential, *row, options)
+
+    return jax.vmap(one)(m, R, v_n, v_t, omega, inertia, g)
+
+
+def batch_options(*, separation: str, contact_point, rtol: float) -> ObliqueOptions:
+    """The options of both of `oblique_impact_batch`'s passes: `oblique_impact`'s
+    defaults (forward solve, no landing) at `rtol`."""
+    rtol, atol, rest_tol = resolvable_tolerances(rtol, rtol, 1e-7)
+    return ObliqueOptions(
+        separation=separation,
+        solver=dfx.Tsit5(),
+        adjoint=dfx.RecursiveCheckpointAdjoint(),
+        rtol=float(rtol),
+        atol=float(atol),
+        max_steps=4096,
+        max_segments=16,
+        tau_max=1e4,
+        rest_tol=float(rest_tol),
+        lever_share=lever_share(contact_point),
+    )
+
+
+def _padded(count: int) -> int:
+    return 1 << max(count - 1, 0).bit_length()
+
+
+def oblique_impact_batch(
+    law,
+    tangential,
+    *,
+    m,
+    R,
+    v_n,
+    v_t,
+    omega=0.0,
+    inertia=0.4,
+    g=0.0,
+    separation: str = "force",
+    contact_point="surface",
+    rtol: float | None = None,
+    method: str = "auto",
+) -> ObliqueResult:
+    """Many oblique impacts at once: `oblique_impact` over rows (SI units; numbers and 1-D
+    arrays broadcast to one length), each row's result as `oblique_impact` gives it to its
+    tolerance, in an `ObliqueResult` of arrays whose `path` names, row by row, the path that
+    served it: `"grid"` (the normal contact and the tangential stick and slip stepped
+    together on the phase-angle grid, the transitions placed on it: `_oblique/grid.py`)
+    or `"integrated"` (the rows the grid cannot serve: heavy damping, a force that pulls,
+    modes that take turns, transitions closer than a grid step or a pair of them inside
+    one, a first touch near Coulomb's limit, a state-dependent law, a rescaled history,
+    gravity; and every row with `method="integrate"`). Concrete inputs only (not inside
+    `jit` or `vmap`: it gathers the rows for its second pass on the host); for
+    derivatives use `jax.vmap` of `oblique_impact`.
+
+    **Example**: `oblique_impact_batch(jaximpact.law("hunt_crossley", c=2.6e10, a=0.0),
+    tangential_law("mindlin", G=1.5e11, nu=0.23, mu=0.092), m=2.6e-4, R=2.5e-3,
+    v_n=3.9 * np.cos(angles), v_t=3.9 * np.sin(angles)).e_t`.
+    """
+    _check_laws(law, tangential)
+    if separation not in SEPARATIONS:
+        raise ValueError(f"separation must be one of {SEPARATIONS}, got {separation!r}")
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    if rtol is None:
+        rtol = DEFAULT_RTOL if law.spec is not None else CUSTOM_RTOL
+    if not (isinstance(rtol, (int, float)) and 0 < rtol < 1):
+        raise ValueError(f"rtol must be a number in (0, 1), got {rtol!r}")
+    rows = dict(
+        m=check_positive("mass m", m, "kg"),
+        R=check_positive("radius R", R, "m"),
+        v_n=check_positive("normal speed v_n (approaching)", v_n, "m/s"),
+        v_t=v_t,
+        omega=omega,
+        inertia=check_positive("inertia factor (I / (m R^2))", inertia),
+        g=check_nonnegative("gravity g", g, "m/s^2"),
+    )
+    arrays = {k: np.asarray(v, dtype=float) for k, v in rows.items()}
+    for name in ("v_t", "omega"):
+        if not np.all(np.isfinite(arrays[name])):
+            raise ValueError(f"{name} must be finite numbers")
+    if any(a.ndim > 1 for a in arrays.values()):
+        raise ValueError("oblique_impact_batch takes numbers and 1-D arrays")
+    arrays = dict(zip(arrays, np.broadcast_arrays(*arrays.values()), strict=True))
+    arrays = {k: np.atleast_1d(v).astype(float) for k, v in arrays.items()}
+    n = arrays["v_n"].shape[0]
+    options = batch_options(separation=separation, contact_point=contact_point, rtol=rtol)
+    names = ("m", "R", "v_n", "v_t", "omega", "inertia")
+    served = np.zeros(n, dtype=bool)
+    fields = None
+    if method == "auto" and grid_applies(law, tangential, options):
+        result, on_grid = _on_grid(
+            law, tangential, *(jnp.asarray(arrays[k]) for k in names), options
+        )
+        served = np.asarray(on_grid) & (arrays["g"] == 0.0)
+        fields = {f.name: np.array(getattr(result, f.name)) for f in _array_fields()}
+    left = np.flatnonzero(~served)
+    if left.size:
+        part = [arrays[k] for k in (*names, "g")]
+        rest = _second_pass(law, tangential, part, left, options)
+        if fields is None:
+            fields = rest
+        else:
+            for name, values in rest.items():
+                fields[name] = fields[name].astype(np.result_type(fields[name], values))
+                fields[name][left] = values
+    path = tuple("grid" if s else "integrated" for s in served)
+    return ObliqueResult(**{k: jnp.asarray(v) for k, v in fields.items()}, path=path)
+
+
+def _second_pass(law, tangential, arrays, left, options) -> dict:
+    """`solve_oblique` over the rows `left` of `arrays`, `CHUNK` rows a call: the
+    result's fields as numpy arrays."""
+    parts = []
+    for start in range(0, left.size, CHUNK):
+        rows = left[start : start + CHUNK]
+        pick = np.concatenate([rows, np.full(_padded(rows.size) - rows.size, rows[0])])
+        rest = _integrated(law, tangential, *(jnp.asarray(a[pick]) for a in arrays), options)
+        parts.append(
+            {f.name: np.asarray(getattr(rest, f.name))[: rows.size] for f in _array_fields()}
+        )
+    return {name: np.concatenate([p[name] for p in parts]) for name in parts[0]}
+
+
+def _array_fields():
+    return [f for f in dataclasses.fields(ObliqueResult) if f.name != "path"]
