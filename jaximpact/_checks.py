@@ -22,7 +22,10 @@ def check_values(value, bad, message: str):
     `eqx.error_if`, so the check survives `jit` (and raises at run time).
     """
     if not is_traced(value):
-        array = np.asarray(value, dtype=float)
+        try:
+            array = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):  # a word, e.g. a number with its unit
+            raise ValueError(f"{message} (give a plain number in SI units)") from None
         if array.size == 0 or np.any(~np.isfinite(array)) or np.any(bad(array)):
             raise ValueError(message)
         return value
@@ -151,6 +154,8 @@ def _show(value, bad) -> str:
     if is_traced(value):
         return "a traced value"
     array = np.asarray(value)
+    if array.dtype.kind not in "biuf":  # not numbers: a word, a number with its unit
+        return repr(value)
     if array.size == 0:
         return "an empty array"
     if array.size == 1:

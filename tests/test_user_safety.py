@@ -575,3 +575,25 @@ def test_a_name_like_no_other_gets_the_list_alone():
         ji.law("xyz", c=1.0)
     message = str(error.value)
     assert "did you mean" not in message and "choose one of: kelvin_voigt" in message
+
+
+@pytest.mark.parametrize(
+    "call, shown",
+    [
+        (lambda law, tl: ji.impact(law, m=2.6e-4, v0="3 m/s"), "impact speed v0"),
+        (
+            lambda law, tl: ji.oblique_impact(law, tl, m=2.6e-4, R="2.5mm", v_n=3.0, v_t=1.0),
+            "radius R",
+        ),
+        (lambda law, tl: ji.impact(law, m=[1.0, "a"], v0=1.0), "mass m"),
+    ],
+)
+def test_a_number_given_with_its_unit_is_refused_in_one_line(call, shown):
+    """A number written with its unit ('2.5mm'), or a word among numbers, is refused before
+    any solve with the input's name, its SI unit and what to give instead (numpy's own
+    "could not convert string to float" named nothing)."""
+    law = ji.law("hunt_crossley", c=2.6e10, a=0.0)
+    tl = ji.tangential_law("mindlin", G=1.5e11, nu=0.23, mu=0.092)
+    with pytest.raises(ValueError, match=shown) as info:
+        call(law, tl)
+    assert "\n" not in str(info.value) and "plain number in SI units" in str(info.value)
