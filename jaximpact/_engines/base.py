@@ -20,6 +20,7 @@ from typing import ClassVar, NamedTuple
 
 import numpy as np
 
+from .._oblique.tangential import TANGENTIAL_LAW_NAMES
 from .materials import check_positive
 
 
@@ -327,15 +328,10 @@ class AbstractEngine(abc.ABC):
         return f"{type(self).__name__}()"
 
 
-# the tangential laws (`tangential_law` names), all with a Coulomb mu: the rows of an engine
-# whose one tangential model is its friction alone (MuJoCo's, Drake's)
-TANGENTIAL_LAWS = (
-    "linear_history",
-    "mindlin",
-    "mindlin_force",
-    "mindlin_rescale",
-    "mindlin_rescale_force",
-)
+# the tangential laws (`tangential_law` names, read from their table), all with a Coulomb
+# mu: the rows of an engine whose one tangential model is its friction alone (MuJoCo's,
+# Drake's)
+TANGENTIAL_LAWS = TANGENTIAL_LAW_NAMES
 # the facts every final class declares (its base's annotated class attributes)
 FACTS, NORMAL_FACTS, TANGENTIAL_FACTS = (
     tuple(base.__annotations__)
