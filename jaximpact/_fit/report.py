@@ -6,11 +6,20 @@ is rendered from the record alone, so that the words and `--json` give the same 
 
 import math
 
-from .._format import KEEP_TOGETHER, format_number, format_quantity, format_table, wrap_text
+from .._format import (
+    KEEP_TOGETHER,
+    format_number,
+    format_quantity,
+    format_table,
+    terminal_width,
+    wrap_text,
+)
 from .calibrate import goodness_text, law_units
 
 # the column of the labels of `fit_text`'s lines, and the width it wraps them to
 _LABEL, _WIDTH = 11, 100
+# the narrowest a ranking's table is wrapped to
+_RANKING_WIDTH = 120
 
 
 def law_title(name: str) -> str:
@@ -260,7 +269,10 @@ def ranking_text(result, evidence=None) -> str:
             if has_T:
                 cells.append("-" if r["rms_T"] is None else f"{100 * r['rms_T']:.3g}%")
         table.append([*cells, "yes" if r["converged"] else "no", params])
-    lines += format_table(header, table, wrap=(len(header) - 1,))
+    # one line per law where the terminal allows, and at least as wide as the command
+    # printed it before the table came from `format_table` (a pipe counts 88 columns)
+    width = max(terminal_width(), _RANKING_WIDTH)
+    lines += format_table(header, table, width=width, wrap=(len(header) - 1,))
     meaning = (
         "chi2/dof: reduced chi-square, about 1 for a law that fits within the sigmas"
         if weighted
