@@ -13,11 +13,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._checks import check_nonnegative, check_positive
-from .._solve.options import CUSTOM_RTOL, DEFAULT_RTOL
+from .._checks import MemberChecks
 from .._solve.precision import resolvable_tolerances
 from .grid import grid_applies, solve_oblique_grid
-from .impact import SEPARATIONS, ObliqueOptions, _check_laws, lever_share, solve_oblique
+from .impact import ObliqueOptions, checked_inputs, checked_settings, lever_share, solve_oblique
 from .results import ObliqueResult
 
 METHODS = ("auto", "integrate")
@@ -96,46 +95,32 @@ def oblique_impact_batch(
     tangential_law("mindlin", G=1.5e11, nu=0.23, mu=0.092), m=2.6e-4, R=2.5e-3,
     v_n=3.9 * np.cos(angles), v_t=3.9 * np.sin(angles)).e_t`.
     """
-    _check_laws(law, tangential)
-    if separation not in SEPARATIONS:
-        raise ValueError(f"separation must be one of {SEPARATIONS}, got {separation!r}")
+    rtol = checked_settings(law, tangential, separation, rtol)
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-    if rtol is None:
-        rtol = DEFAULT_RTOL if law.spec is not None else CUSTOM_RTOL
-    if not (isinstance(rtol, (int, float)) and 0 < rtol < 1):
-        raise ValueError(f"rtol must be a number in (0, 1), got {rtol!r}")
-    rows = dict(
-        m=check_positive("mass m", m, "kg"),
-        R=check_positive("radius R", R, "m"),
-        v_n=check_positive("normal speed v_n (approaching)", v_n, "m/s"),
-        v_t=v_t,
-        omega=omega,
-        inertia=check_positive("inertia factor (I / (m R^2))", inertia),
-        g=check_nonnegative("gravity g", g, "m/s^2"),
-    )
-    arrays = {k: np.asarray(v, dtype=float) for k, v in rows.items()}
-    for name in ("v_t", "omega"):
-        if not np.all(np.isfinite(arrays[name])):
-            raise ValueError(f"{name} must be finite numbers")
+    inputs = checked_inputs(MemberChecks(), m, R, v_n, v_t, omega, inertia, g)
+    names = ("m", "R", "v_n", "v_t", "omega", "inertia", "g")
+    arrays = {k: np.asarray(v, dtype=float) for k, v in zip(names, inputs, strict=True)}
     if any(a.ndim > 1 for a in arrays.values()):
         raise ValueError("oblique_impact_batch takes numbers and 1-D arrays")
     arrays = dict(zip(arrays, np.broadcast_arrays(*arrays.values()), strict=True))
     arrays = {k: np.atleast_1d(v).astype(float) for k, v in arrays.items()}
     n = arrays["v_n"].shape[0]
     options = batch_options(separation=separation, contact_point=contact_point, rtol=rtol)
-    names = ("m", "R", "v_n", "v_t", "omega", "inertia")
     served = np.zeros(n, dtype=bool)
     fields = None
     if method == "auto" and grid_applies(law, tangential, options):
         result, on_grid = _on_grid(
-            law, tangential, *(jnp.asarray(arrays[k]) for k in names), options
+            law,
+            tangential,
+            *(jnp.asarray(arrays[k]) for k in names[:-1]),
+            options,  # no g
         )
         served = np.asarray(on_grid) & (arrays["g"] == 0.0)
         fields = {f.name: np.array(getattr(result, f.name)) for f in _array_fields()}
     left = np.flatnonzero(~served)
     if left.size:
-        part = [arrays[k] for k in (*names, "g")]
+        part = [arrays[k] for k in names]
         rest = _second_pass(law, tangential, part, left, options)
         if fields is None:
             fields = rest

@@ -541,6 +541,34 @@ def _differentiated(*trees) -> bool:
     return bool(differentiation_kinds(*trees))
 
 
+def checked_settings(law, tangential, separation: str, rtol):
+    """The laws and `separation` checked, and `rtol` (its default where None: the table's
+    laws', or a user's law's) checked to lie in (0, 1): `oblique_impact`'s and
+    `oblique_impact_batch`'s one-line refusals."""
+    _check_laws(law, tangential)
+    if separation not in SEPARATIONS:
+        raise ValueError(f"separation must be one of {SEPARATIONS}, got {separation!r}")
+    if rtol is None:
+        rtol = DEFAULT_RTOL if law.spec is not None else CUSTOM_RTOL
+    if not (isinstance(rtol, (int, float)) and 0 < rtol < 1):
+        raise ValueError(f"rtol must be a number in (0, 1), got {rtol!r}")
+    return rtol
+
+
+def checked_inputs(checks: MemberChecks, m, R, v_n, v_t, omega, inertia, g) -> tuple:
+    """The sphere's and the impact's inputs (SI units) checked by `checks`, in
+    `solve_oblique`'s order: `m`, `R`, `v_n`, `inertia` > 0, `g` >= 0, all finite."""
+    return (
+        checks.positive("mass m", m, "kg"),
+        checks.positive("radius R", R, "m"),
+        checks.positive("normal speed v_n (approaching)", v_n, "m/s"),
+        checks.values(v_t, _never, _not_finite("tangential speed v_t", v_t, "m/s"), 0.0),
+        checks.values(omega, _never, _not_finite("spin omega", omega, "rad/s"), 0.0),
+        checks.positive("inertia factor (I / (m R^2))", inertia, harmless=0.4),
+        checks.nonnegative("gravity g", g, "m/s^2"),
+    )
+
+
 def _never(a):
     return a != a  # only NaN and inf (`check_values` refuses them) are bad
 
@@ -662,13 +690,9 @@ def oblique_impact(
     tangential_law("mindlin", G=1.5e11, nu=0.23, mu=0.092), m=2.6e-4, R=2.5e-3, v_n=3.0,
     v_t=2.5).e_t` is the Kharaz alumina sphere's tangential restitution at 40 degrees.
     """
-    _check_laws(law, tangential)
-    if rtol is None:
-        rtol = DEFAULT_RTOL if law.spec is not None else CUSTOM_RTOL
-    if separation not in SEPARATIONS:
-        raise ValueError(f"separation must be one of {SEPARATIONS}, got {separation!r}")
+    rtol = checked_settings(law, tangential, separation, rtol)
     share = lever_share(contact_point)
-    for name, value in (("rtol", rtol), ("atol", atol), ("rest_tol", rest_tol)):
+    for name, value in (("atol", atol), ("rest_tol", rest_tol)):
         if value is not None and not (isinstance(value, (int, float)) and 0 < value < 1):
             raise ValueError(f"{name} must be a number in (0, 1), got {value!r}")
     for name, value in (("max_steps", max_steps), ("max_segments", max_segments)):
@@ -678,14 +702,8 @@ def oblique_impact(
         raise ValueError(f"tau_max must be a finite number > 0, got {tau_max!r}")
     # eager: a one-line ValueError; traced: a bad member is NaN and invalid (`MemberChecks`)
     checks = MemberChecks()
-    m = checks.positive("mass m", m, "kg")
-    R = checks.positive("radius R", R, "m")
-    v_n = checks.positive("normal speed v_n (approaching)", v_n, "m/s")
-    inertia = checks.positive("inertia factor (I / (m R^2))", inertia, harmless=0.4)
-    g = checks.nonnegative("gravity g", g, "m/s^2")
-    v_t = checks.values(v_t, _never, _not_finite("tangential speed v_t", v_t, "m/s"), 0.0)
-    omega = checks.values(omega, _never, _not_finite("spin omega", omega, "rad/s"), 0.0)
-    values = [jnp.asarray(a, dtype=float) for a in (m, R, v_n, v_t, omega, inertia, g)]
+    inputs = checked_inputs(checks, m, R, v_n, v_t, omega, inertia, g)
+    values = [jnp.asarray(a, dtype=float) for a in inputs]
     if any(jnp.ndim(a) for a in values):
         raise ValueError(
             "oblique_impact takes scalar m, R, v_n, v_t, omega, inertia and g; "
