@@ -22,7 +22,7 @@ from .._format import (
     format_value,
     jsonable,
 )
-from .._laws import AbstractLaw, damping_parameter, shape_of
+from .._laws import AbstractLaw, damping_parameter, shape_of, stiffness_parameter
 from .._least_squares import LeastSquares, levenberg_marquardt
 from .._solve.impact import ImpactOptions, solve_impact
 from .._solve.options import (
@@ -830,9 +830,10 @@ def calibrate(
     if free is None:
         free = default_free(law, stiffness=T is not None)
         held = [k for k in law.parameters if k not in free]
-        if T is not None and "c" not in law.parameters and held:
+        if T is not None and stiffness_parameter(law) is None and held:
             warnings.warn(
-                f"T is given but the law has no parameter named c, so only {', '.join(free)} "
+                f"T is given but the law has no stiffness named c (or k beside a damping c), "
+                f"so only {', '.join(free)} "
                 f"is fitted and {', '.join(held)} stays at its start value; name the "
                 f"stiffness among the free parameters to fit it, e.g. free={(*held[:1], *free)}",
                 stacklevel=3,

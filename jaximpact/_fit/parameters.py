@@ -6,7 +6,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
-from .._laws import damping_parameter
+from .._laws import damping_parameter, stiffness_parameter
 
 
 def to_unbounded(name: str, value):
@@ -33,14 +33,16 @@ def law_with(law, free, theta):
 
 def default_free(law, *, stiffness: bool, dry: bool = False) -> tuple[str, ...]:
     """What a fit frees when the caller does not say: the damping parameter
-    (`damping_parameter`, else the law's last parameter), with the stiffness `c` first when
+    (`damping_parameter`, else the law's last parameter), with the stiffness
+    (`stiffness_parameter`: `c`, or a user's `k` beside a damping `c`) first when
     `stiffness` (data that see a time scale), and the dry force `P` when `dry` (data enough
     for it)."""
     params = tuple(law.parameters)
     damping = damping_parameter(law)
     free = [damping] if damping in params else list(params[-1:])
-    if stiffness and "c" in params and "c" not in free:
-        free.insert(0, "c")
+    stiff = stiffness_parameter(law)
+    if stiffness and stiff is not None and stiff not in free:
+        free.insert(0, stiff)
     if dry and "P" in params and "P" not in free:
         free.append("P")
     return tuple(free)

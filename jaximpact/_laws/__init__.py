@@ -5,6 +5,7 @@ from .base import (
     AbstractLaw as AbstractLaw,
     LawSpec as LawSpec,
     damping_parameter as damping_parameter,
+    stiffness_parameter as stiffness_parameter,
     exponents as exponents,
     shape_of as shape_of,
 )

@@ -204,11 +204,22 @@ _DAMPING_NAMES = ("b", "b1", "a", "d", "e_nominal", "P")
 
 def damping_parameter(law) -> str | None:
     """The parameter that sets a law's (or a row's) dissipation: the row's `damping`; for a
-    user's own law, the first of b, b1, a, d, e_nominal, P that it has (None: none)."""
+    user's own law, the first of b, b1, a, d, e_nominal, P that it has, else `c` where it
+    also has `k` (the names of `m x'' + c x' + k x = 0`) (None: none)."""
     spec = law if isinstance(law, LawSpec) else law.spec
     if spec and spec.damping is not None:
         return spec.damping
-    return next((k for k in _DAMPING_NAMES if k in law.parameters), None)
+    named = next((k for k in _DAMPING_NAMES if k in law.parameters), None)
+    if named is None and {"k", "c"} <= set(law.parameters):
+        return "c"
+    return named
+
+
+def stiffness_parameter(law) -> str | None:
+    """The parameter that sets a law's stiffness, which a contact duration fixes: `c` (the
+    table's name), or `k` for a user's law whose `c` is its damping (None: neither)."""
+    damping = damping_parameter(law)
+    return next((k for k in ("c", "k") if k in law.parameters and k != damping), None)
 
 
 def exponents(spec, params=None) -> tuple[float, float]:

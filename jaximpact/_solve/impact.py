@@ -108,6 +108,19 @@ def _check_representable(result, m, v0, g):
     )
 
 
+# what to write instead, for the errors of Python and numpy code given traced x, v, params
+_IF_HINT = (
+    "; x, v and the parameters are traced arrays: write if, max, min, abs and math on "
+    "them with jnp (jnp.where, jnp.maximum, jnp.minimum, jnp.abs, jnp.sqrt)"
+)
+_TRACED_HINTS = {
+    "TracerBoolConversionError": _IF_HINT,
+    "ConcretizationTypeError": _IF_HINT,
+    "TracerIntegerConversionError": _IF_HINT,
+    "TracerArrayConversionError": "; use jax.numpy (jnp), not numpy (np), inside the law",
+}
+
+
 def check_custom_law(law, v0):
     """A user's law is tried at first touch before it is integrated: its function must give
     one real force (a `TypeError` or `ValueError` says what it gave instead), finite; one
@@ -123,6 +136,7 @@ def check_custom_law(law, v0):
         raise kind(
             f"the custom law's function failed at x = 0, v = v0 ({type(error).__name__}: "
             f"{first}); it must take (x, v, params) and return the force in N"
+            + _TRACED_HINTS.get(type(error).__name__, "")
         ) from error
     batch = np.broadcast_shapes(*(np.shape(p) for p in law.parameters.values()))
     if (

@@ -250,17 +250,42 @@ BAD_INPUTS = [
 ]
 
 
-def test_warns_when_T_is_given_and_no_parameter_is_named_c(monkeypatch):
-    """A user's law whose stiffness is not called c: with T given, the default frees only
+def test_warns_when_T_is_given_and_no_stiffness_is_named(monkeypatch):
+    """A user's law whose stiffness is neither c nor k: with T given, the default frees only
     the damping, and a warning names the parameter held and how to fit it."""
     reached = []
     for fitter in ("_fit", "_fit_on_host"):
         monkeypatch.setattr(_calibrate, fitter, lambda *a: reached.append(a[-1].free) or 1 / 0)
-    law = ji.custom_law(lambda x, v, p: p["k"] * x**1.5 * (1 + p["d"] * v), k=2e6, d=0.3)
-    with pytest.warns(UserWarning, match=r"no parameter named c.*k stays.*free=\('k', 'd'\)"):
+    law = ji.custom_law(lambda x, v, p: p["s"] * x**1.5 * (1 + p["d"] * v), s=2e6, d=0.3)
+    with pytest.warns(UserWarning, match=r"no stiffness named c.*s stays.*free=\('s', 'd'\)"):
         with pytest.raises(ZeroDivisionError):
             ji.calibrate(law, m=M, v0=V0, e=0.8, T=5e-3)
     assert reached == [("d",)]
+
+
+@pytest.mark.parametrize(
+    "names, free",
+    [(("k", "c"), ("k", "c")), (("c", "k"), ("k", "c")), (("k", "d"), ("k", "d"))],
+    ids=["k-c", "c-k", "k-d"],
+)
+def test_a_users_k_is_the_stiffness_and_c_beside_it_the_damping(monkeypatch, names, free):
+    """`m x'' + c x' + k x`'s names: with T given, the default fits the stiffness k and the
+    damping c (not c alone as the table's stiffness), in either order; e alone, c."""
+    reached = []
+    for fitter in ("_fit", "_fit_on_host"):
+        monkeypatch.setattr(_calibrate, fitter, lambda *a: reached.append(a[-1].free) or 1 / 0)
+    stiff, damp = free
+    law = ji.custom_law(
+        lambda x, v, p: p[stiff] * x**1.5 + p[damp] * x**0.5 * v,
+        **{n: {stiff: 2e6, damp: 50.0}[n] for n in names},
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no warning: both are fitted
+        with pytest.raises(ZeroDivisionError):
+            ji.calibrate(law, m=M, v0=V0, e=0.8, T=5e-3)
+        with pytest.raises(ZeroDivisionError):
+            ji.calibrate(law, m=M, v0=V0, e=0.8)
+    assert reached == [free, (damp,)]
 
 
 @pytest.mark.parametrize("bad, message", BAD_INPUTS, ids=[m for _, m in BAD_INPUTS])

@@ -330,3 +330,21 @@ def test_a_failed_drop_warns_and_keeps_no_number():
     assert math.isnan(float(b.e[0])) and math.isnan(float(b.T[0]))
     with pytest.raises(Exception, match="failed"):
         ji.bounce(law, m=1.0, h0=0.6, t_end=2.0, max_steps=20, throw=True)
+
+
+@pytest.mark.parametrize(
+    "force, hint",
+    [
+        (lambda x, v, p: max(0.0, p["c"] * x**1.5 + p["b"] * v), "jnp.maximum"),
+        (lambda x, v, p: p["c"] * x**1.5 if x > 0 else 0.0, "jnp.where"),
+        (lambda x, v, p: p["c"] * math.sqrt(x) ** 3 + p["b"] * v, "jnp.sqrt"),
+        (lambda x, v, p: p["c"] * np.power(x, 1.5) + p["b"] * v, "use jax.numpy"),
+    ],
+    ids=["max", "if", "math", "numpy"],
+)
+def test_a_law_written_with_python_or_numpy_is_told_what_to_write(force, hint):
+    """Python's `max`/`if`/`math` and numpy on the traced x, v: one line that says the jnp
+    function to write instead (checked at first touch, before anything is compiled)."""
+    with pytest.raises(TypeError) as error:
+        ji.impact(ji.custom_law(force, c=1e7, b=50.0), m=0.05, v0=1.0)
+    assert hint in str(error.value) and "\n" not in str(error.value)
