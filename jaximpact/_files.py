@@ -316,12 +316,44 @@ def read_csv(text: str, *, comments: bool = False):
     return (rows[0][1], rows[1:]) if rows else ([], [])
 
 
-def read_table(path: Path, columns, *, label: str, hint: str, needed=()):
+# the units a header may give a column in (`T (ms)`, `v0 [mm/s]`), by the column's SI unit,
+# each with how many of it make the SI unit (a divisor: 0.9 ms is 0.9 / 1000 s, rounded once)
+HEADER_UNITS = {
+    "s": {"s": 1.0, "ms": 1e3, "us": 1e6, "µs": 1e6, "μs": 1e6},
+    "m/s": {"m/s": 1.0, "mm/s": 1e3, "cm/s": 1e2},
+    "1": {"1": 1.0, "-": 1.0},
+}
+
+
+def header_unit(name: str, units: dict, label: str) -> tuple[str, float]:
+    """`(column, divisor to SI)` of a header cell `name`: a column alone (1), or a
+    column with its unit in brackets, `T (ms)` or `T [ms]`, where `units` gives the
+    column's SI unit (a key of `HEADER_UNITS`); a one-line `ValueError` for a unit that
+    column cannot take."""
+    stripped = name.strip()
+    if not stripped.endswith((")", "]")) or "(" not in stripped and "[" not in stripped:
+        return stripped, 1.0
+    cut = max(stripped.rfind("("), stripped.rfind("["))
+    column, unit = stripped[:cut].strip(), stripped[cut + 1 : -1].strip()
+    if column not in units:
+        return stripped, 1.0  # an unknown column, which the caller names
+    accepted = HEADER_UNITS[units[column]]
+    if unit not in accepted:
+        raise ValueError(
+            f"{label}: column {column!r} in {unit!r}: give it in one of "
+            f"{', '.join(a for a in accepted if a not in ('us', 'μs'))}"
+        )
+    return column, accepted[unit]
+
+
+def read_table(path: Path, columns, *, label: str, hint: str, needed=(), units=None):
     """`(header, rows)` of the small CSV file at `path` (`read_text` and `read_csv`:
     as people save it, `#` comments skipped), its header stripped and checked against
     `columns` (those in `needed` must be there), each row `(line number, {column: number})`,
-    an empty cell NaN. One-line `ValueError`s that name the file as `label` (e.g. `--data
-    in.csv`) for a file that cannot be read or is not text, is empty, has an unknown column
+    an empty cell NaN. `units`: each column's SI unit (a key of `HEADER_UNITS`), where a
+    header may give the column in another (`T (ms)`: the numbers are read in ms and held
+    in s). One-line `ValueError`s that name the file as `label` (e.g. `--data in.csv`) for
+    a file that cannot be read or is not text, is empty, has an unknown column or unit
     (`hint`: the columns expected, in words), a column named twice or one of `needed`
     missing, a row with too many or too few cells, or a cell that is not a number."""
     import math
@@ -335,7 +367,8 @@ def read_table(path: Path, columns, *, label: str, hint: str, needed=()):
     header, rows = read_csv(text, comments=True)
     if not header:
         raise ValueError(f"{label} is empty")
-    header = [name.strip() for name in header]
+    read = [header_unit(name, units or {}, label) for name in header]
+    header, divisors = [column for column, _ in read], [divisor for _, divisor in read]
     unknown = [name for name in header if name not in columns]
     if unknown:
         raise ValueError(
@@ -351,9 +384,9 @@ def read_table(path: Path, columns, *, label: str, hint: str, needed=()):
         if len(cells) != len(header):
             raise ValueError(f"{label}, line {line}: {len(cells)} cells for {len(header)} columns")
         values = {}
-        for column, cell in zip(header, cells, strict=True):
+        for column, divisor, cell in zip(header, divisors, cells, strict=True):
             try:
-                values[column] = cell_number(cell) if cell.strip() else math.nan
+                values[column] = cell_number(cell) / divisor if cell.strip() else math.nan
             except ValueError as error:
                 raise ValueError(f"{label}, line {line}, column {column}: {error}") from None
         numbers.append((line, values))

@@ -131,6 +131,39 @@ def test_calibrate_data_reads_every_encoding_alike(tmp_path, how):
 
 
 @pytest.mark.parametrize(
+    "header",
+    ["v0,e,T", "v0 (m/s),e,T (s)", "v0 [mm/s],e (-),T [ms]", "v0 (cm/s),e,T (µs)"],
+)
+def test_calibrate_data_reads_the_units_its_header_gives(tmp_path, header):
+    """Excel's habit of a unit in the header: read in that unit, held in SI, once rounded
+    (0.9 ms is 0.9 / 1000 s, the same float as 9e-4 typed in s)."""
+    scale = {"mm/s": 1e3, "cm/s": 1e2, "ms": 1e3, "µs": 1e6}
+    unit = [cell.split("(")[-1].split("[")[-1].strip(")]") for cell in header.split(",")]
+    v0, T = [2.5, 1.5], [9e-4, 7.8e-3]
+    rows = [
+        f"{v * scale.get(unit[0], 1):g},0.8,{t * scale.get(unit[2], 1):g}"
+        for v, t in zip(v0, T, strict=True)
+    ]
+    path = _saved(tmp_path / "d.csv", "\n".join([header, *rows]) + "\n", "utf-8 with a BOM")
+    data = cli_calibrate.read_data(path)
+    assert data["v0"] == v0 and data["T"] == T and data["e"] == [0.8, 0.8]
+
+
+@pytest.mark.parametrize(
+    "header, said",
+    [
+        ("v0,e,T (min)", "column 'T' in 'min': give it in one of s, ms, µs"),
+        ("v0 (km/h),e", "column 'v0' in 'km/h': give it in one of m/s, mm/s, cm/s"),
+        ("speed (m/s),e", "unknown column 'speed (m/s)'"),
+    ],
+)
+def test_calibrate_data_refuses_a_unit_it_cannot_read(capsys, tmp_path, header, said):
+    path = _saved(tmp_path / "d.csv", f"{header}\n1,0.8" + ",1" * header.count("T") + "\n", "utf-8")
+    argv = ["calibrate", "--law", "hertz_rate", "--mass", "1", "--data", str(path)]
+    assert_one_line_error(*run_cli(capsys, argv), contains=said)
+
+
+@pytest.mark.parametrize(
     "row, column, bad", [("2_500,0.8", "v0", "2_500"), ("2.5,0.8µ", "e", "0.8µ")]
 )
 def test_calibrate_data_names_file_line_and_column(capsys, tmp_path, row, column, bad):

@@ -9,14 +9,19 @@ import math
 from .._files import read_table
 
 COLUMNS = ("v0", "e", "T", "sigma_e", "sigma_T")
+# their SI units: a header may give v0 and T in others (`T (ms)`, `v0 [mm/s]`)
+UNITS = dict(v0="m/s", e="1", T="s", sigma_e="1", sigma_T="s")
 
 
 def read_measurements(path, label: str | None = None) -> dict:
     """`{column: [float, ...]}` from a CSV with a header naming some of `COLUMNS`; empty
-    cells are NaN; blank lines and lines starting with `#` are skipped. `label`: how the
+    cells are NaN; blank lines and lines starting with `#` are skipped; a header may give
+    v0 and T with a unit (`v0 (m/s)`, `T [ms]`: read in it, held in SI). `label`: how the
     messages name the file (default its path)."""
     label, hint = label or str(path), "v0,e[,T,sigma_e,sigma_T]"
-    header, rows = read_table(path, COLUMNS, label=label, hint=hint, needed=("v0", "e"))
+    header, rows = read_table(
+        path, COLUMNS, label=label, hint=hint, needed=("v0", "e"), units=UNITS
+    )
     for line, values in rows:
         for name in ("v0", "e"):
             if math.isnan(values[name]):
