@@ -23,6 +23,7 @@ from jaximpact._cli import bench as cli_bench, laws as cli_laws
 from jaximpact._engines import _stepping
 from jaximpact._engines.export import ENGINES, UnrealisedExport, UnrealisedWarning
 from jaximpact._format import KEEP_TOGETHER, format_table
+from jaximpact._jobs.job_law import job_law
 from jaximpact._jobs.row_checks import check_rows
 
 FEW = settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -135,10 +136,10 @@ def test_check_rows_refuses_the_first_row_where_a_column_and_an_option_disagree(
     fixed = {k: 1.0 for k in ("c", "b1", "m", "v0") if k != key}
     differ = [i for i, v in enumerate(column) if v != option]
     if not differ:
-        check_rows("hertz_rate", values, fixed, _where, {key: option})
+        check_rows(job_law("hertz_rate"), values, fixed, _where, {key: option})
         return
     with pytest.raises(ValueError) as info:
-        check_rows("hertz_rate", values, fixed, _where, {key: option})
+        check_rows(job_law("hertz_rate"), values, fixed, _where, {key: option})
     message = str(info.value)
     assert message.startswith(f"{_where(differ[0])}, column {key}: ") and "\n" not in message
     option = f"--param {key}=" if key in ("c", "b1") else {"m": "--mass"}.get(key, f"--{key}")
@@ -149,7 +150,7 @@ def test_check_rows_separation_column_against_its_option():
     values = {"separation": np.array(["force", "penetration"], object)}
     with pytest.raises(ValueError, match="line 3, column separation: .*--separation"):
         check_rows(
-            "hertz_rate",
+            job_law("hertz_rate"),
             values,
             {"c": 1.0, "b1": 1.0, "m": 1.0, "v0": 1.0},
             _where,

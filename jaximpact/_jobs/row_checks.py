@@ -30,17 +30,9 @@ def _signed(law, keys) -> tuple:
     return tuple(k for k in keys if k not in KINEMATICS) if law.user else ()
 
 
-def _job_law(law):
-    """`law` as a file job reads it (`job_law.JobLaw`; a name of the table is looked up)."""
-    from .job_law import job_law
-
-    return job_law(law) if isinstance(law, str) else law
-
-
 def check_fixed(law, fixed: dict):
     """The values given for every row (`--param`, `--mass`, ...): numbers in range (`law`:
-    a `JobLaw`, or a name of the law table)."""
-    law = _job_law(law)
+    a `JobLaw`)."""
     positive, signed = (*_POSITIVE, *law.positive), _signed(law, fixed)
     for key, value in fixed.items():
         if key == "separation":
@@ -74,9 +66,8 @@ def check_rows(law, values: dict, fixed: dict, where, options=None):
     """Raise a one-line `ValueError` at the first row (file order) with a bad value in
     `values` (column -> array), or whose column disagrees with the value `options` (name ->
     value, the options the caller gave for every row) holds for it: a column and an option
-    that disagree are refused, never settled silently. `law`: a `JobLaw` (or a name of the
-    law table); `fixed` completes its parameters; `where(i)` says where row `i` is."""
-    law = _job_law(law)
+    that disagree are refused, never settled silently. `law`: a `JobLaw`; `fixed` completes
+    its parameters; `where(i)` says where row `i` is."""
     positive, signed = (*_POSITIVE, *law.positive), _signed(law, {**fixed, **values})
     options = options or {}
     rows = len(next(iter(values.values())))
