@@ -16,7 +16,14 @@ import numpy as np
 from .._checks import MemberChecks
 from .._solve.precision import resolvable_tolerances
 from .grid import grid_applies, solve_oblique_grid
-from .impact import ObliqueOptions, checked_inputs, checked_settings, lever_share, solve_oblique
+from .impact import (
+    ObliqueInputs,
+    ObliqueOptions,
+    checked_inputs,
+    checked_settings,
+    lever_share,
+    solve_oblique,
+)
 from .results import ObliqueResult
 
 METHODS = ("auto", "integrate")
@@ -34,11 +41,13 @@ def _on_grid(law, tangential, m, R, v_n, v_t, omega, inertia, options):
 
 
 @eqx.filter_jit
-def _integrated(law, tangential, m, R, v_n, v_t, omega, inertia, g, options):
-    def one(*row):
-        return solve_oblique(law, tangential, *row, options)
+def _integrated(law, tangential, rows: ObliqueInputs, options):
+    """`solve_oblique` over `rows` (an `ObliqueInputs` of 1-D arrays, SI units)."""
 
-    return jax.vmap(one)(m, R, v_n, v_t, omega, inertia, g)
+    def one(row):
+        return solve_oblique(law, tangential, row, options)
+
+    return jax.vmap(one)(rows)
 
 
 def batch_options(*, separation: str, contact_point, rtol: float) -> ObliqueOptions:
@@ -139,7 +148,8 @@ def _second_pass(law, tangential, arrays, left, options) -> dict:
     for start in range(0, left.size, CHUNK):
         rows = left[start : start + CHUNK]
         pick = np.concatenate([rows, np.full(_padded(rows.size) - rows.size, rows[0])])
-        rest = _integrated(law, tangential, *(jnp.asarray(a[pick]) for a in arrays), options)
+        rows_in = ObliqueInputs(*(jnp.asarray(a[pick]) for a in arrays))
+        rest = _integrated(law, tangential, rows_in, options)
         parts.append(
             {f.name: np.asarray(getattr(rest, f.name))[: rows.size] for f in _array_fields()}
         )

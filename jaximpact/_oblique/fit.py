@@ -26,7 +26,7 @@ from .._solve.options import CUSTOM_RTOL, DEFAULT_RTOL
 from .._solve.precision import resolvable_tolerances
 from .._status import Status
 from .._xla_log import quietly_compiled
-from .impact import ObliqueOptions, _check_laws, lever_share, solve_oblique
+from .impact import ObliqueInputs, ObliqueOptions, _check_laws, lever_share, solve_oblique
 from .tangential import AbstractTangentialLaw
 from .theory import rigid_oblique
 
@@ -246,9 +246,8 @@ class _Problem(eqx.Module):
         fitted = _with(self.tangential, self.free, theta)
 
         def one(vn, vt, om):
-            return solve_oblique(
-                self.law, fitted, self.m, self.R, vn, vt, om, self.inertia, self.g, self.options
-            )
+            inputs = ObliqueInputs(self.m, self.R, vn, vt, om, self.inertia, self.g)
+            return solve_oblique(self.law, fitted, inputs, self.options)
 
         return jax.vmap(one)(self.v_n, self.v_t, self.omega)
 

@@ -56,7 +56,7 @@ import jax.numpy as jnp
 from .._solve.grid import _A, _B, _B_ERR, _C, E_FLOOR, GRID_ACCEPT, GRID_RTOL, _combine, _Contact
 from .._status import Status
 from .dynamics import SLIP, STICK, ObliqueDynamics
-from .impact import ObliqueOptions, _first_touch, oblique_result
+from .impact import ObliqueInputs, ObliqueOptions, ObliqueOutcome, _first_touch, oblique_result
 
 # grid steps over s in [0, 1] (even: maximum compression is a grid point): the tangential
 # oscillation and the stick-slip splits ask for more than the normal contact's 24
@@ -228,20 +228,15 @@ def _first_root(g0, d0, g1, d1, h):
 def grid_oblique(
     law,
     tangential,
-    m,
-    R,
-    v_n,
-    v_t,
-    omega,
-    inertia,
+    inputs: ObliqueInputs,
+    options: ObliqueOptions,
     *,
     mode,
     sense,
-    separation: str,
-    lever_share: float,
     steps: int = OBLIQUE_STEPS,
 ) -> dict:
-    """One oblique contact (no gravity) on the grid, from first touch in the tangential
+    """One oblique contact of `inputs` (SI units; no gravity: `inputs.g` is not read) on
+    the grid, with `options`' separation and lever arm, from first touch in the tangential
     `mode` and `sense` (`impact._first_mode`'s). Returns the outgoing `e` (`v_n_out /
     v_n`), `V_t` and `W` (the centre's tangential velocity and `R omega` in units of
     `v_n`), `X` (the overlap at the end, units of `x*`), `tau` (the duration, units of
@@ -249,6 +244,8 @@ def grid_oblique(
     `estimate` (module docstring)."""
     if steps % 2:
         raise ValueError(f"the grid needs an even number of steps, got {steps}")
+    m, R, v_n, v_t, omega, inertia, _ = inputs
+    separation, lever_share = options.separation, options.lever_share
     contact = _Contact(law, m, v_n)
     spring = tangential.dynamics(m=m, R=R, inertia=inertia, x_star=contact.x_star, v_n=v_n)
     loss = lever_share * contact.x_star / R if lever_share else None
@@ -536,28 +533,9 @@ def grid_outcome(law, tangential, m, R, v_n, v_t, omega, inertia, options: Obliq
     dyn = ObliqueDynamics(normal=normal, tangential=spring, size=int(y_n0.shape[0]))
     y0 = jnp.concatenate([y_n0, jnp.stack([jnp.zeros(()), v_t / v_n, R * omega / v_n])])
     mode, sense, ratio = _first_touch(dyn, y0, jnp.asarray(normal.split))
-    out = grid_oblique(
-        law,
-        tangential,
-        m,
-        R,
-        v_n,
-        v_t,
-        omega,
-        inertia,
-        mode=mode,
-        sense=sense,
-        separation=options.separation,
-        lever_share=options.lever_share,
-    )
-    result = oblique_result(
-        m=m,
-        R=R,
-        v_n=v_n,
-        v_t=v_t,
-        omega=omega,
-        inertia=inertia,
-        g=0.0,
+    inputs = ObliqueInputs(m, R, v_n, v_t, omega, inertia, 0.0)
+    out = grid_oblique(law, tangential, inputs, options, mode=mode, sense=sense)
+    outcome = ObliqueOutcome(
         v_n_out=out["e"] * v_n,
         v_t_out=out["V_t"] * v_n,
         omega_out=out["W"] * v_n / R,
@@ -566,8 +544,8 @@ def grid_outcome(law, tangential, m, R, v_n, v_t, omega, inertia, options: Obliq
         status=jnp.full(jnp.shape(v_n), Status.separated, jnp.int32),
         switches=out["switches"],
         steps=out["iterations"],
-        path="grid",
     )
+    result = oblique_result(inputs, outcome, path="grid")
     # a first touch near the limit (Maw et al.'s psi_1 near 1) starts with transitions
     # close to s = 0, where the conditions' rates vanish with the grading: integrated
     marginal = (ratio > 1.0 / FIRST_TOUCH_MARGIN) & (ratio < FIRST_TOUCH_MARGIN)

@@ -13,6 +13,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
+from jaxtyping import ArrayLike
 
 from .._checks import MemberChecks, is_traced
 from .._laws import AbstractLaw
@@ -90,6 +91,32 @@ class ObliqueOptions(eqx.Module):
     lever_share: float = eqx.field(static=True, default=0.0)
 
 
+class ObliqueInputs(NamedTuple):
+    """The sphere and its impact, the numbers of one oblique solve (SI units; arrays are
+    traced, Python numbers static under `eqx.filter_jit`): see `oblique_impact`."""
+
+    m: ArrayLike  # mass (kg)
+    R: ArrayLike  # radius (m)
+    v_n: ArrayLike  # normal speed, approaching > 0 (m/s)
+    v_t: ArrayLike  # the centre's tangential speed (m/s)
+    omega: ArrayLike  # spin (rad/s)
+    inertia: ArrayLike  # I / (m R^2)
+    g: ArrayLike  # gravity along the inward normal (m/s^2)
+
+
+class ObliqueOutcome(NamedTuple):
+    """What a solve (either path) ends with, in SI units, for `oblique_result`."""
+
+    v_n_out: ArrayLike  # outgoing normal speed (m/s, leaving > 0)
+    v_t_out: ArrayLike  # outgoing tangential speed of the centre (m/s)
+    omega_out: ArrayLike  # outgoing spin (rad/s)
+    x_end: ArrayLike  # overlap at the end of contact (m)
+    T: ArrayLike  # contact duration (s)
+    status: ArrayLike  # `Status` (int32)
+    switches: ArrayLike  # stick-slip switches
+    steps: ArrayLike  # steps taken (the solver's; the grid's loop iterations)
+
+
 def _conditions(dyn: ObliqueDynamics, separation: str, rest_tol: float):
     """Real-valued event conditions, positive before their event, in order of precedence
     (where two cross in one step diffrax takes the first in order, not the earlier in
@@ -135,9 +162,10 @@ def _conditions(dyn: ObliqueDynamics, separation: str, rest_tol: float):
     return tuple(conditions)
 
 
-def _land(dyn, conditions, masks, term, tau, y, tau_event, args, options, controller):
-    """The state and time at the segment's event, with derivatives that use the vector
-    field, not the interpolant's slope.
+def _land(setup: "_Setup", masks, tau, y, tau_event, args):
+    """The state and time at the segment's event (units of `x*`, `v_n`, `t*`), from the
+    segment's start `(tau, y)` and the event time `tau_event` diffrax found, with
+    derivatives that use the vector field, not the interpolant's slope.
 
     diffrax returns the state at an event from its dense interpolant, whose derivative in
     time is less accurate than the solution (measured: 3.5e-5 against 1e-10): where the
@@ -148,16 +176,17 @@ def _land(dyn, conditions, masks, term, tau, y, tau_event, args, options, contro
     and one Newton step on the fired condition `g` places it, `dt = -g / (grad g . f)`:
     its value moves by the root finder's 1e-13 at most, its derivatives are the implicit
     function theorem's with the exact vector field."""
+    dyn, options, conditions = setup.dyn, setup.options, setup.conditions
     t_star = jax.lax.stop_gradient(tau_event)
     solved = dfx.diffeqsolve(
-        term,
+        setup.term,
         options.solver,
         tau,
         t_star,
         None,
         y,
         args=args,
-        stepsize_controller=controller,
+        stepsize_controller=setup.controller,
         saveat=dfx.SaveAt(t1=True),
         adjoint=options.adjoint,
         max_steps=options.max_steps,
@@ -239,7 +268,7 @@ class _Setup(NamedTuple):
 def _segment(setup: _Setup, carry, _):
     """One segment of `_segments`' scan: solve in the current tangential mode until an
     event, then decide the status and the next mode (the carry of `_segments`)."""
-    dyn, options, conditions, event = setup.dyn, setup.options, setup.conditions, setup.event
+    dyn, options, event = setup.dyn, setup.options, setup.event
     term, controller, has_surface = setup.term, setup.controller, setup.has_surface
     normal, size = dyn.normal, dyn.size
     y, tau, mode, sense, compressing, mute, t_stop, alive, status, switches, steps, pin = carry
@@ -264,7 +293,7 @@ def _segment(setup: _Setup, carry, _):
     y1, tau1 = sol.ys[-1], sol.ts[-1]
     masks = sol.event_mask
     if options.land:
-        y1, tau1 = _land(dyn, conditions, masks, term, tau, y, tau1, args, options, controller)
+        y1, tau1 = _land(setup, masks, tau, y, tau1, args)
     ended = (masks[0] & ~compressing) | (masks[3] if has_surface else False)
     at_max = masks[0] & compressing
     switched = masks[-1]
@@ -449,8 +478,10 @@ def _safe_angle(t, n):
 
 
 @eqx.filter_jit
-def solve_oblique(law, tangential, m, R, v_n, v_t, omega, inertia, g, options: ObliqueOptions):
-    """The compiled part of `oblique_impact` (no input checks)."""
+def solve_oblique(law, tangential, inputs: ObliqueInputs, options: ObliqueOptions):
+    """The compiled part of `oblique_impact` (no input checks): the `ObliqueResult` of
+    `inputs` (SI units)."""
+    m, R, v_n, v_t, omega, inertia, g = inputs
     normal = law.dynamics(m=m, v0=v_n, g=g)
     spring = tangential.dynamics(m=m, R=R, inertia=inertia, x_star=normal.x_star, v_n=v_n)
     y_n0 = normal.y0()
@@ -464,14 +495,7 @@ def solve_oblique(law, tangential, m, R, v_n, v_t, omega, inertia, g, options: O
     separated = status == Status.separated
     v_n_out = jnp.where(separated, -normal.velocity(y_n) * v_n, 0.0)
     x_end = normal.position(y_n) * normal.x_star
-    return oblique_result(
-        m=m,
-        R=R,
-        v_n=v_n,
-        v_t=v_t,
-        omega=omega,
-        inertia=inertia,
-        g=g,
+    outcome = ObliqueOutcome(
         v_n_out=v_n_out,
         v_t_out=y[dyn.size + 1] * v_n,
         omega_out=y[dyn.size + 2] * v_n / R,
@@ -481,29 +505,16 @@ def solve_oblique(law, tangential, m, R, v_n, v_t, omega, inertia, g, options: O
         switches=switches,
         steps=steps,
     )
+    return oblique_result(inputs, outcome)
 
 
 def oblique_result(
-    *,
-    m,
-    R,
-    v_n,
-    v_t,
-    omega,
-    inertia,
-    g,
-    v_n_out,
-    v_t_out,
-    omega_out,
-    x_end,
-    T,
-    status,
-    switches,
-    steps,
-    path="integrated",
+    inputs: ObliqueInputs, outcome: ObliqueOutcome, *, path="integrated"
 ) -> ObliqueResult:
-    """The `ObliqueResult` of a solve's outcome (SI units; every path's): the fields that
-    follow from the outgoing velocities, NaN where the solve failed."""
+    """The `ObliqueResult` of a solve's `outcome` from `inputs` (SI units; every path's):
+    the fields that follow from the outgoing velocities, NaN where the solve failed."""
+    m, R, v_n, v_t, omega, inertia, g = inputs
+    v_n_out, v_t_out, omega_out, x_end, T, status, switches, steps = outcome
     u_in = v_t - R * omega
     u_out = v_t_out - R * omega_out
     moment = inertia * m * R**2
@@ -555,10 +566,10 @@ def checked_settings(law, tangential, separation: str, rtol):
     return rtol
 
 
-def checked_inputs(checks: MemberChecks, m, R, v_n, v_t, omega, inertia, g) -> tuple:
-    """The sphere's and the impact's inputs (SI units) checked by `checks`, in
-    `solve_oblique`'s order: `m`, `R`, `v_n`, `inertia` > 0, `g` >= 0, all finite."""
-    return (
+def checked_inputs(checks: MemberChecks, m, R, v_n, v_t, omega, inertia, g) -> ObliqueInputs:
+    """The sphere's and the impact's inputs (SI units) checked by `checks`, as
+    `solve_oblique` takes them: `m`, `R`, `v_n`, `inertia` > 0, `g` >= 0, all finite."""
+    return ObliqueInputs(
         checks.positive("mass m", m, "kg"),
         checks.positive("radius R", R, "m"),
         checks.positive("normal speed v_n (approaching)", v_n, "m/s"),
@@ -728,14 +739,14 @@ def oblique_impact(
         # jax.grad: the forward-mode Jacobian, transposed (`adjoint.by_forward_jacobian`)
         forward = dataclasses.replace(options, adjoint=dfx.ForwardMode())
         result = through_forward_jacobian(
-            lambda *args: solve_oblique(*args, forward),
+            lambda law, tangential, *v: solve_oblique(law, tangential, ObliqueInputs(*v), forward),
             law,
             tangential,
             *values,
             closes_over=law.spec is None,
         )
     else:
-        result = solve_oblique(law, tangential, *values, options)
+        result = solve_oblique(law, tangential, ObliqueInputs(*values), options)
     result = checks.refuse(result, status=Status.invalid)
     if throw is not False and not is_traced(result.status) and np.ndim(result.status) == 0:
         status = Status(int(result.status))

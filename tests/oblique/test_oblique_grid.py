@@ -25,7 +25,7 @@ import jaximpact as ji
 from jaximpact._oblique import oblique_impact_batch, tangential_law
 from jaximpact._oblique.batch import batch_options
 from jaximpact._oblique.grid import DIP_TOL, MIN_GAP, OBLIQUE_STEPS, grid_outcome
-from jaximpact._oblique.impact import solve_oblique
+from jaximpact._oblique.impact import ObliqueInputs, solve_oblique
 
 E, NU, RHO, R = 380e9, 0.23, 4000.0, 2.5e-3
 M = RHO * 4.0 / 3.0 * np.pi * R**3
@@ -118,7 +118,7 @@ def case(request):
     def integrated(v_n, v_t, mu):
         def one(a, b, f):
             tl = tangential_law(name, mu=f, **params)
-            return solve_oblique(law, tl, M, R, a, b, 0.0, 0.4, 0.0, options)
+            return solve_oblique(law, tl, ObliqueInputs(M, R, a, b, 0.0, 0.4, 0.0), options)
 
         return jax.vmap(one)(v_n, v_t, mu)
 
