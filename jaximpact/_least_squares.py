@@ -39,8 +39,9 @@ def levenberg_marquardt(
     direction the data do not see stays where it is. `active`: a mask of the components
     to move (default all). `max_step`: the largest move of one component in one step (a
     step beyond it is shortened along its direction), for parameters in logarithms or
-    logits, where a long step can land where the loss is flat. Converged: the scaled gradient, the relative decrease or the
-    step fell below `tol`, or no step lowers the loss any more."""
+    logits, where a long step can land where the loss is flat. Converged: the scaled
+    gradient, the relative decrease or the step fell below `tol`, or no step lowers the
+    loss any more."""
     theta = np.array(theta0, dtype=float)
     r, J, extra = evaluate(theta)
     cost = 0.5 * float(r @ r)

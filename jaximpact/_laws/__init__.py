@@ -5,9 +5,9 @@ from .base import (
     AbstractLaw as AbstractLaw,
     LawSpec as LawSpec,
     damping_parameter as damping_parameter,
-    stiffness_parameter as stiffness_parameter,
     exponents as exponents,
     shape_of as shape_of,
+    stiffness_parameter as stiffness_parameter,
 )
 from .custom import CustomLaw as CustomLaw, custom_law as custom_law
 from .maxwell import MaxwellLaw as MaxwellLaw

@@ -63,8 +63,8 @@ def _is_literal_zero(atom, consts_by_var, zeros) -> bool:
 
 def _zero_flags(jaxpr, consts, invar_zeros):
     """Which variables of `jaxpr` are known to hold zeros (structurally)."""
-    consts_by_var = dict(zip(jaxpr.constvars, consts))
-    zeros = dict(zip(jaxpr.invars, invar_zeros))
+    consts_by_var = dict(zip(jaxpr.constvars, consts, strict=False))
+    zeros = dict(zip(jaxpr.invars, invar_zeros, strict=False))
     for eqn in jaxpr.eqns:
         if eqn.primitive.name in _ZERO_PRESERVING and len(eqn.invars) >= 1:
             zeros[eqn.outvars[0]] = _is_literal_zero(eqn.invars[0], consts_by_var, zeros)
@@ -111,8 +111,8 @@ def _call_body(eqn):
 def _peel(jaxpr, consts, args, invar_zeros):
     """Evaluate `jaxpr` at `args`, returning the operand of its final clamp at zero."""
     zeros, consts_by_var = _zero_flags(jaxpr, consts, invar_zeros)
-    env = dict(zip(jaxpr.constvars, consts))
-    env.update(zip(jaxpr.invars, args))
+    env = dict(zip(jaxpr.constvars, consts, strict=False))
+    env.update(zip(jaxpr.invars, args, strict=False))
 
     def read(atom):
         return atom.val if isinstance(atom, jex_core.Literal) else env[atom]
@@ -131,5 +131,5 @@ def _peel(jaxpr, consts, args, invar_zeros):
         values = eqn.primitive.bind(*invals, **eqn.primitive.get_bind_params(eqn.params))
         if not eqn.primitive.multiple_results:
             values = [values]
-        env.update(zip(eqn.outvars, values))
+        env.update(zip(eqn.outvars, values, strict=False))
     raise AssertionError("the clamp was found when the law was read, but not evaluated")

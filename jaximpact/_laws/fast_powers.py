@@ -78,9 +78,9 @@ def _constant(atom, constants):
 def _evaluate(jaxpr, consts, args, constants=None):
     """Evaluate `jaxpr` at `args` (its flat inputs), with the rewrite (see the module);
     `constants`: the inputs known when the law is read (the literals of a call)."""
-    constants = {**dict(zip(jaxpr.constvars, consts)), **(constants or {})}
-    env = dict(zip(jaxpr.constvars, consts))
-    env.update(zip(jaxpr.invars, args))
+    constants = {**dict(zip(jaxpr.constvars, consts, strict=False)), **(constants or {})}
+    env = dict(zip(jaxpr.constvars, consts, strict=False))
+    env.update(zip(jaxpr.invars, args, strict=False))
 
     def read(atom):
         return atom.val if isinstance(atom, jex_core.Literal) else env[atom]
@@ -96,7 +96,7 @@ def _evaluate(jaxpr, consts, args, constants=None):
                 inner, inner_consts = body
                 known = {
                     var: value
-                    for var, atom in zip(inner.invars, eqn.invars)
+                    for var, atom in zip(inner.invars, eqn.invars, strict=False)
                     if (value := _constant(atom, constants)) is not None
                 }
                 values = _evaluate(inner, inner_consts, invals, known)
@@ -104,7 +104,7 @@ def _evaluate(jaxpr, consts, args, constants=None):
                 values = eqn.primitive.bind(*invals, **eqn.primitive.get_bind_params(eqn.params))
                 if not eqn.primitive.multiple_results:
                     values = [values]
-        env.update(zip(eqn.outvars, values))
+        env.update(zip(eqn.outvars, values, strict=False))
     return [read(a) for a in jaxpr.outvars]
 
 

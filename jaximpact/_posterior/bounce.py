@@ -90,10 +90,16 @@ class BounceModel(eqx.Module):
 
     def values(self, z) -> dict:
         """`{name: value}` (SI, data units for a track's floor and scale) at `z`."""
-        return {k: p.value(z[..., i]) for i, (k, p) in enumerate(zip(self.names, self.priors))}
+        return {
+            k: p.value(z[..., i])
+            for i, (k, p) in enumerate(zip(self.names, self.priors, strict=False))
+        }
 
     def coordinates(self, values: dict) -> np.ndarray:
-        return np.stack([p.coordinate(values[k]) for k, p in zip(self.names, self.priors)], axis=-1)
+        return np.stack(
+            [p.coordinate(values[k]) for k, p in zip(self.names, self.priors, strict=False)],
+            axis=-1,
+        )
 
     def theta(self, values: dict):
         """The fit's own coordinates of `values`: `to_unbounded` of the law's, the

@@ -80,7 +80,10 @@ class EvidenceRankings(list):
                 ]
             )
         widths = [max(len(line[i]) for line in lines) for i in range(len(header))]
-        text = ["  ".join(c.ljust(w) for c, w in zip(line, widths)).rstrip() for line in lines]
+        text = [
+            "  ".join(c.ljust(w) for c, w in zip(line, widths, strict=False)).rstrip()
+            for line in lines
+        ]
         text.append(
             "bayes_factor: the best law's evidence over this one's (Laplace, nats in log_evidence)"
         )

@@ -212,7 +212,7 @@ def posterior(
         noise=noise,
         nu=float(nu),
         units=units,
-        priors={k: p.as_tuple() for k, p in zip(model.names, model.priors)},
+        priors={k: p.as_tuple() for k, p in zip(model.names, model.priors, strict=False)},
         map={k: float(v) for k, v in at_mode.items()},
         log_evidence=float(mode.log_evidence),
         diagnostics=diag,

@@ -651,8 +651,9 @@ def bounce(
     - `solver`, `rtol`, `atol`, `max_steps`, `tau_max`, `rest_tol`, `peaks`: each contact's
       solve, as in `impact` (`rtol` by default 1e-11 for a law of the table, 1e-12 for a
       user's law: each contact's e, T and x_max within 1e-9; `peaks=False` leaves `F_max`
-      and `x_max` out and integrates each contact in one phase; the histories always use the three phases, so they then agree
-      with the per-contact arrays to the solver's tolerance rather than exactly); `adjoint`:
+      and `x_max` out and integrates each contact in one phase; the histories always use
+      the three phases, so they then agree with the per-contact arrays to the solver's
+      tolerance rather than exactly); `adjoint`:
       default picks the cheapest diffrax adjoint for the transformation in use
       (`ForwardMode` under `jax.jacfwd`). Tolerances must lie in (0, 1), `tau_max` be > 0,
       `max_steps` and `max_impacts` integers >= 1 (a ValueError otherwise).
