@@ -1,8 +1,6 @@
-"""The engines people run (MuJoCo, Drake, LAMMPS, LIGGGHTS, Chrono, Yade): material inputs,
-and exports of a law to an engine's own contact parameters with the e and T the engine
-realises (docs/engines.md). `base.AbstractEngine` is what an engine declares, its tables
-of normal and tangential models (`base.AbstractNormalModel`, `base.AbstractTangentialModel`)
-included; `registry.ENGINES` is the one registry of them (docs/layout.md, "Adding an engine")."""
+"""Exports of a law to the contact parameters of MuJoCo, Drake, LAMMPS, LIGGGHTS, Chrono and
+Yade with the e and T they realise (docs/engines.md); the engines are declared through
+`base.py` and registered in `registry.ENGINES` (docs/layout.md, "Adding an engine")."""
 
 from .base import (
     AbstractEngine as AbstractEngine,

@@ -1,36 +1,23 @@
-"""Replicas of the engines' time stepping for one head-on contact, in numpy, and the time step
-an export recommends from them.
-
-They predict what an engine realises (its discretisation included) without running it; the
-engine tests check them against the engines themselves. Each contact is started at several
-phases inside a time step (the first touch falls `phase * h` after a step's start), since
-the realised e depends on it at first order in the step.
-"""
+"""Replicas of the engines' time stepping of one head-on contact (numpy; tests/engines checks
+them against the engines), and the step an export recommends. Each contact starts at
+`PHASES` inside a step (first touch `phase * h` after its start): e depends on it."""
 
 import math
 
 import numpy as np
 
 PHASES = (np.arange(16) + 0.5) / 16
-# The export's tolerance (relative): at its recommended step the engine realises e within it
-# of the target wherever the first touch falls inside a step (every start phase), and T (the
-# mean over start phases; each contact is counted in whole steps) within it; a given step
-# that misses it is warned about (`replicated`).
-STEP_TOL = 0.005
+STEP_TOL = 0.005  # the recommended step's tolerance (relative; `realises`)
 _COARSEST_STEPS, MAX_STEPS = 10, 51200  # steps per contact a recommended step searches
 _BISECTIONS = 5  # halvings of log(h) between a step that realises and one twice as coarse
-# What an export refuses (`unrealised`): a contact resolved by fewer steps than this, or a
-# realised (phase-mean) e or T further than this (relative) from the target
-RESOLVED_STEPS = 5
-REFUSE_TOL = 0.05
+RESOLVED_STEPS, REFUSE_TOL = 5, 0.05  # what an export refuses (`unrealised`)
 _E_SLACK = 0.005  # e above 1 by less than this is round-off, not a gain of energy
 
 
 def step_until_separated(step, h, v0, phases=PHASES, max_steps=2_000_000):
     """`(e, T)` per start phase of a contact stepped by `step(x, v) -> (x1, v1, pushing)`
-    (arrays: penetration `x` in m, approach speed `v` in m/s, whether the step's force is
-    non-zero) from `x = -phase v0 h` until the force is zero again; `T` (s) is the number of
-    steps with a non-zero force times `h`."""
+    (penetration m, approach speed m/s) from `x = -phase v0 h` until the force is zero again;
+    `T` (s): the steps with a force times `h`."""
     x = -v0 * h * np.asarray(phases, float)
     v = np.full_like(x, v0)
     steps = np.zeros_like(x)
@@ -48,10 +35,7 @@ def step_until_separated(step, h, v0, phases=PHASES, max_steps=2_000_000):
 
 
 def semi_implicit_euler(accel, h, v0, phases=PHASES, max_steps=2_000_000):
-    """MuJoCo's Euler: `a_k = accel(x_k, v_k)`, `v += h a`, `x += h v`; the contact is
-    active while `x > 0` at a step's start. `accel(x, v)` is the contact acceleration along
-    the penetration `x` (<= 0, it never pulls). Returns `(e, T)` per phase, `T` the number of
-    steps with a non-zero force times `h`."""
+    """MuJoCo's Euler: `a = accel(x, v)` while `x > 0`, `v += h a`, `x += h v`."""
 
     def step(x, v):
         a = np.where(x > 0, accel(np.maximum(x, 0.0), v), 0.0)
@@ -62,8 +46,8 @@ def semi_implicit_euler(accel, h, v0, phases=PHASES, max_steps=2_000_000):
 
 
 def velocity_verlet(accel, h, v0, phases=PHASES, max_steps=2_000_000):
-    """LAMMPS's `fix nve` (and `nve/sphere`): half kick, drift, force from the new
-    positions and the half-step velocities, half kick. `accel(x, v)` as above."""
+    """LAMMPS's `fix nve/sphere`: half kick, drift, force at the new positions and half-step
+    velocities, half kick."""
     a = np.zeros(np.shape(phases))
 
     def step(x, v):
@@ -77,13 +61,9 @@ def velocity_verlet(accel, h, v0, phases=PHASES, max_steps=2_000_000):
 
 
 def cohesive_verlet(force, holds, h, m_eff, v0, phases=PHASES, max_steps=10_000_000):
-    """`(e, T)` per start phase of LAMMPS's `fix nve/sphere` (velocity Verlet) on a contact
-    that can hold the body (a cohesive normal model, `jkr` or `dmt`): `force(x, v)` (N,
-    pushing apart) at overlap `x` (m) and the half-step approach speed `v` (m/s), `holds(x,
-    attached)` whether the contact exists at `x` given that it did before, effective mass
-    `m_eff` (kg), impact speed `v0` (m/s). T (s) is the number of steps with a contact times
-    `h`; a body the contact holds (its speed turns back in before it lets go) gives `e = 0`
-    and T the steps until then (as `impact`'s `captured`)."""
+    """`velocity_verlet` on a cohesive contact (`jkr`, `dmt`): `force(x, v)` (N, pushing
+    apart), `holds(x, attached)` whether the contact exists at `x`, mass `m_eff` (kg). A body
+    held (turning back in before it lets go) gives `e = 0`, T the steps until then."""
     x = -v0 * h * np.asarray(phases, float)
     v = np.full_like(x, v0)  # approach speed, d delta / dt
     a = np.zeros_like(x)
@@ -116,8 +96,7 @@ def cohesive_verlet(force, holds, h, m_eff, v0, phases=PHASES, max_steps=10_000_
 
 
 def _floor3(x: float) -> str:
-    """`x` > 0 rounded down to three significant digits, as text: 4.9996 reads 4.99, never
-    the 5 it falls short of."""
+    """`x` > 0 rounded down to three digits, as text (4.9996 reads 4.99, not 5)."""
     if not (x > 0 and math.isfinite(x)):
         return f"{x:g}"
     scale = 10.0 ** (math.floor(math.log10(x)) - 2)
@@ -131,10 +110,8 @@ def nice_down(h: float) -> float:
 
 
 def realises(es, Ts, e: float | None, T: float, tol: float = STEP_TOL) -> bool:
-    """Whether a stepping's `(e, T)` per start phase is within `tol` (relative) of the
-    target: every phase's e within `tol` of `e` and the phase-mean T within `tol` of `T`
-    (s). `e` None: the phases' e within `tol` of their own mean, and T not judged (a design
-    that corrects its mean e and T for the step afterwards, as MuJoCo's)."""
+    """Whether every phase's e is within `tol` (relative) of `e` and the phase-mean T of `T`
+    (s); `e` None: of their own mean, T not judged (MuJoCo corrects its means after)."""
     es, Ts = np.asarray(es, float), np.asarray(Ts, float)
     if not (np.all(np.isfinite(es)) and np.all(np.isfinite(Ts))):
         return False
@@ -146,28 +123,22 @@ def realises(es, Ts, e: float | None, T: float, tol: float = STEP_TOL) -> bool:
 
 
 def per_contact(h: float, T: float) -> str:
-    """The step `h` (s) as a share of the contact's duration `T` (s): `"T/45"` (T over the
-    step, rounded; below 10 steps rounded down to three digits, so that 4.996 steps never
-    reads as 5)."""
+    """`"T/45"`: the step `h` (s) as a share of `T` (s), below 10 rounded down (`_floor3`)."""
     steps = T / h
     return f"T/{steps:.0f}" if steps >= 10 else f"T/{_floor3(steps)}"
 
 
 def describe_step(h: float, T: float | None) -> str:
-    """`h` (s) for people, with `per_contact` beside it: `"1.1e-06 s (T/45)"` (without a
-    duration `T`, s, or a step, the step alone)."""
+    """`"1.1e-06 s (T/45)"`: `h` (s) with `per_contact` where `T` (s) is given."""
     if not T or not h:
         return f"{h:.3g} s"
     return f"{h:.3g} s ({per_contact(h, T)})"
 
 
 def replicated(replica, params: dict, scene, e: float, T: float, timestep, *, engine, step):
-    """`(params, es, Ts, warnings)` for an engine whose stepping `replica(params, m, v0) ->
-    (e, T)` per start phase in `scene` (its `m` kg, `v0` m/s; on a wall, `params` with
-    `geometry` "wall") realises the target `e` and `T` (s): `params` with the `timestep`
-    given (s) or, when None, `recommended_step`; what `replica` realises there; and a
-    warning (its step called `step` in `engine`'s words) where that misses the export's
-    tolerance (`realises`, `STEP_TOL`), naming the recommended step."""
+    """`(params, es, Ts, warnings)`: `params` at `timestep` (s; None: `recommended_step`),
+    what `replica(params, m, v0)` realises there in `scene`, and a warning where that misses
+    `STEP_TOL` (its step named `step` in `engine`'s words)."""
     params = {**params, **({"geometry": "wall"} if scene.wall else {})}
 
     def run(h):
@@ -187,14 +158,9 @@ def replicated(replica, params: dict, scene, e: float, T: float, timestep, *, en
 
 
 def recommended_step(run, T: float, e: float | None = None, tol: float = STEP_TOL) -> float:
-    """The time step (s) an export recommends for a contact of duration `T` (s): the
-    coarsest at which the engine's stepping `run(h) -> (e, T)` per start phase realises the
-    target `e` and `T` within `tol` (`realises`; `e` None: e's spread over start phases
-    alone), rounded down to two digits (`nice_down`). The search halves the step from T/10
-    until it realises the target, then bisects log(h) between that step and the one twice
-    as coarse (which did not), so that a step twice the recommended one misses the target;
-    T/51200 where none down to it does. A stepping that fails at a step (no separation, a
-    non-finite value) does not realise the target there."""
+    """The coarsest step (s, `nice_down`) at which `run(h) -> (e, T)` per phase `realises`
+    the target: halving from T/10 until it does, then bisecting log(h) against the step
+    twice as coarse; T/51200 where none does. A step that fails does not realise it."""
     passed = []  # the steps that realised the target
 
     def ok(h: float) -> bool:
@@ -236,18 +202,10 @@ def recommended_step(run, T: float, e: float | None = None, tol: float = STEP_TO
 
 
 def unrealised(e, T, *, target_e: float, target_T, steps_per_contact, parameters: dict):
-    """Why an engine cannot realise the target `target_e`, `target_T` (s) with its exported
-    `parameters`, or None where it can. It cannot when (in this order):
-
-    - a parameter is not a finite number (NaN or an overflow in the design);
-    - what it realises is not an impact: e or T (s) not finite, e outside [0, 1] (0.5 % of
-      slack for round-off at e = 1), T <= 0;
-    - its step does not resolve the contact: fewer than `RESOLVED_STEPS` (5) steps per
-      contact (`steps_per_contact`: target T over the step; None where no step applies);
-    - what it realises (the mean over where first touch falls inside a step) misses the
-      target e or T by more than `REFUSE_TOL` (5 %, ten times the 0.5 % that warns).
-
-    The reason is one line naming what the engine would realise."""
+    """Why the engine cannot realise `target_e`, `target_T` (s) with `parameters`, in one
+    line, or None: a parameter not finite; no impact (e or T not finite, e outside [0, 1]
+    with `_E_SLACK`, T <= 0); fewer than `RESOLVED_STEPS` steps per contact; or the phase-mean
+    e or T more than `REFUSE_TOL` off."""
     for key, value in parameters.items():
         values = value if isinstance(value, (list, tuple)) else [value]
         for v in values:

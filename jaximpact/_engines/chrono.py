@@ -1,40 +1,24 @@
-"""Project Chrono (SMC): two equal spheres with `ChContactMaterialSMC` and the Hertz force
-model from material properties, by its source (not run here: PyChrono is on conda only).
-
-Chrono main (commit 7689fbc, 2026), `src/chrono/physics/ChContactSMC.cpp`,
-`ChDefaultContactForceTorqueSMC::CalculateForceTorque`: `eff_mass = m1 m2/(m1 + m2)`;
-`case ChSystemSMC::Hertz` with `UsingMaterialProperties()` (the default):
-`Sn = 2 E_eff sqrt(eff_radius delta)`, `beta = ln(cr_eff)/sqrt(ln^2 cr_eff + pi^2)`,
-`kn = 2/3 Sn`, `gn = -2 sqrt(5/6) beta sqrt(Sn eff_mass)`; then
-`forceN = kn delta - gn relvel_n` "and if negative, set to zero" (line ~175).
-`ChContactMaterialSMC.cpp`: `E_eff = 1/((1 - nu1^2)/E1 + (1 - nu2^2)/E2)` (computed in
-float), `cr_eff = min(cr1, cr2)` (`ChContactMaterialCompositionStrategy`). That is the Tsuji
-form of LAMMPS's `coeff_restitution` (law `tsuji_restitution`) with the force kept
-non-attractive (`separation="force"`): the realised e is above the `cr` given, and no `cr`
-gives less than about 0.14; the export inverts that law. Chrono's time stepper (implicit
-Euler by default) is not replicated: the promise is the continuous law's, at a recommended
-step of T/100 or less. Pitfalls: (1) `eff_radius` comes from the collision system: the
-Multicore narrowphase computes `R1 R2/(R1 + R2)` for two spheres, but the default Bullet
-system leaves `ChCollisionInfo`'s default, 0.1 m (`ChCollisionInfo.cpp`), whatever the
-spheres' size: the snippet sets that default to the pair's `R/2`. (2) `eff_mass` uses both
-contactables' masses, so a sphere on a fixed ground body sees the ground's own mass (give it
-a large one). (3) `cr_eff` is the smaller of the two materials' restitutions.
-"""
+"""Chrono's SMC Hertz contact from material properties, by its source (not run here: PyChrono
+is on conda only). Chrono 7689fbc, `src/chrono/physics/ChContactSMC.cpp`, `CalculateForceTorque`:
+`Sn = 2 E_eff sqrt(eff_radius delta)`, `beta = ln(cr_eff)/sqrt(ln^2 cr_eff + pi^2)`, `kn = 2/3
+Sn`, `gn = -2 sqrt(5/6) beta sqrt(Sn eff_mass)`, `forceN = kn delta - gn relvel_n`, zero where
+negative; `ChContactMaterialSMC.cpp`: `E_eff = 1/((1 - nu1^2)/E1 + (1 - nu2^2)/E2)`, `cr_eff =
+min(cr1, cr2)`: LAMMPS's Tsuji form with the force clamped (`"force"`), inverted. Its implicit
+stepper is not replicated (a step of T/100 or less). Pitfalls: Bullet's `eff_radius` is
+`ChCollisionInfo`'s default 0.1 m (the snippet sets R/2); `eff_mass` takes a fixed ground's
+mass (give it a large one); `cr_eff` is the smaller restitution."""
 
 from . import _stepping
 from .base import AbstractEngine, AbstractNormalModel, Design, Key, Stepping
 from .lammps import hertz
 from .lammps.engine import Lammps
 
-# A fixed body still enters eff_mass = m1 m2/(m1 + m2) with its own mass (ChContactSMC.cpp,
-# GetContactableMass): the snippet gives the ground 1e6 m, so eff_mass = m (1 - 1e-6) and gn
-# is 5e-7 (relative) below the design's: e moves by less than 1e-6.
+# the ground's mass over m: eff_mass = m (1 - 1e-6), e moved by less than 1e-6
 GROUND_MASS_RATIO = 1e6
 
 
 def _ground(parameters) -> list[str]:
-    """The fixed ground box of the sphere's material, its top face the plane z = 0, heavy:
-    Chrono's eff_mass takes the ground's mass even when it is fixed."""
+    """The fixed, heavy ground box of the sphere's material, its top face z = 0."""
     return [
         "# the ground: fixed, heavy (eff_mass takes its mass), the sphere's material",
         "ground = chrono.ChBodyEasyBox(1, 1, 0.1, 1000, True, True, mat)",
@@ -46,9 +30,7 @@ def _ground(parameters) -> list[str]:
 
 
 class SMCHertz(AbstractNormalModel):
-    """Chrono's SMC Hertz contact from material properties (`ChContactMaterialSMC`), its force
-    always kept non-attractive; its stepper is not replicated (the module's docstring has
-    the formulas, sources and pitfalls)."""
+    """Chrono's SMC Hertz contact (the module's docstring)."""
 
     NAME = "ChSystemSMC.Hertz"
     LAW = hertz.HertzMaterial.LAW
@@ -70,9 +52,6 @@ class SMCHertz(AbstractNormalModel):
     SCENES = None
 
     def design(self, e, T, scene, *, timestep=None, poisson=0.3, limit_damping=False) -> Design:
-        """`ChContactMaterialSMC` inputs for target `e` and `T` (s) in `scene` (on a wall,
-        `E_eff = E/(2 (1 - nu^2))`, `eff_radius = R`, `eff_mass` = m up to the ground's mass,
-        1e6 m); its force always kept non-attractive, whatever `limit_damping`."""
         contact = hertz.tsuji_design(e, T, scene, poisson, clamped=True)
         coefficient, c, R_eff, v0 = contact.coefficient, contact.c, contact.R_eff, scene.v0
         h = _stepping.nice_down(T / 100.0) if timestep is None else float(timestep)
@@ -112,15 +91,12 @@ class SMCHertz(AbstractNormalModel):
         )
 
     def law_parameters(self, parameters, m):
-        """As LAMMPS's: `tsuji`'s `c` = k and `b`."""
         return {"c": parameters["k"], "b": parameters["b"]}
 
     def response(self, parameters, *, m, radius=None):
-        """`(law, separation)`: the Tsuji form with the force always kept non-attractive."""
         return hertz.tsuji_response("chrono", parameters, m=m, radius=radius, clamped=True)
 
     def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
-        """None: Chrono's implicit stepper is not replicated."""
         return None
 
 

@@ -1,10 +1,6 @@
-"""Material and geometry inputs: the Hertz constant from Young's modulus, Poisson's ratio and
-the radii, and the effective mass and radius of two bodies.
-
-Hertz (1882); Johnson, *Contact Mechanics* (1985), section 4.2: two elastic spheres pressed
-together by `x` (m) repel with `F = c x^1.5`, `c = (4/3) E* sqrt(R*)`, where
-`1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2` and `1/R* = 1/R1 + 1/R2` (a flat has `R2 = inf`).
-"""
+"""Material inputs: Hertz (1882; Johnson, *Contact Mechanics* 1985, section 4.2), two elastic
+spheres pressed together by `x` (m) repel with `F = c x^1.5`, `c = (4/3) E* sqrt(R*)`,
+`1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2`, `1/R* = 1/R1 + 1/R2` (a flat: `R2 = inf`)."""
 
 import math
 import sys
@@ -19,7 +15,8 @@ __all__ = [
 ]
 
 
-def _positive(name: str, value, unit: str, *, infinite_ok: bool = False) -> float:
+def check_positive(name: str, value, unit: str, *, infinite_ok: bool = False) -> float:
+    """`value` as a float > 0 (finite unless `infinite_ok`); a one-line ValueError if not."""
     try:
         number = float(value)
     except (TypeError, ValueError):
@@ -42,15 +39,10 @@ def check_poisson(name: str, value) -> float:
 
 
 def effective_mass(m1, m2=math.inf) -> float:
-    """The reduced mass `m1 m2 / (m1 + m2)` (kg) of two bodies of masses `m1`, `m2` (kg).
-
-    `m2 = inf` (the default) is a fixed body (the result is `m1`); two equal spheres of
-    mass `m` give `m / 2`.
-
-    **Example**: `effective_mass(0.1, 0.3)` is `0.075`.
-    """
-    m1 = _positive("m1", m1, "kg", infinite_ok=True)
-    m2 = _positive("m2", m2, "kg", infinite_ok=True)
+    """The reduced mass `m1 m2 / (m1 + m2)` (kg) of masses `m1`, `m2` (kg; `m2 = inf`, the
+    default: a fixed body). **Example**: `effective_mass(0.1, 0.3)` is `0.075`."""
+    m1 = check_positive("m1", m1, "kg", infinite_ok=True)
+    m2 = check_positive("m2", m2, "kg", infinite_ok=True)
     if math.isinf(m1) and math.isinf(m2):
         raise ValueError("effective_mass: at least one of m1, m2 must be finite (kg)")
     if math.isinf(m2):
@@ -61,13 +53,10 @@ def effective_mass(m1, m2=math.inf) -> float:
 
 
 def effective_radius(R1, R2=math.inf) -> float:
-    """The effective radius `R* = R1 R2 / (R1 + R2)` (m), `1/R* = 1/R1 + 1/R2`, of two
-    spheres of radii `R1`, `R2` (m); `R2 = inf` (the default) is a flat.
-
-    **Example**: `effective_radius(0.01, 0.01)` is `0.005`.
-    """
-    R1 = _positive("R1", R1, "m", infinite_ok=True)
-    R2 = _positive("R2", R2, "m", infinite_ok=True)
+    """The effective radius `R* = R1 R2 / (R1 + R2)` (m) of spheres of radii `R1`, `R2` (m;
+    `R2 = inf`, the default: a flat). **Example**: `effective_radius(0.01, 0.01)` is 0.005."""
+    R1 = check_positive("R1", R1, "m", infinite_ok=True)
+    R2 = check_positive("R2", R2, "m", infinite_ok=True)
     if math.isinf(R1) and math.isinf(R2):
         raise ValueError(
             "effective_radius: two flats have no Hertz contact; give a finite radius (m)"
@@ -80,14 +69,11 @@ def effective_radius(R1, R2=math.inf) -> float:
 
 
 def effective_modulus(E, nu, E2=None, nu2=None) -> float:
-    """The contact modulus `E*` (Pa), `1/E* = (1 - nu^2)/E + (1 - nu2^2)/E2`.
-
-    `E2`, `nu2` default to `E`, `nu` (both bodies of one material); `E2 = inf` is a rigid
-    counterpart (then `E* = E / (1 - nu^2)`).
-    """
-    E = _positive("E", E, "Pa")
+    """The contact modulus `E*` (Pa), `1/E* = (1 - nu^2)/E + (1 - nu2^2)/E2`; `E2`, `nu2`
+    default to `E`, `nu`; `E2 = inf`: a rigid counterpart."""
+    E = check_positive("E", E, "Pa")
     nu = check_poisson("nu", nu)
-    E2 = E if E2 is None else _positive("E2", E2, "Pa", infinite_ok=True)
+    E2 = E if E2 is None else check_positive("E2", E2, "Pa", infinite_ok=True)
     nu2 = nu if nu2 is None else check_poisson("nu2", nu2)
     # p / (1 + p/q) with p = E/(1 - nu^2), q = E2/(1 - nu2^2): no sum of compliances to
     # overflow, and (1 - nu)(1 + nu) keeps its digits as nu nears -1
@@ -97,24 +83,18 @@ def effective_modulus(E, nu, E2=None, nu2=None) -> float:
 
 
 def hertz_stiffness(E, nu, R, E2=None, nu2=None, R2=None) -> float:
-    """The Hertz constant `c` (N/m^1.5) of `F = c x^1.5` for a sphere on a flat or two spheres.
-
-    `c = (4/3) E* sqrt(R*)` (Hertz 1882; Johnson 1985, eq. 4.23) with
-    `1/E* = (1 - nu^2)/E + (1 - nu2^2)/E2` and `1/R* = 1/R + 1/R2`.
-
-    - `E` (Pa), `nu` (-, in (-1, 0.5)), `R` (m): the first body (a sphere of radius `R`).
-    - `E2`, `nu2`: the second body's material; default the same as the first. `E2=math.inf`
-      makes it rigid.
-    - `R2` (m): the second body's radius; default `None`, a flat (`R* = R`).
+    """The Hertz constant `c = (4/3) E* sqrt(R*)` (N/m^1.5) of `F = c x^1.5` (Johnson 1985,
+    eq. 4.23): a sphere of `E` (Pa), `nu` (in (-1, 0.5)), `R` (m) on a second body of `E2`,
+    `nu2` (default the same material; `E2=math.inf`: rigid) and radius `R2` (m; None: a flat).
 
     Use it to fix the stiffness and fit only the damping, e.g.
     `calibrate(law("hertz_rate", c=hertz_stiffness(E=2e11, nu=0.3, R=0.01), b1=100.0),
     m=..., v0=..., e=..., free=("b1",))`.
 
     **Example**: `hertz_stiffness(E=2e11, nu=0.3, R=0.01)` (steel ball on a steel plate) is
-    `(4/3) (2e11 / (2 (1 - 0.09))) sqrt(0.01)`, about `1.465e10` N/m^1.5.
+    about `1.465e10` N/m^1.5.
     """
-    R = _positive("R", R, "m")
+    R = check_positive("R", R, "m")
     R_star = R if R2 is None else effective_radius(R, R2)
     return _representable(
         "c", 4.0 / 3.0 * effective_modulus(E, nu, E2, nu2) * math.sqrt(R_star), "N/m^1.5"
@@ -122,79 +102,55 @@ def hertz_stiffness(E, nu, R, E2=None, nu2=None, R2=None) -> float:
 
 
 def yield_overlap(E, nu, R, *, p_y=None, Y=None, E2=None, nu2=None, R2=None) -> float:
-    """The yield overlap `x_y` (m) of `law("thornton", c=..., x_y=...)`: where the Hertz
-    contact's mean pressure reaches the limiting pressure `p_y`,
-    `x_y = R* (pi p_y / (2 E*))^2` (Thornton 1997).
-
-    - `p_y` (Pa): the limiting contact pressure; or `Y` (Pa), the yield stress, with
-      `p_y = 1.6 Y` (first yield below the surface, Johnson 1985, section 6.2).
-    - `E` (Pa), `nu`, `R` (m), and `E2`, `nu2`, `R2` for the second body as in
-      `hertz_stiffness` (default: the same material, a flat).
-
-    **Example**: steel (E = 210 GPa, nu = 0.3, Y = 1 GPa) ball of R = 5 mm on a rigid flat:
-    `yield_overlap(E=2.1e11, nu=0.3, R=5e-3, Y=1e9, E2=math.inf)`, about 0.36 µm.
-    """
+    """The yield overlap `x_y = R* (pi p_y / (2 E*))^2` (m) of `law("thornton", ...)`, where
+    the Hertz contact's mean pressure reaches the limiting pressure `p_y` (Pa; or the yield
+    stress `Y`, `p_y = 1.6 Y`: Johnson 1985, section 6.2) (Thornton 1997); the bodies as in
+    `hertz_stiffness`. **Example**: a steel ball (R = 5 mm) on a rigid flat,
+    `yield_overlap(E=2.1e11, nu=0.3, R=5e-3, Y=1e9, E2=math.inf)`, about 0.36 µm."""
     if (p_y is None) == (Y is None):
         raise ValueError("give the limiting contact pressure p_y (Pa) or the yield stress Y (Pa)")
-    p_y = 1.6 * _positive("Y", Y, "Pa") if p_y is None else _positive("p_y", p_y, "Pa")
-    R = _positive("R", R, "m")
+    p_y = 1.6 * check_positive("Y", Y, "Pa") if p_y is None else check_positive("p_y", p_y, "Pa")
+    R = check_positive("R", R, "m")
     R_star = R if R2 is None else effective_radius(R, R2)
     E_star = effective_modulus(E, nu, E2, nu2)
     return _representable("x_y", R_star * (math.pi * p_y / (2.0 * E_star)) ** 2, "m")
 
 
 def yield_pressure(x_y, E, nu, R, *, E2=None, nu2=None, R2=None) -> float:
-    """The limiting contact pressure `p_y` (Pa) that a yield overlap `x_y` (m) means, the
-    inverse of `yield_overlap`: `p_y = (2 E* / pi) (x_y / R*)^0.5`; the yield stress is
-    `Y = p_y / 1.6`. For a fitted `x_y` with standard error `s`, `p_y`'s is
-    `p_y s / (2 x_y)`.
-
-    `E` (Pa), `nu`, `R` (m), and `E2`, `nu2`, `R2` for the second body as in
-    `hertz_stiffness` (default: the same material, a flat).
-
-    **Example**: `yield_pressure(fit.params["x_y"], E=2.1e11, nu=0.3, R=5e-3, E2=math.inf)`.
-    """
-    x_y = _positive("x_y", x_y, "m")
-    R = _positive("R", R, "m")
+    """The limiting pressure `p_y = (2 E* / pi) (x_y / R*)^0.5` (Pa) of a yield overlap `x_y`
+    (m), `yield_overlap`'s inverse (`Y = p_y / 1.6`; a standard error `s` of `x_y` gives
+    `p_y s / (2 x_y)`); the bodies as in `hertz_stiffness`. **Example**:
+    `yield_pressure(fit.params["x_y"], E=2.1e11, nu=0.3, R=5e-3, E2=math.inf)`."""
+    x_y = check_positive("x_y", x_y, "m")
+    R = check_positive("R", R, "m")
     R_star = R if R2 is None else effective_radius(R, R2)
     E_star = effective_modulus(E, nu, E2, nu2)
     return _representable("p_y", 2.0 * E_star / math.pi * math.sqrt(x_y / R_star), "Pa")
 
 
 def work_of_adhesion(gamma, gamma2=None, gamma12=0.0) -> float:
-    """The work of adhesion `w` (J/m^2) of `law("jkr", ..., w=...)` from surface energies
-    (J/m^2) by Dupre's rule, `w = gamma + gamma2 - gamma12`: twice the surface energy for
-    like surfaces (`gamma2` defaults to `gamma`, the interface energy `gamma12` to 0).
-    Mind the convention: a pull-off force written `3 pi Gamma R` uses `Gamma = w / 2`.
-
-    **Example**: `work_of_adhesion(0.2)` is 0.4 J/m^2.
-    """
-    gamma = _positive("gamma", gamma, "J/m^2")
-    gamma2 = gamma if gamma2 is None else _positive("gamma2", gamma2, "J/m^2")
+    """The work of adhesion `w = gamma + gamma2 - gamma12` (J/m^2, Dupre) of `law("jkr", ...)`
+    from surface energies (J/m^2; `gamma2` defaults to `gamma`, `gamma12` to 0). A pull-off
+    force written `3 pi Gamma R` uses `Gamma = w / 2`. **Example**: `work_of_adhesion(0.2)`
+    is 0.4 J/m^2."""
+    gamma = check_positive("gamma", gamma, "J/m^2")
+    gamma2 = gamma if gamma2 is None else check_positive("gamma2", gamma2, "J/m^2")
     w = gamma + gamma2 - float(gamma12)
     if not w > 0:
         raise ValueError(f"the work of adhesion gamma + gamma2 - gamma12 must be > 0, got {w:g}")
     return w
 
 
-# The Young's moduli (Pa) that materials have: a soft gel or foam (1e5) to diamond (1.2e12);
-# an export whose contact implies one outside warns (`modulus_warnings`)
-PLAUSIBLE_MODULUS = (1e5, 1e12)
-# how far (a factor either way) a tangential law's shear modulus may lie from the normal
-# contact's G = E / (2 (1 + nu)) before an export warns
-SHEAR_FACTOR = 100.0
-
-
-# the mean densities (kg/m^3) a sphere of a command's --mass and --radius plausibly has: a
-# thin hollow ball (a ping-pong ball: 80) to osmium (22,590); a radius in mm given as m
-# moves it by 1e-9, a mass in g given as kg by 1e3
+PLAUSIBLE_MODULUS = (1e5, 1e12)  # Pa: a soft gel or foam to diamond (1.2e12)
+SHEAR_FACTOR = 100.0  # how far a shear modulus may lie from E / (2 (1 + nu)) unwarned
+# kg/m^3: a thin hollow ball (a ping-pong ball: 80) to osmium (22,590); mm given as m moves
+# it by 1e-9, g given as kg by 1e3
 PLAUSIBLE_DENSITY = (1.0, 3e4)
 
 
 def warn_sphere_density(m, R) -> None:
-    """A warning (one line on the command line) where a sphere of mass `m` (kg) and
-    radius `R` (m) would have a mean density outside `PLAUSIBLE_DENSITY`: a unit is
-    likely wrong. Nothing for values the commands' own checks refuse."""
+    """A warning where a sphere of mass `m` (kg) and radius `R` (m) has a mean density
+    outside `PLAUSIBLE_DENSITY` (a unit likely wrong)."""
     import warnings
 
     if m is None or R is None or not (math.isfinite(m) and math.isfinite(R) and m > 0 and R > 0):
@@ -211,9 +167,8 @@ def warn_sphere_density(m, R) -> None:
 
 
 def hertz_constant(law, v0: float) -> float | None:
-    """The Hertz constant `c` (N/m^1.5) of `law`'s elastic force `c x^1.5` (a family law
-    with `n = 1.5` at speed `v0`, m/s, or a law whose `c` is in N/m^1.5: JKR's, Thornton's),
-    or None (another elastic force)."""
+    """The Hertz constant `c` (N/m^1.5) of `law`'s elastic force at `v0` (m/s), or None
+    where it is not `c x^1.5`."""
     coefficients = law.coefficients(v0)
     if coefficients is not None:
         c, n = float(coefficients[0]), float(coefficients[1])
@@ -224,18 +179,11 @@ def hertz_constant(law, v0: float) -> float | None:
 
 
 def modulus_warnings(c, tangential, *, radius: float, poisson: float, two_spheres: bool) -> list:
-    """The sanity lines of an export (each one line; none where `c` is None):
-
-    - where the contact's Hertz constant `c` (N/m^1.5; for two spheres, the pair's) with the
-      spheres' `radius` (m) implies a Young's modulus outside `PLAUSIBLE_MODULUS`: `c = 4/3
-      E* sqrt(R*)` (Johnson 1985, eq. 4.23), `R* = R/2` (`two_spheres`) or `R` (a sphere on
-      a flat), `E* = E / (2 (1 - nu^2))` (two bodies of one material, as the engines take
-      them; a rigid flat would halve E), `nu` = `poisson`;
-    - where a tangential law (`tangential`, exported alike; None: none) has an effective
-      shear modulus (its parameters in Pa: Mindlin's `G*`) more than `SHEAR_FACTOR` from the
-      one the normal contact's material has: one elastic material has `G = E / (2 (1 +
-      nu))`, i.e. `G*/E* = (1 - nu) / (2 (2 - nu))`, against a body of itself or a rigid
-      one alike."""
+    """An export's sanity lines: where the Hertz constant `c` (N/m^1.5) with `radius` (m)
+    implies a Young's modulus outside `PLAUSIBLE_MODULUS` (`c = 4/3 E* sqrt(R*)`, `R* = R/2`
+    for `two_spheres` else `R`, `E* = E / (2 (1 - nu^2))` of one material), and where the
+    `tangential` law's shear modulus (its Pa parameters) lies more than `SHEAR_FACTOR` from
+    the material's, `G*/E* = (1 - nu) / (2 (2 - nu))` (`G = E / (2 (1 + nu))`)."""
     if c is None or not (c > 0 and math.isfinite(c)):
         return []
     R_star = radius / 2.0 if two_spheres else radius
@@ -276,9 +224,7 @@ def modulus_warnings(c, tangential, *, radius: float, poisson: float, two_sphere
 
 
 def _representable(name: str, value: float, unit: str) -> float:
-    """`value` if float64 holds it to full precision (finite, not below the smallest normal
-    number); a one-line ValueError otherwise (inputs whose result over- or underflows:
-    E = 1e158 Pa with R = 1e300 m gave c = inf)."""
+    """`value` where float64 holds it (finite, normal), else a one-line ValueError."""
     if not (math.isfinite(value) and value >= sys.float_info.min):
         raise ValueError(
             f"{name} = {value:g} {unit}: float64 cannot hold it for these inputs; are they in "
@@ -296,8 +242,3 @@ def check_restitution(e, name: str = "e") -> float:
     if not (0.0 < number <= 1.0):
         raise ValueError(f"{name} (restitution) must lie in (0, 1], got {e!r}")
     return number
-
-
-def check_positive(name: str, value, unit: str) -> float:
-    """`value` as a finite float > 0; a one-line ValueError otherwise."""
-    return _positive(name, value, unit)

@@ -1,28 +1,21 @@
-"""The promise of an export with a tangential law: the oblique impacts the engine realises
-at v0 from `OBLIQUE_ANGLES` (its own stepping where it is replicated, else its continuous
-laws) beside the given laws', and the warnings that go with them."""
+"""An export's tangential promise: the oblique impacts the engine realises at v0 from
+`OBLIQUE_ANGLES` (its stepping where replicated, else its continuous laws) beside the given
+laws', and their warnings."""
 
 import numpy as np
 
 from .base import contact_mass
 
-# the steps per contact an export with a tangential law takes at most when no step is given:
-# its promise was measured against the real engines at this resolution (docs/oblique.md)
-TANGENTIAL_STEPS = 400
-# the incidences (degrees from the normal) an export with a tangential law reports
-OBLIQUE_ANGLES = (5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 75.0)
-# how far the engine's e_t may fall from the law's before an export warns
-E_T_WARN = 0.005
-# how far two spheres' turning line of centres may mix their velocities before it warns
-TURN_WARN = 0.01
+TANGENTIAL_STEPS = 400  # steps per contact at most: the promise's, measured (docs/oblique.md)
+OBLIQUE_ANGLES = (5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 75.0)  # degrees from the normal
+E_T_WARN = 0.005  # how far the engine's e_t may fall from the law's unwarned
+TURN_WARN = 0.01  # how far two spheres' turning line of centres may mix v_n, v_t unwarned
 
 
 def tangential_promise(chosen, slot, design, parameters, engine_law, tangential, given, scene):
-    """`(fields, warnings)`: the `Export` fields of the oblique promise of engine `chosen`
-    with its tangential model `slot` (`_oblique_promise`, for the normal `design` and the
-    exported `parameters`), and the warnings that go with it: the model's `notes`, what its
-    friction makes of the law (`FRICTION`) or how far its e_t departs from the law's, and
-    where two spheres turn their line of centres."""
+    """`(fields, warnings)`: the oblique promise of `chosen`'s tangential model `slot` with
+    `parameters`, and its warnings (the model's notes, its friction or e_t departure, two
+    spheres turning)."""
     oblique = _oblique_promise(
         chosen, slot, parameters, engine_law, design.separation, tangential, given, scene
     )
@@ -38,15 +31,11 @@ def tangential_promise(chosen, slot, design, parameters, engine_law, tangential,
 
 
 def _oblique_promise(chosen, slot, parameters, engine_law, separation, tangential, given, scene):
-    """The oblique impacts at speed `scene.v0` (m/s) from `OBLIQUE_ANGLES` (no spin before)
-    that the engine realises with `parameters`: its own stepping where it is replicated
-    (`slot.oblique`, the mean over first-touch phases), else its continuous laws (its
-    normal law `engine_law`, the exported `tangential` law) through `oblique_impact`; and
-    the tangential restitution of the given law `scene.law` with the given tangential law
-    `given` (None from targets). A sphere of mass `m` (kg) and radius `radius` (m) on the
-    wall, or the pair's effective sphere (`two_spheres`) for two spheres; the given laws
-    move it at mass `m` (the normal export's convention: the law's e and T at `m`, realised
-    by the pair at `m/2` with its forces halved, the tangential ones too)."""
+    """The oblique impacts at `scene.v0` from `OBLIQUE_ANGLES` (no spin before) the engine
+    realises: its stepping (`slot.oblique`, phase means) or its continuous laws
+    (`engine_law`, `tangential`) through `oblique_impact`; and the given laws' e_t at mass
+    `m` (None from targets). The body: the sphere, or for two spheres the pair's effective
+    one."""
     from .._oblique import incidence, oblique_impact, two_spheres
 
     m, v0, radius, geometry, source = scene.m, scene.v0, scene.radius, scene.geometry, scene.law
@@ -57,18 +46,9 @@ def _oblique_promise(chosen, slot, parameters, engine_law, separation, tangentia
     def continuous(normal_law, tangential_law, contact_point=0.0, ends=separation, body=body):
         # a soft spring sticks and slips many times (throw=False: a solve that still
         # fails is NaN in the promise, not an error of the export)
+        how = dict(separation=ends, contact_point=contact_point, max_segments=64, throw=False)
         rows = [
-            oblique_impact(
-                normal_law,
-                tangential_law,
-                **body,
-                v_n=float(a),
-                v_t=float(b),
-                separation=ends,
-                contact_point=contact_point,
-                max_segments=64,
-                throw=False,
-            )
+            oblique_impact(normal_law, tangential_law, **body, v_n=float(a), v_t=float(b), **how)
             for a, b in zip(v_n, v_t, strict=True)
         ]
         return tuple(
@@ -99,9 +79,7 @@ def _oblique_promise(chosen, slot, parameters, engine_law, separation, tangentia
 
 
 def _friction_note(slot, tangential, oblique) -> str:
-    """The warning of an export to an engine with friction alone (the tangential model's
-    `FRICTION`): what it takes, how far its e_t falls from the law's over the angles, how
-    its normal e moves."""
+    """The warning of friction alone (`FRICTION`): its mu, normal e and e_t departure."""
     angles, e_n = np.asarray(oblique["angles"]), np.asarray(oblique["e_n_engine"])
     note = (
         f"{slot.FRICTION} (mu = {float(tangential.params['mu']):.4g} of "
@@ -114,13 +92,11 @@ def _friction_note(slot, tangential, oblique) -> str:
 
 
 def _turning_note(T: float, *, v0: float, radius: float) -> list[str]:
-    """Two spheres passing each other turn their line of centres by about `v_t T / (2 R)`
-    (rad) during a contact of duration `T` (s), which a promise computed for one body
-    against a fixed normal leaves out; their normal and tangential velocities then mix by
-    about `tan(theta)` times that angle. A warning where that reaches 0.01 at the largest
-    angle. Measured at 75 degrees: Yade's soft pair (turn 0.075 rad, estimate 0.28) fell
-    0.23 in e and 0.036 in e_t; LAMMPS's Kharaz pair (turn 0.0096 rad, estimate 0.036)
-    0.0043 in e_t, 0.0077 at 45 degrees."""
+    """Two spheres turn their line of centres by about `v_t T / (2 R)` (rad) in contact (the
+    promise holds it fixed), mixing v_n and v_t by `tan(theta)` times that: a warning where
+    that reaches `TURN_WARN`. Measured at 75 degrees: Yade's soft pair (turn 0.075 rad,
+    estimate 0.28) fell 0.23 in e, 0.036 in e_t; LAMMPS's Kharaz pair (0.0096 rad, 0.036)
+    0.0043 in e_t."""
     theta = np.deg2rad(max(OBLIQUE_ANGLES))
     turn = v0 * np.sin(theta) * T / (2.0 * radius)
     mixing = float(np.tan(theta) * turn)
@@ -136,20 +112,18 @@ def _turning_note(T: float, *, v0: float, radius: float) -> list[str]:
 
 
 def _two_spheres(chosen, geometry) -> bool:
-    """Whether the export's scene is two equal spheres (a two-sphere engine, no wall)."""
+    """Whether the scene is two equal spheres."""
     return contact_mass(chosen, 1.0, geometry) != 1.0
 
 
 def _engine_share(chosen, slot, geometry) -> float:
-    """`oblique_impact`'s `contact_point` for the engine's scene: each sphere's share of
-    the overlap off its lever arm (the tangential model's `CONTACT_POINT`), halved for two
-    equal spheres through their effective radius."""
+    """`oblique_impact`'s `contact_point`: `slot.CONTACT_POINT`, halved for two spheres."""
     share = slot.CONTACT_POINT[geometry]
     return share / 2.0 if _two_spheres(chosen, geometry) else share
 
 
 def _contact_point_note(chosen, slot, geometry) -> str:
-    """Where the engine applies the tangential force, when not on the undeformed surface."""
+    """Where the engine applies the tangential force, if not at R."""
     share = slot.CONTACT_POINT[geometry]
     if not share:
         return ""
@@ -161,8 +135,7 @@ def _contact_point_note(chosen, slot, geometry) -> str:
 
 
 def _departure(oblique) -> tuple[float, str]:
-    """How far the engine's e_t falls from the law's over the angles: the largest
-    |e_t engine - e_t law|, and that in words."""
+    """The largest |e_t engine - e_t law| over the angles, and that in words."""
     gap = np.abs(np.asarray(oblique["e_t_engine"]) - np.asarray(oblique["e_t_target"]))
     k = int(np.nanargmax(gap))
     angle = oblique["angles"][k]

@@ -1,17 +1,14 @@
-"""An export its engine cannot realise at the given step: the refusal
-(`UnrealisedExport`, a one-line ValueError that names a step that works) or, with
-`strict=False`, its warning (`UnrealisedWarning`)."""
+"""An export its engine cannot realise at the given step: refused (`UnrealisedExport`) or,
+with `strict=False`, warned (`UnrealisedWarning`)."""
 
 from . import _stepping
 from .base import Design
 
 
 class UnrealisedExport(ValueError):
-    """An export its engine cannot realise at the given step (`_stepping.unrealised`): the
-    `engine`, its time `step` (s), the `reason`, and `working` (s), a step that realises the
-    target (0.0: Drake's continuous plant; None where none was found); `continuous`: the
-    engine also has a continuous plant (time step 0); `T` (s): the target duration, by
-    which the steps are also told as T/n."""
+    """A one-line ValueError: `engine` cannot realise the target at `step` (s) for `reason`;
+    `working` (s): a step that does (0.0: a continuous plant; None: none found);
+    `continuous`: the engine has a continuous plant; `T` (s): to tell steps as T/n."""
 
     def __init__(
         self, engine: str, step, reason: str, working, *, continuous: bool = False, T=None
@@ -21,9 +18,8 @@ class UnrealisedExport(ValueError):
         super().__init__(self.message("strict=False"))
 
     def message(self, option: str, *, exported: bool = False) -> str:
-        """The one line: the refusal, ending with how to export it anyway (`option`:
-        `"strict=False"` in Python, `"--no-strict"` on the command line), or with
-        `exported` the warning of an export made anyway with that option."""
+        """The refusal, ending with how to export anyway (`option`: `"strict=False"`,
+        `"--no-strict"`), or with `exported` the warning of an export made so."""
         if self.working is None:
             fix = f"no time step down to T/{_stepping.MAX_STEPS} realises it"
         elif self.working == 0.0:
@@ -45,9 +41,8 @@ class UnrealisedExport(ValueError):
 
 
 class UnrealisedWarning(UserWarning):
-    """`export(..., strict=False)` of an export its engine cannot realise, built from the
-    `refusal` it would have raised (an `UnrealisedExport`, kept as `.refusal`: its `message`
-    in other words, as the command line's) or from a text (`.refusal` None)."""
+    """`export(strict=False)`'s warning, from the `UnrealisedExport` it would have raised
+    (kept as `.refusal`) or from a text."""
 
     def __init__(self, refusal):
         self.refusal = refusal if isinstance(refusal, UnrealisedExport) else None
@@ -70,10 +65,9 @@ def unrealised(out: Design, target_e: float, target_T) -> str | None:
 
 
 def working_step(normal, target_e: float, target_T, scene, options: dict):
-    """A time step (s) at which the normal model `normal` realises the target in `scene`:
-    its recommended step (the design without a step), or where that is a continuous plant
-    (0.0), the first of T/50, T/100, ... T/51200 whose discrete plant does; None where none
-    does. `options`: the design's other arguments."""
+    """A step (s) at which `normal` realises the target in `scene`: its recommended one, or
+    for a continuous plant the first of T/50, T/100, ... T/51200 that does (else 0.0);
+    None where none does."""
     try:
         out = normal.design(target_e, target_T, scene, timestep=None, **options)
     except ValueError:

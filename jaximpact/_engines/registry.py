@@ -1,6 +1,4 @@
-"""`ENGINES`, the one registry of the engines that `export`, `engine_response`,
-`stepped_response` and the command line read, and `engine(name)`, the lookup that refuses
-an unknown name in one line."""
+"""`ENGINES`, the one registry of the engines, and `engine(name)`."""
 
 from .._choices import unknown_name
 from . import chrono, yade
@@ -10,8 +8,7 @@ from .lammps.engine import Lammps
 from .liggghts.engine import Liggghts
 from .mujoco.engine import Mujoco
 
-# The registry, in the order messages list the engines: one final `AbstractEngine` each.
-# A new engine is its module and one line here (docs/layout.md, "Adding an engine").
+# in the order messages list them; a new engine is its module and one line here
 ENGINES: dict[str, AbstractEngine] = {
     engine.NAME: engine
     for engine in (Mujoco(), Lammps(), Drake(), Liggghts(), chrono.Chrono(), yade.Yade())

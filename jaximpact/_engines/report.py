@@ -1,10 +1,5 @@
-"""An export as `jaximpact export` and `jaximpact engine-e` report it: the engines' labels
-and the commands' descriptions read from the registry (`labels`, `export_description`,
-`engine_e_description`), the text of an `Export` (`export_text`), the law and speed of a
-fit's JSON that an export is of (`fit_source`) and the engine's band over its posterior's
-draws (`posterior_band`), the check of an engine's parameters (`check_parameters`), and the
-record and text of what given parameters realise (`response_record`, `response_text`).
-Bad input is a one-line ValueError; the text is rendered from the records alone."""
+"""`jaximpact export` and `jaximpact engine-e`: their help read from the registry, their
+checks of input (one-line ValueErrors) and their text, rendered from the records alone."""
 
 import math
 
@@ -19,7 +14,7 @@ def listed(words, last: str = "and") -> str:
 
 
 def labels(where=lambda engine: True, last: str = "and") -> str:
-    """The engines' labels (as their documentation spells them) where `where(engine)`."""
+    """The engines' labels where `where(engine)`."""
     return listed([e.LABEL for e in ENGINES.values() if where(e)], last)
 
 
@@ -56,8 +51,7 @@ def export_description() -> str:
 
 
 def engine_e_description() -> str:
-    """What `jaximpact engine-e` does, then one paragraph per engine: its keys and how it
-    steps."""
+    """What `jaximpact engine-e` does, then each engine's keys and stepping."""
     each = []
     for engine in ENGINES.values():
         needed, optional = (
@@ -79,10 +73,8 @@ def engine_e_description() -> str:
 
 
 def export_text(x, *, given_step: bool, source: str | None = None, warnings=None) -> str:
-    """The text of the export `x`: the scene, what was asked (`source`: where its law came
-    from, a line of its own), the step (`given_step`: the caller's, else the recommended
-    one), what the engine realises, its parameters and snippet, e(v), the oblique impacts
-    and the `warnings` (default `x.warnings`)."""
+    """The text of the export `x` (`source`: where its law came from; `given_step`: the
+    step is the caller's; `warnings`: default `x.warnings`)."""
     from ._stepping import describe_step
 
     if not x.timestep:
@@ -135,8 +127,7 @@ def export_text(x, *, given_step: bool, source: str | None = None, warnings=None
 
 
 def check_scene(engine: str, *, mass, radius, from_law: bool, wall: bool) -> None:
-    """A one-line ValueError where an export to `engine` lacks `--mass` (kg; needed but for
-    a per-kg engine from targets alone) or `--radius` (m; a two-sphere engine's)."""
+    """A one-line ValueError where an export to `engine` lacks `--mass` or `--radius`."""
     chosen = _engine(engine)
     missing = []
     if mass is None and (from_law or chosen.MASS_DEPENDS is not None):
@@ -145,7 +136,7 @@ def check_scene(engine: str, *, mass, radius, from_law: bool, wall: bool) -> Non
         missing.append("--radius (m)")
     what = " and ".join(missing)
     if "--mass (kg)" in missing:
-        from .export import missing_mass
+        from .compose import missing_mass
 
         raise ValueError(missing_mass(engine, from_law, f"give {what}"))
     if missing:
@@ -153,11 +144,9 @@ def check_scene(engine: str, *, mass, radius, from_law: bool, wall: bool) -> Non
 
 
 def reworded(run, option: str = "--no-strict"):
-    """`(x, words)`: `run()`, an export, with its refusal in the words of `option`
-    (`UnrealisedExport.message`: `"--no-strict"` on the command line) raised as a one-line
-    ValueError, and its `UnrealisedWarning` (an export made anyway) warned again in those
-    words; other warnings are shown as they came. `words` maps a warning's text in
-    `x.warnings` to the text shown."""
+    """`(x, words)`: the export `run()`, its refusal raised as a one-line ValueError in the
+    words of `option`, and its `UnrealisedWarning` warned again in them (`words`: the text in
+    `x.warnings` -> the text shown); other warnings as they came."""
     import warnings
 
     from .refusal import UnrealisedExport, UnrealisedWarning
@@ -186,13 +175,10 @@ def _number(value) -> bool:
 
 
 def fit_source(fit, record: dict, path: str, *, mass=None, v0=None):
-    """`(law, m, v0, notes, posterior)` of the fit `fit` read back from `record`, the JSON
-    of `jaximpact calibrate --json` in the file `path`: its law, its mass (kg) and its speed
-    (m/s). With `calibrate --posterior --json`'s `posterior`, the law is at the posterior
-    medians of its free parameters and `posterior` is that record (else None). `mass`,
-    where given, must agree with the file; `v0` picks the speed (required where the fit has
-    several). Each missing or mismatched field is a one-line ValueError; `notes` are
-    warnings for the output."""
+    """`(law, m, v0, notes, posterior)` of the fit in `record` (`calibrate --json`'s, read
+    from `path`): its law (at the posterior medians, with `posterior` that record, where it
+    has one), mass (kg; `mass` must agree) and speed (m/s; `v0` picks one of several).
+    One-line ValueErrors; `notes`: warnings for the output."""
     where = f"--from {path}"
     m = mass if fit.m is None else float(fit.m)
     if m is None:
@@ -246,10 +232,8 @@ def posterior_band(
     x, posterior: dict, path: str, *, user_law: bool, band_draws, progress, **options
 ):
     """`(x, origin, notes)`: the export `x` with the engine's band over the draws of
-    `posterior` (a `Posterior.to_dict` record, as `calibrate --posterior --json` writes it
-    into the file `path`), each exported with `options` (`export`'s), and the words for its
-    origin, or `x` alone with a note saying why there is no band (no draws in the file, a
-    user's law)."""
+    `posterior` (`Posterior.to_dict`'s record, in the file `path`), each exported with
+    `options`, and the words for its origin; or `x` and a note why there is no band."""
     from .._posterior import Posterior
     from .export import with_band
 
@@ -276,9 +260,8 @@ def posterior_band(
 
 
 def check_parameters(engine: str, params) -> None:
-    """`params` (JSON read) as `engine_response` takes them for `engine`: an object, every
-    needed key there, every key one that `engine` reads (its `KEYS`), every value a number
-    (`solref` two numbers, `limit_damping` true or false); else a one-line ValueError."""
+    """A one-line ValueError unless `params` (JSON) has every needed key of `engine`'s `KEYS`,
+    no other, and numbers (`solref` two, `limit_damping` true or false)."""
     if not isinstance(params, dict):
         raise ValueError("--params must be a JSON object, e.g. '{\"solref\": [0.02, 1]}'")
     keys = _engine(engine).KEYS
@@ -304,10 +287,8 @@ def check_parameters(engine: str, params) -> None:
 
 
 def response_record(engine: str, params: dict, *, m, speeds, radius=None) -> dict:
-    """What `params` realise in `engine` for mass `m` (kg) at each of `speeds` (m/s): the
-    engine's continuous law, its criterion, e and T (s), and what its stepping realises
-    (`engine_response`, `stepped_response`), as `jaximpact engine-e --json` prints it.
-    `m` None: 1 kg for an engine whose contact is per unit mass, else a ValueError."""
+    """`jaximpact engine-e --json`'s record: what `params` realise in `engine` for mass `m`
+    (kg; None: per unit mass, where the engine allows) at `speeds` (m/s)."""
     from .response import engine_response, stepped_response
 
     chosen = _engine(engine)
@@ -334,7 +315,7 @@ def response_record(engine: str, params: dict, *, m, speeds, radius=None) -> dic
 
 
 def response_text(data: dict) -> str:
-    """The text of a `response_record`: e and T per speed, and the stepped ones beside."""
+    """The text of a `response_record`."""
     e, T, stepped = data["e"], data["T"], data["stepped"]
     lines = [f"{data['engine']}: law {data['law']['name']} ({data['separation']} criterion)"]
     if stepped is None:

@@ -1,15 +1,13 @@
-"""What an export aims at: its inputs checked, the law's e and T (or the targets), the
-speeds of its report, the curves e(v) and T(v) of the engine and of the law, and the line
-for a law the engine lacks."""
+"""What an export aims at: its inputs checked, the law's e and T (or the targets), the e(v)
+and T(v) of the engine and the law, and the line for a law the engine lacks."""
 
 import numpy as np
 
 from .._checks import check_scale
-from .base import AbstractEngine, Design
+from .base import AbstractEngine, Design, Scene
 from .materials import check_poisson, check_positive, check_restitution
 
-# the speeds of an export's report, in units of v0
-SPEED_FACTORS = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0)
+SPEED_FACTORS = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0)  # an export's speeds, in units of v0
 
 
 def law_of(law_or_fit):
@@ -38,8 +36,7 @@ def curve(law, m, speeds, separation):
 
 
 def inputs(m, v0, timestep, poisson):
-    """`(m, v0, timestep, poisson)` checked (kg, m/s, s or None, Poisson's ratio or None);
-    one-line ValueErrors."""
+    """`(m, v0, timestep, poisson)` checked (kg, m/s, s or None, - or None)."""
     m = check_scale("m", check_positive("m", m, "kg"), "kg")
     v0 = check_scale("v0", check_positive("v0", v0, "m/s"), "m/s")
     if timestep is not None:
@@ -50,12 +47,9 @@ def inputs(m, v0, timestep, poisson):
 
 
 def targets(law_or_fit, *, e, T, m: float, v0: float, speeds=None):
-    """`(source, target_e, target_T)`: the law of `law_or_fit` (None with targets) and the e
-    and T (s; None where not given) an export aims at: the targets `e` and `T`, checked, or
-    the law's e and T for mass `m` (kg) at `v0` (m/s); with `speeds` (m/s, a law the engine
-    lacks), the middle of the law's e over them (the constant e nearest to it in the worst
-    case) and its T at `v0`. A one-line ValueError where neither or both are given, or the
-    law does not separate."""
+    """`(source, target_e, target_T)`: the law (None from targets) and the e and T (s) aimed
+    at: the targets, or the law's at `m` (kg), `v0` (m/s); with `speeds` (m/s) the middle of
+    its e over them. One-line ValueErrors: neither or both given, no separation."""
     if law_or_fit is None:
         if e is None:
             raise ValueError("export needs a law or fit, or the target e= (and T=)")
@@ -82,13 +76,12 @@ def targets(law_or_fit, *, e, T, m: float, v0: float, speeds=None):
     return source, float(result.e), float(result.T)
 
 
-def responses(engine_law, m_engine: float, out: Design, stepping, source, *, m, v0, speeds=None):
-    """`(fields, note)`: the `Export` fields `speeds` (m/s, `v0` times `SPEED_FACTORS`, or
-    the `speeds` given),
-    `e_engine`, `T_engine` (what the engine realises: its `stepping`'s mean over first-touch
-    phases where it is replicated, else its continuous law `engine_law` on mass `m_engine`,
-    kg) and `e_target`, `T_target` (the `source` law's on mass `m`; None from targets), and a
-    warning where the two e(v) part by more than 0.02 (else None)."""
+def responses(engine_law, m_engine: float, out: Design, stepping, scene: Scene, speeds=None):
+    """`(fields, note)`: the `Export`'s `speeds` (`v0` times `SPEED_FACTORS`, or those
+    given), `e_engine`, `T_engine` (the `stepping`'s phase means, else `engine_law` on
+    `m_engine`, kg), the law's `e_target`, `T_target` at `scene.m`, and a warning where the
+    two e(v) part by more than 0.02."""
+    source, m, v0 = scene.law, scene.m, scene.v0
     speeds = tuple(v0 * f for f in SPEED_FACTORS) if speeds is None else tuple(speeds)
     if stepping is None:  # the continuous plant, or a stepper not replicated (Chrono)
         e_engine, T_engine = curve(engine_law, m_engine, speeds, out.separation)
@@ -111,11 +104,8 @@ def responses(engine_law, m_engine: float, out: Design, stepping, source, *, m, 
 
 
 def normal_model(chosen: AbstractEngine, source):
-    """`(model, lacked)`: the normal model of engine `chosen` that exports the law `source`
-    (None: targets), its row of `NORMAL` (LAMMPS's `jkr` for a `jkr` law) or else the first
-    (the default design), and whether the engine lacks the law, a plastic or adhesive one
-    (`LawSpec.kind`: Thornton's, JKR's), so that the export goes to its nearest law
-    (`nearest` says so where their e(v) part)."""
+    """`(model, lacked)`: `chosen`'s normal model for the law `source` (its row of `NORMAL`,
+    else the first) and whether the engine lacks a plastic or adhesive law (`LawSpec.kind`)."""
     default = next(iter(chosen.NORMAL.values()))
     if source is None:
         return default, False
@@ -126,9 +116,8 @@ def normal_model(chosen: AbstractEngine, source):
 
 
 def given_speeds(v0, lacked, chosen: AbstractEngine):
-    """`(v0, speeds)`: a speed (m/s) as given, with None; or from a sequence of speeds (for
-    a law the engine lacks), their geometric middle and the speeds, sorted. One-line
-    ValueErrors."""
+    """`(v0, speeds)`: one speed (m/s) and None, or for a law the engine lacks the speeds'
+    geometric middle and the speeds, sorted."""
     if isinstance(v0, str) or np.ndim(v0) == 0:
         return v0, None
     if not lacked:
@@ -143,20 +132,10 @@ def given_speeds(v0, lacked, chosen: AbstractEngine):
     return float(np.sqrt(speeds[0] * speeds[-1])), tuple(speeds)
 
 
-def nearest(
-    chosen: AbstractEngine,
-    normal,
-    source,
-    fields: dict,
-    target_e: float,
-    *,
-    fitted: bool,
-    v0: float,
-) -> str:
-    """The one line for a law with a contact state (`source`) that engine `chosen` does not
-    have: the nearest law it has (its normal model `normal`'s `NEAREST`), how it was set (`fitted`:
-    the middle of the law's e over the speeds given, else e and T at `v0`), and the worst
-    |e_engine - e_law| over `fields`' speeds."""
+def nearest(chosen: AbstractEngine, normal, scene: Scene, fields, target_e, *, fitted) -> str:
+    """The line for a law with a contact state that `chosen` lacks: its nearest (`normal`'s
+    `NEAREST`), how it was set (`fitted`: over the speeds given), the worst |de|."""
+    source, v0 = scene.law, scene.v0
     speeds, mine, law = fields["speeds"], fields["e_engine"], fields["e_target"]
     gaps = [abs(a - b) for a, b in zip(mine, law, strict=True)]
     worst = int(np.argmax(gaps))
@@ -176,8 +155,8 @@ def nearest(
 
 
 def check_scales(m: float, v0: float, T: float) -> None:
-    """A one-line ValueError where float64 cannot hold the contact's scales: its stiffness
-    `m / T^2`, the square of a step `(T / 1e5)^2`, its depth `v0 T` and force `m v0 / T`."""
+    """A one-line ValueError where float64 cannot hold `m / T^2`, `(T / 1e5)^2`, `v0 T` or
+    `m v0 / T`."""
     with np.errstate(all="ignore"):
         m_, v_, T_ = np.float64(m), np.float64(v0), np.float64(T)
         scales = (m_ / T_**2, (T_ / 1e5) ** 2, v_ * T_, m_ * v_ / T_)

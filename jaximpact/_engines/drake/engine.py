@@ -1,5 +1,4 @@
-"""Drake: point contact in a MultibodyPlant, continuous or discrete (`normal.py`), and its
-friction for every tangential law on the continuous plant (`friction.py`)."""
+"""Drake: point contact in a MultibodyPlant (`normal.py`) and its friction."""
 
 from ..base import TANGENTIAL_LAWS, AbstractEngine
 from .friction import StribeckFriction

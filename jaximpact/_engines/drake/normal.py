@@ -1,22 +1,12 @@
-"""Drake: point contact in a continuous MultibodyPlant (`time_step = 0`), `f = k x (1 + d v)`.
-
-Drake's docs (multibody "Contact Modeling", `drake::multibody::CoulombFriction` and
-`geometry::AddContactMaterial`: `point_contact_stiffness` k (N/m), `hunt_crossley_dissipation`
-d (s/m)) give the normal force of point contact as `f = k x (1 + d v)`, clamped to be
-non-negative: Hunt & Crossley with n = 1 (law `point_contact`). Its restitution depends on
-`d v0` alone (`closed_forms.hunt_crossley_restitution`), so it changes with the impact speed:
-an export is exact at the `v0` it was made for. Drake documents no d-from-e formula. Two
-geometries combine as springs in series, `k = k1 k2 / (k1 + k2)`,
-`d = (k2 d1 + k1 d2) / (k1 + k2)`: giving both the body and the ground `2k` and `d` yields
-`k` and `d`. A discrete plant (`time_step > 0`) steps the contact implicitly: with TAMSI,
-Lagged (Drake's default approximation) and Similar, a point contact found at a step's start
-(`x > 0`) gives the new speed from `m (v1 - v) = -h k (x + h v1)_+ (1 + d v1)_+`
-(Castro et al., "An unconstrained convex formulation of compliant contact", 2022, and TAMSI,
-Castro et al. 2019): `replica` integrates that and equals Drake 1.51.1 to 5 digits phase by
-phase (tests/engines). That step damps (e = 0.9 came out 0.59 at 10 steps per
-contact), so with a `timestep` the export corrects k and d for it, or warns where even
-d = 0 damps too much. kSap ignores `hunt_crossley_dissipation`.
-"""
+"""Drake's point contact, `f = k x (1 + d v)` clamped non-negative (multibody "Contact
+Modeling", `geometry::AddContactMaterial`: `point_contact_stiffness` k N/m,
+`hunt_crossley_dissipation` d s/m): Hunt & Crossley with n = 1 (law `point_contact`), e a
+function of `d v0` (exact at the export's v0). Two geometries combine in series (`k = k1 k2 /
+(k1 + k2)`, `d = (k2 d1 + k1 d2) / (k1 + k2)`): both get `2k` and `d`. A discrete plant (TAMSI,
+Lagged, Similar; Castro et al. 2019, 2022) steps a contact found at a step's start by `m (v1 -
+v) = -h k (x + h v1)_+ (1 + d v1)_+` (`replica`, equal to Drake 1.51.1 to 5 digits per
+phase), which damps (e = 0.9 gave 0.59 at 10 steps): the export corrects k and d for it.
+kSap ignores `hunt_crossley_dissipation`."""
 
 import math
 
@@ -28,8 +18,7 @@ from ..materials import check_positive
 
 
 def _tau(alpha: float) -> float:
-    """The duration of `m x'' = -k x (1 + D v)` at `k = m = v0 = 1`, `D = alpha` (units of
-    `sqrt(m/k)`), from jaximpact's solver."""
+    """The duration (in `sqrt(m/k)`) of `m x'' = -k x (1 + alpha v)` at `k = m = v0 = 1`."""
     from ..._laws import law
     from ..._solve.impact import impact
 
@@ -37,8 +26,7 @@ def _tau(alpha: float) -> float:
 
 
 def alpha_for(e: float) -> float:
-    """The damping group `alpha = d v0` whose restitution (`f = k x (1 + d v)`, the
-    force-criterion closed form) is `e` (0 for `e = 1`), or a one-line ValueError."""
+    """The `alpha = d v0` whose restitution is `e` (closed form, force criterion)."""
     from scipy.optimize import brentq
 
     from ...closed_forms import hunt_crossley_restitution
@@ -68,10 +56,7 @@ def _parameters(k: float, d: float, time_step: float) -> dict:
 
 
 def discrete_step(x, v, k, d, m, h):
-    """One step of a discrete plant's implicit contact (TAMSI's scheme, Castro et al. 2019;
-    Lagged and Similar agree with it here): with the contact found at the step's start
-    (`x > 0`), the new approach speed `v1` solves `m (v1 - v) = -h k (x + h v1)_+ (1 + d
-    v1)_+` and `x1 = x + h v1`. Arrays `x` (m), `v` (m/s); returns `(x1, v1, pushing)`."""
+    """`(x1, v1, pushing)` of one implicit step (the module's docstring), `x1 = x + h v1`."""
     A = h * h * k * d
     B = m + h * h * k + h * k * d * x
     C = h * k * x - m * v
@@ -87,10 +72,8 @@ def discrete_step(x, v, k, d, m, h):
 
 
 def replica(parameters, m: float, v0: float, timestep: float, phases=None):
-    """`(e, T)` per start phase that a discrete plant (`time_step = timestep` s) realises with
-    `parameters` for a body of mass `m` (kg) at `v0` (m/s): `discrete_step` from first touch,
-    `phase * timestep` after a step's start, to the step where the contact is no longer
-    found. Checked against Drake's TAMSI, Lagged and Similar (tests/engines)."""
+    """`(e, T)` per start phase of a discrete plant at `timestep` (s) with `parameters`, for
+    mass `m` (kg) at `v0` (m/s)."""
     phases = _stepping.PHASES if phases is None else phases
     k = parameters["point_contact_stiffness"]
     d = parameters["hunt_crossley_dissipation"]
@@ -101,9 +84,8 @@ def replica(parameters, m: float, v0: float, timestep: float, phases=None):
 
 
 def _discrete(e: float, T: float, k: float, alpha: float, m: float, v0: float, h: float):
-    """`(parameters, es, Ts, reachable)`: `k` (N/m) and `alpha = d v0` corrected until a
-    discrete plant of step `h` (s) realises `e` and `T` (s) on the phase mean (`replica`),
-    what it realises per start phase, and whether some `d >= 0` reaches `e`."""
+    """`(parameters, es, Ts, reachable)`: `k` (N/m), `alpha` corrected until the plant at `h`
+    (s) realises `e`, `T` (s) on the phase mean, and whether some `d >= 0` reaches `e`."""
     params = _parameters(k, alpha / v0, h)
     reachable = True
     for _ in range(40):
@@ -122,8 +104,7 @@ def _discrete(e: float, T: float, k: float, alpha: float, m: float, v0: float, h
 
 
 class PointContact(AbstractNormalModel):
-    """Drake's point contact `f = k x (1 + d v)` for a body on a half space: its continuous
-    plant, or a discrete plant's implicit step (the module's docstring has the sources)."""
+    """Drake's point contact (the module's docstring)."""
 
     NAME = "point"
     LAW = "point_contact"
@@ -142,28 +123,19 @@ class PointContact(AbstractNormalModel):
     SCENES = None
 
     def design(self, e, T, scene, *, timestep=None, poisson=0.3, limit_damping=False) -> Design:
-        """`point_contact_stiffness` k (N/m) and `hunt_crossley_dissipation` d (s/m) that
-        realise `e` and `T` (s) for mass `m` (kg) at `v0` (m/s): on the continuous plant
-        (`timestep` None or 0: exact, from the closed-form e of `f = k x (1 + d v)`), or on a
-        discrete plant of step `timestep` (s) with the Lagged (Drake's default), Similar or
-        TAMSI approximation, whose implicit step damps further: k and d are then corrected
-        through `replica` (mean over where first touch falls inside a step), and a warning
-        says when no d >= 0 can give `e` at that step. The other options do not apply."""
+        """k and d: exact on the continuous plant (`timestep` None or 0), corrected through
+        `replica` on a discrete one (a warning where no d >= 0 gives `e`)."""
         from ...closed_forms import hunt_crossley_restitution
 
         m, v0 = scene.m, scene.v0
         if T is None:
             raise ValueError("Drake needs a contact duration: pass T= (s) or a law")
         alpha = alpha_for(e)
-        k = m * (_tau(alpha) / T) ** 2
-        if not timestep:
-            return Design(
-                parameters=_parameters(k, alpha / v0, 0.0),
-                e=float(hunt_crossley_restitution(alpha)),
-                T=float(_tau(alpha) * math.sqrt(m / k)),
-                timestep=0.0,
-                separation="force",
-            )
+        tau = _tau(alpha)
+        k = m * (tau / T) ** 2
+        if not timestep:  # the continuous plant: exact
+            e_c, T_c = float(hunt_crossley_restitution(alpha)), float(tau * math.sqrt(m / k))
+            return Design(_parameters(k, alpha / v0, 0.0), e_c, T_c, 0.0, "force")
         h = float(timestep)
         params, es, Ts, reachable = _discrete(e, T, k, alpha, m, v0, h)
         steps = float(Ts.mean() / h)
@@ -187,15 +159,12 @@ class PointContact(AbstractNormalModel):
         return Design.stepped(params, es, Ts, h, warnings, "force", params)
 
     def law_parameters(self, parameters, m):
-        """`point_contact`'s `c` = k (N/m) and `d` (s/m), whatever the mass."""
         return {
             "c": parameters["point_contact_stiffness"],
             "d": parameters["hunt_crossley_dissipation"],
         }
 
     def response(self, parameters, *, m, radius=None):
-        """`(law, separation)`: the point contact of `parameters` (`point_contact_stiffness`
-        N/m > 0, `hunt_crossley_dissipation` s/m >= 0) for a body of mass `m` (kg)."""
         k = check_positive("point_contact_stiffness", parameters["point_contact_stiffness"], "N/m")
         d = float(parameters["hunt_crossley_dissipation"])
         if not (math.isfinite(d) and d >= 0):
@@ -204,8 +173,6 @@ class PointContact(AbstractNormalModel):
         return law, "force"
 
     def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
-        """The discrete plant's implicit step (`replica`) when `parameters["time_step"] > 0`,
-        else None (the continuous plant has no step error)."""
         if not parameters.get("time_step"):
             return None
         h = check_positive("time_step", parameters["time_step"], "s")

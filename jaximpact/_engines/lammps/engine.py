@@ -1,8 +1,5 @@
-"""LAMMPS: `pair_style granular` between two equal spheres, or a sphere and `fix wall/gran`,
-at `fix nve/sphere`'s velocity Verlet. Its normal models by the law each exports
-(`hertz/material` with `damping coeff_restitution`, the default design; `jkr`; `jkr` with
-`damping viscoelastic`; `dmt`) and its tangential models by tangential law, as LAMMPS's
-`GranSubModStyle` lines register them (src/GRANULAR/gran_sub_mod_normal.h)."""
+"""LAMMPS's `pair_style granular` (two equal spheres, or a sphere on `fix wall/gran`) at `fix
+nve/sphere`'s velocity Verlet: its models as `GranSubModStyle` lines register them."""
 
 from ..base import AbstractEngine
 from . import script
@@ -14,8 +11,7 @@ from .tangential import TANGENTIAL
 
 
 class Lammps(AbstractEngine):
-    """LAMMPS's `pair_style granular` (the modules of this folder have the formulas and
-    sources)."""
+    """LAMMPS's `pair_style granular`."""
 
     NAME = "lammps"
     LABEL = "LAMMPS"

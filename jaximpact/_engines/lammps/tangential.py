@@ -1,20 +1,10 @@
-"""LAMMPS's tangential models for jaximpact's tangential laws: the `tangential ...` clause of
-`pair_style granular`'s `pair_coeff` (and of `fix wall/gran granular`), which follows the
-clause of any of its normal models (`hertz.py`, `jkr.py`, `jkr_viscoelastic.py`, `dmt.py`).
-
-LAMMPS doc pair_granular; src/GRANULAR/gran_sub_mod_tangential.cpp (release 22Jul2025):
-`linear_history` is a spring with displacement history `F_t = -k xi`; `mindlin`,
-`F_t = -k a xi` with the contact radius `a = (R x)^0.5`; `mindlin/force`, the force history
-`dF_t = -k a dxi`; `mindlin_rescale` and `mindlin_rescale/force` the same with the history
-scaled by `a_new / a_old` at each step where the contact radius shrinks; each capped at
-`mu |F_n|` (the normal force with its damping), the history rescaled to the cap while
-sliding. These are the equations of jaximpact's `linear_history`, `mindlin`,
-`mindlin_force`, `mindlin_rescale` and `mindlin_rescale_force` (`k = kt`, or `k = 8 G*`),
-whose spring is
-set to the limit it was held at when it sticks again. LAMMPS's own `k = NULL` for a wall
-is `8 E / (4 (2 - nu)(1 + nu))`, the G* of a sphere on a wall of its own material; the
-export writes `k` itself, so any G* goes.
-"""
+"""LAMMPS's tangential models: the `tangential ...` clause after any normal model's in
+`pair_coeff` (and `fix wall/gran granular`). src/GRANULAR/gran_sub_mod_tangential.cpp
+(22Jul2025): `linear_history` `F_t = -k xi`; `mindlin` `F_t = -k a xi`, `a = (R x)^0.5`;
+`mindlin/force` `dF_t = -k a dxi`; the `_rescale` ones scale the history by `a_new / a_old`
+where `a` shrinks; each capped at `mu |F_n|`, the history rescaled to the cap while sliding:
+jaximpact's laws of those names (`k = kt`, or `8 G*`). The export writes `k` (LAMMPS's
+`NULL` is a wall of the sphere's material), so any G* goes."""
 
 import dataclasses
 
@@ -24,11 +14,9 @@ from . import script
 
 @dataclasses.dataclass(frozen=True)
 class Granular(AbstractTangentialModel):
-    """One tangential model of LAMMPS's `pair_style granular`: its name (`model`, as
-    `pair_coeff` spells it) and its spring constant, the law's `kt` (N/m) or, for Mindlin's
-    models (`mindlin`: k = 8 G*, in Pa, times the contact radius), 8 times its `G_star`;
-    no tangential damping (xgammat 0: LAMMPS scales it with the normal damping, which a
-    constant `ct` or EDEM's `beta` does not match)."""
+    """One tangential `model` (as `pair_coeff` spells it), its k the law's `kt` (N/m) or with
+    `mindlin` `8 G_star` (Pa); no damping (xgammat 0: LAMMPS scales it with the normal
+    damping, as neither `ct` nor EDEM's `beta` does)."""
 
     model: str
     mindlin: bool = True
@@ -60,8 +48,6 @@ class Granular(AbstractTangentialModel):
         return None
 
     def parameters(self, design: Design, tangential) -> dict:
-        """The design's parameters with the clause in `pair_coeff` and `fix_wall`, after
-        the normal model's (`design.clause`), and under `tangential`."""
         clause = self.clause(tangential)
         p = design.parameters
         lines = script.commands(
@@ -79,7 +65,6 @@ class Granular(AbstractTangentialModel):
         return None
 
 
-# jaximpact tangential law -> LAMMPS tangential model: the rows of `Lammps.TANGENTIAL`
 TANGENTIAL = {
     "linear_history": Granular("linear_history", mindlin=False),
     "mindlin": Granular("mindlin"),
@@ -90,9 +75,7 @@ TANGENTIAL = {
 
 
 def tangential_clause(tangential) -> str:
-    """The `tangential ...` clause of `pair_coeff` (and `fix wall/gran`) for a jaximpact
-    tangential law (`linear_history kt 0 mu`, kt in N/m; `mindlin 8G* 0 mu`, ...), or a
-    one-line ValueError for one LAMMPS does not take."""
+    """The `tangential ...` clause for a tangential law, or a one-line ValueError."""
     model = TANGENTIAL.get(tangential.name)
     if model is None:
         raise ValueError(

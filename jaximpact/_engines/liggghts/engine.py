@@ -1,6 +1,4 @@
-"""LIGGGHTS: two equal spheres through `pair_style gran model hertz` (`normal.py`: LAMMPS's
-hertz/material in LIGGGHTS's words) and its `tangential history` for a `mindlin` law
-(`tangential.py`); checked against LIGGGHTS 3.8.0 (Debian's `liggghts`) in tests/engines."""
+"""LIGGGHTS: `pair_style gran model hertz` (`normal.py`) and its `tangential history`."""
 
 from ..base import AbstractEngine
 from ..lammps.engine import Lammps

@@ -1,6 +1,4 @@
-"""MuJoCo: a body on a plane through its soft contact (solref, solimp), and the e and T that
-MuJoCo's time stepping realises: one normal model (`normal.py`) and its friction for every
-tangential law (`friction.py`)."""
+"""MuJoCo: a body on a plane through its soft contact (`normal.py`) and friction."""
 
 from ..base import TANGENTIAL_LAWS, AbstractEngine
 from .friction import PyramidalFriction

@@ -1,35 +1,14 @@
-"""MuJoCo's friction on a sphere meeting a plane obliquely: Coulomb's `mu` in its soft
-pyramidal cone, the oblique impact its Euler step realises (replicated), and how the cone
-changes the normal contact.
-
-MuJoCo has no tangential spring: a contact with `condim="3"` and the default
-`cone="pyramidal"` is four constraint rows, the cone's edges `J_n +- mu J_t1`,
-`J_n +- mu J_t2` (src/engine/engine_core_constraint.c, `mj_instantiateContact`), each
-pushing only (`f >= 0`) and softened as the normal row is:
-
-- `mj_diagApprox`: each edge's approximate inverse inertia `diagA = tran (1 + mu^2)`, `tran`
-  the body's translational `invweight0` (1/m for a free body);
-- `mj_makeImpedance`: `R = (1 - d)/d diagA`, then for a pyramid the common
-  `R_py = 2 mu^2 R` on every edge (`impratio = 1`), `D = 1/R_py`; the reference
-  acceleration of each edge `aref = -B (J v) - K d r` with `r` the contact's distance
-  (negative inside) and `K`, `B` from solref as for the normal row;
-- the solver (Newton, to its tolerance) gives the unique minimum of
-  `1/2 (a - a0)' M (a - a0) + sum 1/2 D (J a - aref)^2` over the edges where
-  `J a < aref` (`a0 = 0` here: no gravity, and a sphere's gyroscopic term is zero);
-- the contact point lies halfway through the penetration: the lever arm of the friction
-  about the centre is `R + r/2`.
-
-Head-on (no slip) the four edges share the normal acceleration, which is then
-`d_eff aref` with `d_eff = 1 / (1 + mu^2 (1 + mu^2) (1 - d) / (2 d))` in place of the
-frictionless row's `d aref`: friction stiffens and damps the normal contact by `d_eff / d`
-(`head_on_factor`), which an export with friction divides out. Obliquely the edges' damping
-`B (J v)` carries the slip `mu u`, so MuJoCo's normal restitution changes with the incidence
-(measured in tests/engines: the replica equals MuJoCo 4.0 to round-off).
-
-The motion stays in the plane of incidence, so the two edges across it carry equal forces
-and act as normal rows; the replica solves the other two and the pair in one 3 x 3 system
-per active set (x, z and the spin about y, per unit mass), and takes the consistent one.
-"""
+"""MuJoCo's friction: Coulomb's `mu` in its soft pyramidal cone (`condim="3"`), no tangential
+spring. src/engine/engine_core_constraint.c: `mj_instantiateContact` makes four rows, the
+edges `J_n +- mu J_t1`, `J_n +- mu J_t2`, each pushing only; `mj_diagApprox` `diagA = (1 +
+mu^2)/m`; `mj_makeImpedance` `R_py = 2 mu^2 (1 - d)/d diagA` on every edge (`impratio = 1`),
+`D = 1/R_py`, `aref = -B (J v) - K d r` (K, B from solref); the solver minimises `1/2 (a -
+a0)' M (a - a0) + sum 1/2 D (J a - aref)^2` over the edges where `J a < aref`; the lever arm
+is `R + r/2`. Head-on the edges share the normal acceleration `d_eff aref`, `d_eff = 1 / (1 +
+mu^2 (1 + mu^2) (1 - d) / (2 d))`: the export divides out `head_on_factor` = `d_eff / d`.
+Obliquely the damping carries the slip, so e changes with the incidence. In the plane of
+incidence the two edges across it act as one normal row: the replica solves a 3 x 3 system
+(x, z, spin) per active set (equal to MuJoCo 4.0 to round-off, tests/engines)."""
 
 import itertools
 import math
@@ -41,32 +20,27 @@ from ..base import AbstractTangentialModel, Design
 from .solref import SOLIMP, continuous, effective, replica
 
 INERTIA = 0.4  # MuJoCo's solid sphere, I = 0.4 m R^2
-# the active sets: edge + (mu along the slip), edge -, the pair across the plane
-_ACTIVE = np.array(list(itertools.product([0.0, 1.0], repeat=3)))
+_ACTIVE = np.array(list(itertools.product([0.0, 1.0], repeat=3)))  # edge +, edge -, the pair
 
 
-def head_on_factor(mu: float, impedance: float = SOLIMP[0]) -> float:
-    """`d_eff / d`: how much stiffer and more damped MuJoCo's pyramidal cone with friction
-    `mu` makes the normal contact head-on than a frictionless one (impedance `d`)."""
-    d = impedance
+def head_on_factor(mu: float) -> float:
+    """`d_eff / d`: how much the cone of friction `mu` stiffens and damps the contact head-on."""
+    d = SOLIMP[0]  # the impedance
     d_eff = 1.0 / (1.0 + mu**2 * (1.0 + mu**2) * (1.0 - d) / (2.0 * d))
     return d_eff / d
 
 
 def frictional_solref(solref, timestep: float, mu: float) -> list[float]:
-    """The direct solref `[-stiffness, -damping]` with which MuJoCo's pyramidal cone of
-    friction `mu` realises head-on the contact that `solref` (at `timestep`, s) gives a
-    frictionless row: the effective stiffness (1/s^2) and damping (1/s) over
-    `head_on_factor(mu)`."""
+    """The direct solref with which the cone of friction `mu` realises head-on what `solref`
+    (at `timestep`, s) gives a frictionless row: both over `head_on_factor(mu)`."""
     stiffness, damping = effective(solref, timestep)
     s = head_on_factor(mu)
     return [-stiffness / s, -damping / s]
 
 
 def _edge_solve(J, aref, D, inv_mass):
-    """The acceleration `(a_x, a_z, a_spin)` per row of `J` (..., 3, 3: edge +, edge -, the
-    pair across), from the active set whose solution is consistent (each active edge's
-    `J a <= aref`, each inactive one's `J a >= aref`); `D` per edge (the pair's doubled)."""
+    """`(a_x, a_z, a_spin)` of the active set whose solution is consistent (`J a <= aref` on
+    active rows, `>=` on the others)."""
     M = np.diag(1.0 / inv_mass)
     best, violation = None, None
     for active in _ACTIVE:
@@ -85,33 +59,18 @@ def _edge_solve(J, aref, D, inv_mass):
     return best
 
 
-def oblique_replica(
-    solref,
-    timestep,
-    *,
-    mu,
-    radius,
-    v_n,
-    v_t,
-    phases=_stepping.PHASES,
-    impedance=SOLIMP[0],
-    inertia=INERTIA,
-):
-    """`(e, e_t, omega)` per start phase (the last axis; `v_n`, `v_t` arrays of one shape
-    before it): the normal restitution, the centre's tangential
-    restitution and the spin after (rad/s, positive rolling forward) of a free sphere of
-    radius `radius` (m) and moment of inertia `inertia m R^2` meeting a plane at normal
-    speed `v_n` and tangential speed `v_t` (m/s, no spin before) under MuJoCo's Euler step
-    `timestep` (s) with `solref` (either form; solimp `SOLIMP`), friction `mu`,
-    `condim="3"`, the pyramidal cone, impratio 1. The mass cancels (per unit mass)."""
+def oblique_replica(solref, timestep, *, mu, radius, v_n, v_t, phases=_stepping.PHASES):
+    """`(e, e_t, omega)` per start phase (the last axis) of a free sphere (`radius` m, inertia
+    `INERTIA m R^2`) meeting a plane at `v_n`, `v_t` (m/s, no spin before) under MuJoCo's
+    Euler step `timestep` (s) with `solref`, friction `mu` (the module's docstring)."""
     h = float(timestep)
     stiffness, damping = effective(solref, h)
-    d = impedance
+    d = SOLIMP[0]  # the impedance
     K_d, B = stiffness / d, damping / d  # aref = -B (J v) - (K d) r
     diag = 1.0 + mu**2  # mj_diagApprox, per unit mass
     D = 1.0 / (2.0 * mu**2 * (1.0 - d) / d * diag)
     D_rows = np.array([D, D, 2.0 * D])
-    inv_mass = np.array([1.0, 1.0, 1.0 / (inertia * radius**2)])
+    inv_mass = np.array([1.0, 1.0, 1.0 / (INERTIA * radius**2)])
     v_n = np.asarray(v_n, float)[..., None]  # (..., phase)
     v_t = np.asarray(v_t, float)[..., None]
     gap = v_n * h * np.asarray(phases, float)  # the distance at the first step (> 0: apart)
@@ -137,7 +96,7 @@ def oblique_replica(
 
 
 class PyramidalFriction(AbstractTangentialModel):
-    """MuJoCo's friction for any tangential law: its Coulomb `mu` on the pyramidal cone."""
+    """MuJoCo's friction for any tangential law: its `mu` on the pyramidal cone."""
 
     MODEL = "MuJoCo's pyramidal friction cone"
     FRICTION = (
@@ -155,10 +114,8 @@ class PyramidalFriction(AbstractTangentialModel):
         return None
 
     def parameters(self, design: Design, tangential) -> dict:
-        """The design's parameters with friction `mu` (the tangential law's) on the pyramidal
-        cone, and solref in its direct form divided by `head_on_factor(mu)`, so that head-on
-        MuJoCo realises the frictionless design. `mu = 0`: no friction (condim 1),
-        unchanged."""
+        """Friction `mu` on the cone, solref direct over `head_on_factor(mu)` (`mu = 0`: condim
+        1, unchanged)."""
         parameters = design.parameters
         mu = float(tangential.params["mu"])
         out = dict(
@@ -177,9 +134,8 @@ class PyramidalFriction(AbstractTangentialModel):
         return tangential
 
     def notes(self, parameters, tangential) -> list[str]:
-        """How strongly MuJoCo's friction can act: its cone slows the slip at the rate of
-        the contact's damping `B` (1/s), over the contact's duration `T`; `B T` well below
-        1 leaves the slip almost as it came."""
+        """The cone slows the slip at the damping's rate `B` (1/s) over `T`: `B T` well below
+        1 leaves it almost as it came."""
         if "cone_factor" not in parameters:
             return []
         stiffness, damping = effective(parameters["solref"], parameters["timestep"])
@@ -193,8 +149,6 @@ class PyramidalFriction(AbstractTangentialModel):
         ]
 
     def oblique(self, parameters, *, m, radius, v_n, v_t):
-        """MuJoCo's Euler step on the sphere with the exported friction (`oblique_replica`);
-        without friction the normal replica, the tangential speed and spin unchanged."""
         mu = float(parameters.get("friction", [0.0])[0])
         if mu > 0:
             return oblique_replica(

@@ -1,5 +1,4 @@
-"""MuJoCo's normal model: solref, solimp and a time step designed so that its Euler step
-realises a target e and T (its bias corrected), through `solref.replica`."""
+"""MuJoCo's normal model: solref, solimp and a step whose Euler step realises e and T."""
 
 import math
 
@@ -19,13 +18,9 @@ from .solref import (
 
 
 def _corrected(e: float, T: float, v0: float, timestep) -> tuple[float, float, float]:
-    """`(w0, zeta, h)`: the natural frequency (1/s) and damping ratio that MuJoCo's Euler
-    step at `h` (s: `timestep`, or the recommended step) turns into `e` and `T` (s) at `v0`
-    (m/s), the continuous contact's corrected for the step's own bias (phase means). The
-    recommended step is the coarsest at which e's spread over start phases stays within the
-    export's tolerance (`_stepping.recommended_step`; the correction then moves the mean onto
-    the target, within `_CORRECTION_TOL`), halved where the corrected contact still misses
-    it."""
+    """`(w0, zeta, h)`: natural frequency (1/s) and damping ratio that the Euler step at `h`
+    (s: `timestep`, or the coarsest whose e spread is within tolerance, halved while the
+    corrected contact misses) turns into `e`, `T` (s) at `v0` (m/s)."""
     if timestep is not None:
         return (*_at_step(e, T, v0, float(timestep))[:2], float(timestep))
     zeta = dampratio_for(e)
@@ -39,14 +34,11 @@ def _corrected(e: float, T: float, v0: float, timestep) -> tuple[float, float, f
         h = _stepping.nice_down(h / 2.0)
 
 
-# how far (relative) the corrected contact's phase-mean e and T may stay from the target
-_CORRECTION_TOL = 2e-5
+_CORRECTION_TOL = 2e-5  # how far the corrected phase means may stay from the target
 
 
 def _at_step(e: float, T: float, v0: float, h: float):
-    """`(w0, zeta, es, Ts)`: the continuous contact's natural frequency (1/s) and damping
-    ratio corrected (phase means, up to 8 rounds) so that MuJoCo's Euler step at `h` (s)
-    realises `e` and `T` (s) at `v0` (m/s), and what it realises per start phase."""
+    """`(w0, zeta, es, Ts)`: corrected (up to 8 rounds) for the Euler step at `h` (s)."""
     zeta = target = dampratio_for(e)
     w0 = continuous(zeta)[1] / T
     for _ in range(8):
@@ -72,8 +64,7 @@ def _solref(w0: float, zeta: float):
 
 
 def _solref_at(w0: float, zeta: float, h: float):
-    """`_solref`, in the direct form where refsafe would raise the standard form's
-    timeconst (below two steps `h`, s): the solref the design gives MuJoCo."""
+    """`_solref`, direct where refsafe would raise the timeconst (below two steps `h`)."""
     solref = _solref(w0, zeta)
     if solref[0] > 0 and solref[0] < 2.0 * h:
         return (-(w0**2), -2.0 * zeta * w0)
@@ -81,8 +72,7 @@ def _solref_at(w0: float, zeta: float, h: float):
 
 
 class Solref(AbstractNormalModel):
-    """MuJoCo's soft contact (solref, solimp) for a body on a plane, at its Euler step
-    (`solref.py` has the formulas and sources)."""
+    """MuJoCo's soft contact at its Euler step (`solref.py`)."""
 
     NAME = "solref"
     LAW = "kelvin_voigt"
@@ -94,17 +84,12 @@ class Solref(AbstractNormalModel):
         f"its Euler step at timestep (default {DEFAULT_TIMESTEP:g} s), semi-implicit in the "
         "contact force: replicated"
     )
-    # solref scales the contact per unit mass: from targets e and T no mass is needed (from
-    # a law, its e and T at v0 depend on the mass)
-    MASS_DEPENDS = None
+    MASS_DEPENDS = None  # per unit mass
     ALLOWS_LIMIT_DAMPING = True
     NEAREST = "its kelvin_voigt law"
     SCENES = None
 
     def design(self, e, T, scene, *, timestep=None, poisson=0.3, limit_damping=False) -> Design:
-        """solref, solimp and time step that realise `e` and `T` (s; None: MuJoCo's default
-        timeconst) at `v0` (m/s) in MuJoCo, and what MuJoCo realises with them. The contact
-        per unit mass does not depend on the mass `m`; the other options do not apply."""
         v0 = scene.v0
         warnings = []
         if T is None:
@@ -149,20 +134,15 @@ class Solref(AbstractNormalModel):
         return Design.stepped(parameters, es, Ts, h, warnings, "force", parameters, target_T=T)
 
     def law_parameters(self, parameters, m):
-        """`kelvin_voigt`'s `c` (N/m) and `b` (N s/m) for a body of mass `m` (kg), to be
-        read with `separation="force"`."""
         stiffness, damping = effective(parameters["solref"], parameters["timestep"])
         return {"c": m * stiffness, "b": m * damping}
 
     def response(self, parameters, *, m, radius=None):
-        """`(law, separation)`: the continuous law of `parameters` (`solref`, `timestep`,
-        default 0.002 s, for refsafe) for a body of mass `m` (kg), each value checked."""
         solref = check_solref(parameters["solref"])
         timestep = check_positive("timestep", parameters.get("timestep", DEFAULT_TIMESTEP), "s")
         return self.law({"solref": solref, "timestep": timestep}, m), "force"
 
     def stepper(self, parameters, *, m, radius=None) -> Stepping:
-        """MuJoCo's Euler step at `parameters["timestep"]` (default 0.002 s)."""
         h = check_positive("timestep", parameters.get("timestep", DEFAULT_TIMESTEP), "s")
         solref = check_solref(parameters["solref"])
         return Stepping(h, lambda v: replica(solref, h, v))

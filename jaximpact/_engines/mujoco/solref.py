@@ -1,26 +1,11 @@
-"""MuJoCo's soft contact (solref, solimp) per unit mass, and its Euler step replicated: what
-its normal model (`normal.py`), its friction (`friction.py`) and Yade's design share.
-
-MuJoCo: a body on a plane through its soft contact (solref, solimp), and the e and T that
-MuJoCo's time stepping realises.
-
-MuJoCo (src/engine/engine_core_constraint.c, `getsolparam`, `getimpedance`, `mj_makeImpedance`;
-docs: Modeling > Solver parameters) gives a contact row the reference acceleration
-`aref = -B v - K d r` with impedance `d` from solimp; the solved acceleration of one
-frictionless row is `(1 - d) a0 + d aref`. Standard solref `(timeconst, dampratio)`:
-`K = 1/(dmax^2 timeconst^2 dampratio^2)`, `B = 2/(dmax timeconst)`. With a constant impedance
-(`solimp` with `dmin = dmax`) the penetration `x` obeys, for any mass,
-
-    x'' = -max(0, 2/timeconst x' + x/(timeconst dampratio)^2)
-
-a linear spring-dashpot per unit mass with natural frequency `1/(timeconst dampratio)` and
-damping ratio `dampratio` whose force never pulls: `kelvin_voigt` under
-`separation="force"`. `refsafe` (on by default) raises `timeconst` to at least two time
-steps; the direct form `(-stiffness, -damping)` (`x'' = -stiffness x - damping x'`) is never
-raised. The default integrator (Euler) is semi-implicit in the contact force:
-`_stepping.semi_implicit_euler` replicates it to round-off (checked against MuJoCo in
-tests/engines).
-"""
+"""MuJoCo's soft contact per unit mass (shared by `normal.py`, `friction.py` and Yade).
+src/engine/engine_core_constraint.c (`getsolparam`, `getimpedance`, `mj_makeImpedance`): a
+row's `aref = -B v - K d r`, solved `(1 - d) a0 + d aref`; standard solref `(timeconst,
+dampratio)` gives `K = 1/(dmax^2 timeconst^2 dampratio^2)`, `B = 2/(dmax timeconst)`, so with
+constant impedance `x'' = -max(0, 2/timeconst x' + x/(timeconst dampratio)^2)`: `kelvin_voigt`
+per unit mass under `separation="force"`. `refsafe` raises timeconst to two steps; the direct
+form `(-stiffness, -damping)` is never raised. Euler is semi-implicit in the contact force
+(`_stepping.semi_implicit_euler`, equal to MuJoCo to round-off)."""
 
 import math
 
@@ -35,9 +20,7 @@ _MAX_DAMPRATIO = 1e3
 
 
 def continuous(dampratio: float) -> tuple[float, float]:
-    """`(e, tau)` of the continuous contact: restitution and duration in units of
-    `timeconst * dampratio` (= 1/natural frequency), from jaximpact's exact Kelvin-Voigt
-    under the force criterion."""
+    """`(e, tau)` of the continuous contact, tau in `timeconst dampratio` (1/natural frequency)."""
     from ...closed_forms import kelvin_voigt
 
     out = kelvin_voigt(1.0, 2.0 * dampratio, 1.0, 1.0, "force")
@@ -45,7 +28,7 @@ def continuous(dampratio: float) -> tuple[float, float]:
 
 
 def dampratio_for(e: float) -> float:
-    """The damping ratio whose force-criterion restitution is `e` (0 for `e = 1`)."""
+    """The damping ratio whose restitution is `e` (force criterion)."""
     if e >= 1.0:
         return 0.0
     from scipy.optimize import brentq
@@ -58,14 +41,12 @@ def dampratio_for(e: float) -> float:
 
 
 def acceleration(stiffness: float, damping: float):
-    """The contact acceleration `a(x, v)` along the penetration (per unit mass, never
-    pulling) of stiffness `stiffness` (1/s^2) and damping `damping` (1/s)."""
+    """`a(x, v)` per unit mass, never pulling: stiffness (1/s^2), damping (1/s)."""
     return lambda x, v: -np.maximum(0.0, damping * v + stiffness * x)
 
 
 def check_solref(solref) -> tuple[float, float]:
-    """`solref` as two floats, or a one-line ValueError: the standard form `[timeconst > 0,
-    dampratio > 0]` or the direct form `[-stiffness < 0, -damping <= 0]`."""
+    """`solref` as two floats, standard or direct, or a one-line ValueError."""
     try:
         a, b = (float(value) for value in solref)
     except (TypeError, ValueError):
@@ -82,9 +63,7 @@ def check_solref(solref) -> tuple[float, float]:
 
 
 def effective(solref, timestep: float) -> tuple[float, float]:
-    """`(stiffness, damping)` per unit mass that MuJoCo applies for `solref` (standard form
-    `(timeconst, dampratio)`, raised to `timeconst >= 2 timestep` as refsafe does, or direct
-    form `(-stiffness, -damping)`)."""
+    """`(stiffness, damping)` per unit mass MuJoCo applies for `solref` (refsafe included)."""
     a, b = float(solref[0]), float(solref[1])
     if a < 0:
         return -a, -b
@@ -93,6 +72,6 @@ def effective(solref, timestep: float) -> tuple[float, float]:
 
 
 def replica(solref, timestep: float, v0: float, phases=_stepping.PHASES):
-    """`(e, T)` per start phase that MuJoCo's Euler step realises (see `_stepping`)."""
+    """`(e, T)` per start phase of MuJoCo's Euler step."""
     stiffness, damping = effective(solref, timestep)
     return _stepping.semi_implicit_euler(acceleration(stiffness, damping), timestep, v0, phases)
