@@ -11,6 +11,8 @@ damping puts it within a step of maximum compression), and restitution from maxi
 compression to separation (`e`, `T`).
 """
 
+from typing import NamedTuple
+
 import diffrax as dfx
 import jax.numpy as jnp
 import optimistix as optx
@@ -65,7 +67,23 @@ def _peak_condition(y, beta, n, p, gamma=0.0):
     return elastic + damping
 
 
-def _solve(y0, t0, t1, condition, beta, n, p, *, rtol, max_steps, gamma=0.0, direction=False):
+class _Motion(NamedTuple):
+    """`X'' = -X^n - beta X^p X' + gamma` (nondimensional): the damping group `beta`, the
+    exponents `n`, `p` (numbers) and the constant push `gamma` (gravity in, minus a dry
+    force against the motion)."""
+
+    beta: object
+    n: float
+    p: float
+    gamma: object = 0.0
+
+
+def _solve(y0, t0, t1, condition, motion: _Motion, *, rtol, max_steps, direction=False):
+    """`motion` from `y0` at `t0` up to `t1` or the crossing of `condition(y)` (in the
+    sense `direction`); returns the state and instant at the end and whether the event
+    fired."""
+    beta, n, p, gamma = motion
+
     def rhs(t, y, args):
         return jnp.stack([y[1], -_force(y, beta, n, p) + gamma])
 
@@ -114,18 +132,16 @@ def reference_impact(
     includes it."""
     y0 = jnp.stack([jnp.zeros_like(beta), jnp.ones_like(beta)])
     options = dict(rtol=rtol, max_steps=max_steps)
+    # compression: gravity in, the dry force out
     constant = (0.0 if gamma is None else gamma) - (0.0 if dry is None else dry)
-    if gamma is not None or dry is not None:
-        options["gamma"] = constant  # compression: gravity in, the dry force out
-    y_max, t_max, _ = _solve(y0, 0.0, tau_max, lambda y: y[1], beta, n, p, **options)
+    compressing = _Motion(beta, n, p, constant)
+    y_max, t_max, _ = _solve(y0, 0.0, tau_max, lambda y: y[1], compressing, **options)
     y_peak, _, peaked = _solve(
         y0,
         0.0,
         t_max,
-        lambda y: _peak_condition(y, beta, n, p, options.get("gamma", 0.0)),
-        beta,
-        n,
-        p,
+        lambda y: _peak_condition(y, beta, n, p, constant),
+        compressing,
         **options,
     )
     in_dry = 0.0 if dry is None else dry
@@ -137,8 +153,9 @@ def reference_impact(
     f_max = jnp.maximum(at_touch, later)
     restitution = y_max.at[1].set(0.0)
     end = tau_max
+    restoring = compressing
     if dry is not None:  # restitution: gravity in, the dry force in (against V < 0)
-        options["gamma"] = (0.0 if gamma is None else gamma) + dry
+        restoring = compressing._replace(gamma=(0.0 if gamma is None else gamma) + dry)
     if gamma is not None or dry is not None:
         # where V comes back up to 0 (upwards only): gravity holding the body, or, after
         # a separation, its fall back; the separation must come before it. (V - 1e-14:
@@ -148,9 +165,7 @@ def reference_impact(
             t_max,
             tau_max,
             lambda y: y[1] - 1e-14,
-            beta,
-            n,
-            p,
+            restoring,
             direction=True,
             **options,
         )
@@ -159,9 +174,7 @@ def reference_impact(
         t_max,
         end,
         lambda y: _separation_gap(y, beta, n, p, separation, dry),
-        beta,
-        n,
-        p,
+        restoring,
         **options,
     )
     return dict(

@@ -37,9 +37,8 @@ from .._progress import AbstractMeter, metered
 from .._status import Status
 from .chunks import compute_chunk
 from .job_law import JobLaw, job_law
-from .parts import Parts
+from .parts import OUTPUTS, Parts
 from .processes import ProcessGroup
-from .parts import OUTPUTS
 from .readers import (
     PARQUET_SUFFIXES,
     TEXT_COLUMNS,
@@ -190,10 +189,7 @@ def batch_file(
         law,
         params=params,
         given=given,
-        chunk_rows=chunk_rows,
-        resume=resume,
-        progress=progress,
-        mesh=mesh,
+        run=Run(chunk_rows=chunk_rows, resume=resume, progress=progress, mesh=mesh),
         impact_options=impact_options,
     )
     with _one_writer(job):
@@ -218,12 +214,24 @@ def _one_writer(job: Job):
         yield
 
 
-def plan(
-    source, out, law, *, params, given, chunk_rows, resume, progress, mesh, impact_options
-) -> Job:
-    """The job of `batch_file`'s arguments (`given`: its `m`, `v0`, `g`, `separation`), each
-    checked, and the table opened: a one-line `ValueError` before any work."""
+@dataclasses.dataclass(frozen=True)
+class Run:
+    """How a file job runs, as `batch_file` takes it: `chunk_rows` (rows per chunk),
+    `resume`, `progress` (a meter, `True` or `False`) and `mesh` (`"local"` or
+    `"global"`)."""
+
+    chunk_rows: int = 100_000
+    resume: bool = False
+    progress: bool | AbstractMeter = True
+    mesh: str = "local"
+
+
+def plan(source, out, law, *, params, given, run: Run, impact_options) -> Job:
+    """The job of `batch_file`'s arguments (`given`: its `m`, `v0`, `g`, `separation`;
+    `run`: its `chunk_rows`, `resume`, `progress`, `mesh`), each checked, and the table
+    opened: a one-line `ValueError` before any work."""
     law = job_law(law)
+    chunk_rows, mesh = run.chunk_rows, run.mesh
     if mesh not in ("global", "local"):
         raise ValueError(f"mesh must be 'global' or 'local', got {mesh!r}")
     if isinstance(chunk_rows, bool) or not (isinstance(chunk_rows, int) and chunk_rows >= 1):
@@ -274,8 +282,8 @@ def plan(
         settings=settings,
         group=ProcessGroup.current(),
         chunk_rows=chunk_rows,
-        resume=resume,
-        progress=progress,
+        resume=run.resume,
+        progress=run.progress,
         mesh=mesh,
         one_pass=not getattr(table, "replayable", True),  # a generator: checked as it comes
     )

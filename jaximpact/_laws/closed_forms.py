@@ -30,6 +30,7 @@ from jax.scipy.special import gammaln
 from .._checks import is_traced
 from .._status import Status
 from .closed_forms_linear import (
+    LinearCoefficients,
     linear_impact,
     maxwell_creep as maxwell_creep,  # where dynamics.py reads it
     maxwell_gravity_impact,
@@ -349,9 +350,8 @@ def kelvin_voigt_closed_form(separation):
         def with_gravity(args):
             c, b, m, v0, g = args
             zero = jnp.zeros_like(c)
-            fields = linear_impact(
-                c, b, zero, zero, m, v0, g, separation, dry=False, rest_tol=rest_tol
-            )
+            coefficients = LinearCoefficients(c, b, zero, zero)
+            fields = linear_impact(coefficients, m, v0, g, separation, dry=False, rest_tol=rest_tol)
             fields["status"] = jnp.asarray(fields["status"]).astype(jnp.int32)
             return fields
 
@@ -370,18 +370,8 @@ def _linear_impact(p_in, p_out, damped, dry):
         def impact_fields(law, *, m, v0, g=0.0, rest_tol, tau_max=TAU_MAX, with_end=False):
             c, pressure = law.params["c"], law.params["P"]
             b = law.params["b"] if damped else jnp.zeros_like(c)
-            fields = linear_impact(
-                c,
-                b,
-                p_in(pressure),
-                p_out(pressure),
-                m,
-                v0,
-                g,
-                separation,
-                dry=dry,
-                rest_tol=rest_tol,
-            )
+            coefficients = LinearCoefficients(c, b, p_in(pressure), p_out(pressure))
+            fields = linear_impact(coefficients, m, v0, g, separation, dry=dry, rest_tol=rest_tol)
             return _finish(fields, m, v0, g, with_end)
 
         return impact_fields

@@ -19,9 +19,12 @@ surface, at rest when `|V| + |F - m g|/(c x*)` falls to `rest_tol`, or (Maxwell 
 gravity, whose dashpot lets the body sink in at `m g/b` for ever) at the horizon `tau_max`.
 """
 
+from typing import NamedTuple
+
 import jax
 import jax.numpy as jnp
 import optimistix as optx
+from jaxtyping import Array
 
 from .._status import Status
 from .oscillator import (
@@ -114,8 +117,19 @@ def _rest_time(s, r, y0, v0, rest_tol):
     return _newton_root(excess, (s, r, y0, v0), start)
 
 
-def linear_impact(c, b, p_in, p_out, m, v0, g, separation, *, dry, rest_tol=1e-7):
-    """Exact impact of `m x'' = -(c x + b v + P_phase) + m g`, `x(0) = 0`, `x'(0) = v0`.
+class LinearCoefficients(NamedTuple):
+    """The linear law `F = c x + b v + P_phase`: stiffness `c` (N/m), damping `b` (N s/m),
+    and the dry force `p_in` in compression, `p_out` in restitution (N)."""
+
+    c: Array | float
+    b: Array | float
+    p_in: Array | float
+    p_out: Array | float
+
+
+def linear_impact(law: LinearCoefficients, m, v0, g, separation, *, dry, rest_tol=1e-7):
+    """Exact impact of `m x'' = -(c x + b v + P_phase) + m g`, `x(0) = 0`, `x'(0) = v0`,
+    for the coefficients `law` (`LinearCoefficients`: `c`, `b`, `p_in`, `p_out`).
 
     `P_phase = p_in` (N) while `v > 0`, `-p_out` after: Kelvin-Voigt (eq. 1) with
     `p_in = p_out = 0`, Bingham (eq. 7, `F = c x + b v + P sgn(v)`) with `p_in = p_out = P`,
@@ -138,6 +152,7 @@ def linear_impact(c, b, p_in, p_out, m, v0, g, separation, *, dry, rest_tol=1e-7
     Returns a dict of `e, T, x_max, t_max, F_max, status` and `x_end` (m, where contact
     ended, for the work of gravity).
     """
+    c, b, p_in, p_out = law
     t_star = jnp.sqrt(m / c)
     x_star = v0 * t_star
     scale = c * x_star

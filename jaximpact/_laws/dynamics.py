@@ -7,6 +7,7 @@ A dynamics object knows its state layout; the impact solve only calls the method
 """
 
 import abc
+from typing import NamedTuple
 
 import equinox as eqx
 import jax
@@ -272,11 +273,27 @@ class ScaledDynamics(AbstractDynamics):
         return y[0]
 
 
+class PowerCoefficients(NamedTuple):
+    """The coefficients of `F = c x^n + b x^p v + P_phase` at one impact speed, as
+    `LawSpec.coefficients` gives them: `c` (N/m^n), `n`, `b` (N s/m^(p+1)), `p`, and the
+    dry force `dry_in` in compression and `dry_out` in restitution (N)."""
+
+    c: Array | float
+    n: Array | float
+    b: Array | float
+    p: Array | float
+    dry_in: Array | float
+    dry_out: Array | float
+
+
 def power_dynamics(
-    c, n, b, p, dry_in, dry_out, *, m, v0, g, gap, split=False, can_stick=False
+    coefficients: PowerCoefficients, *, m, v0, g, gap, split=False, can_stick=False
 ) -> PowerDynamics:
-    """Build `PowerDynamics` from dimensional coefficients (SI units); `split`: the dry
-    force differs between compression and restitution; `can_stick`: it can hold the body."""
+    """Build `PowerDynamics` from the law's `coefficients` (SI units), the mass `m` (kg),
+    the impact speed `v0` (m/s) and gravity `g` (m/s^2); `gap` as `PowerDynamics.gap`;
+    `split`: the dry force differs between compression and restitution; `can_stick`: it
+    can hold the body."""
+    c, n, b, p, dry_in, dry_out = coefficients
     x_star = (m * v0**2 / c) ** (1.0 / (n + 1.0))
     force_scale = m * v0**2 / x_star
     return PowerDynamics(

@@ -14,7 +14,7 @@ from .._checks import invalid_entries
 from .._choices import unknown_name
 from .._powers import contact_pow
 from .base import AbstractLaw, LawSpec
-from .dynamics import power_dynamics
+from .dynamics import PowerCoefficients, power_dynamics
 from .parameters import checked_parameters, parameter_rule
 from .table import LAW_NAMES, LAWS
 
@@ -48,17 +48,12 @@ class Law(AbstractLaw):
         return law(self.name, **{**self.params, **params})
 
     def dynamics(self, *, m, v0, g):
-        c, n, b, p, p_in, p_out = self.spec.coefficients(self.params, v0)
+        coefficients = PowerCoefficients(*self.spec.coefficients(self.params, v0))
         gap = self.spec.gap
         if gap == "power":
-            gap = _power_gap(n, p)
+            gap = _power_gap(coefficients.n, coefficients.p)
         return power_dynamics(
-            c,
-            n,
-            b,
-            p,
-            p_in,
-            p_out,
+            coefficients,
             m=m,
             v0=v0,
             g=g,

@@ -19,7 +19,7 @@ import numpy as np
 from jax.scipy.special import gammaln
 
 from .._curves.shapes import CurveKey
-from .._fit.calibrate import _residual_function
+from .._fit.calibrate import ForwardModel, _residual_function
 from .._fit.forward_jacobian import with_forward_jacobian
 from .._fit.parameters import to_unbounded
 from .._laws import AbstractLaw
@@ -53,11 +53,16 @@ class Model(eqx.Module):
 
     def values(self, z) -> dict:
         """`{name: value}` (SI) at `z` (last axis: the names)."""
-        return {k: p.value(z[..., i]) for i, (k, p) in enumerate(zip(self.names, self.priors))}
+        return {
+            k: p.value(z[..., i])
+            for i, (k, p) in enumerate(zip(self.names, self.priors, strict=True))
+        }
 
     def coordinates(self, values: dict) -> np.ndarray:
         """`z` of `{name: value}` (numpy)."""
-        return np.stack([p.coordinate(values[k]) for k, p in zip(self.names, self.priors)], axis=-1)
+        return np.stack(
+            [p.coordinate(values[k]) for k, p in zip(self.names, self.priors, strict=True)], axis=-1
+        )
 
     # ------------------------------------------------------------------ forward model
 
@@ -119,14 +124,11 @@ def _forward(model: Model, theta, v0):
     raw = _residual_function(
         model.law,
         model.free,
+        ForwardModel.of(setup),
         m=model.m,
-        separation=setup.separation,
         g=model.g,
-        rtol=setup.rtol,
         has_e=True,
         has_T=False,
-        curves=setup.curves,
-        closed_form=setup.closed_form,
     )
     ones = jnp.ones_like(v0)
     data = (v0, ones, ones, ones, ones)

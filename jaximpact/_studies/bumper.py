@@ -4,8 +4,6 @@ stays under a bound and the restitution under a target (optax, constraints by pe
 Several (bound, target) pairs run at once (vmapped): trade-off curves in one compilation.
 """
 
-import functools
-
 import equinox as eqx
 import jax
 import jax.numpy as jnp
@@ -79,19 +77,35 @@ def _bumper_response(theta, scales, m, speeds, rtol):
     return jax.vmap(one)(speeds)
 
 
-@functools.partial(jax.jit, static_argnames=("steps", "rtol"))
-def _optimise_bumper(theta0, scales, m, speeds, bound, e_target, tol, lr, mu, steps, rtol):
-    """Adam on `log(c / scales[0]), log(b1 / scales[1])`, the penalty weight growing
-    geometrically from `mu[0]` to `mu[1]` (a continuation: first find the region, then
-    sharpen the constraints) while the learning rate decays to 1% (to settle on the
-    constraint boundary). Returns the parameters of the last evaluation, its response
-    (`F_max, x_max, e` per speed) and the objective's history."""
-    schedule = optax.cosine_decay_schedule(lr, steps, alpha=0.01)
+class _Run(eqx.Module):
+    """How `_optimise_bumper` iterates: the constraints' tolerance `tol` (relative in
+    `x_max`, absolute in `e`), the initial learning rate `lr`, the penalty weights
+    `mu = (first, last)`, the number of `steps` and the `rtol` of each impact solve
+    (`steps` and `rtol` static: one compilation per value)."""
+
+    tol: Array | float
+    lr: Array | float
+    mu: Array
+    steps: int = eqx.field(static=True)
+    rtol: float = eqx.field(static=True)
+
+
+@jax.jit
+def _optimise_bumper(scales, m, speeds, bound, e_target, run: _Run):
+    """Adam on `log(c / scales[0]), log(b1 / scales[1])` from 0, for a body of `m` (kg)
+    at `speeds` (m/s) under the bounds `bound` (m) on `x_max` and `e_target` on `e`, the
+    penalty weight growing geometrically from `mu[0]` to `mu[1]` (a continuation: first
+    find the region, then sharpen the constraints) while the learning rate decays to 1%
+    (to settle on the constraint boundary). Returns the parameters of the last
+    evaluation, its response (`F_max, x_max, e` per speed) and the objective's history."""
+    theta0 = jnp.zeros(2)
+    tol, mu, steps = run.tol, run.mu, run.steps
+    schedule = optax.cosine_decay_schedule(run.lr, steps, alpha=0.01)
     # clipped: the first (penalty-dominated) gradients must not freeze Adam's step size
     optimiser = optax.chain(optax.clip_by_global_norm(1.0), optax.adam(schedule, b2=0.99))
 
     def objective(theta, weight):
-        response = _bumper_response(theta, scales, m, speeds, rtol)
+        response = _bumper_response(theta, scales, m, speeds, run.rtol)
         F, x, e = response.T
         peak = 0.01 * jax.nn.logsumexp(jnp.log(F) / 0.01)  # smooth max of log F_max
         over_x = jax.nn.relu(jnp.log(x / bound) + 0.5 * tol)
@@ -170,19 +184,10 @@ def bumper_design(
 
     def solve(bound, target):
         scales = start(bound)
-        theta, response, history = _optimise_bumper(
-            jnp.zeros(2),
-            scales,
-            m,
-            speeds,
-            bound,
-            target,
-            tol,
-            learning_rate,
-            jnp.asarray(penalty, dtype=float),
-            steps,
-            rtol,
+        run = _Run(
+            tol=tol, lr=learning_rate, mu=jnp.asarray(penalty, dtype=float), steps=steps, rtol=rtol
         )
+        theta, response, history = _optimise_bumper(scales, m, speeds, bound, target, run)
         F, x, e = response.T
         design = scales * jnp.exp(theta)
         feasible = jnp.all(x <= bound * (1 + tol)) & jnp.all(e <= target + tol)

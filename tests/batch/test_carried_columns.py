@@ -188,10 +188,7 @@ def test_a_resume_checks_the_carried_columns(tmp_path):
             "hertz_rate",
             params={},
             given=dict.fromkeys(("m", "v0", "g", "separation")),
-            chunk_rows=CHUNK,
-            resume=True,
-            progress=False,
-            mesh="local",
+            run=job.Run(chunk_rows=CHUNK, resume=True, progress=False, mesh="local"),
             impact_options={},
         )
         return job.check(planned).digests

@@ -173,10 +173,7 @@ def test_a_users_law_takes_parameters_of_any_sign(tmp_path):
             law,
             params=None,
             given={"m": None, "v0": None, "g": None, "separation": None},
-            chunk_rows=CHUNK,
-            resume=False,
-            progress=False,
-            mesh="local",
+            run=job.Run(chunk_rows=CHUNK, resume=False, progress=False, mesh="local"),
             impact_options={},
         )
     )

@@ -23,7 +23,11 @@ from scipy.integrate import solve_ivp
 
 import jaximpact as ji
 from jaximpact._laws.closed_forms import kelvin_voigt
-from jaximpact._laws.closed_forms_linear import linear_impact, maxwell_impact
+from jaximpact._laws.closed_forms_linear import (
+    LinearCoefficients,
+    linear_impact,
+    maxwell_impact,
+)
 
 REST_TOL = 1e-7
 SEPARATIONS = ("force", "penetration")
@@ -136,7 +140,7 @@ def linear_batch(separation):
 
     def one(c, b, p_in, p_out, m, v0, g):
         def e_and_T(q):
-            out = linear_impact(*q, m, v0, g, separation, dry=True)
+            out = linear_impact(LinearCoefficients(*q), m, v0, g, separation, dry=True)
             return jnp.stack([out["e"], out["T"]]), out
 
         q = jnp.stack([c, b, p_in, p_out])

@@ -558,13 +558,11 @@ def test_no_gravity_compiles_without_gravitys_formulas(where, monkeypatch):
         raw = calibrate._residual_function(
             law,
             ("b", "c"),
+            calibrate.ForwardModel(separation="force", rtol=1e-10, closed_form=True),
             m=0.0027,
-            separation="force",
             g=0.0,
-            rtol=1e-10,
             has_e=True,
             has_T=False,
-            closed_form=True,
         )
         data = (jnp.ones(2), jnp.ones(2), jnp.full(2, jnp.nan), jnp.ones(2), jnp.ones(2))
         jax.eval_shape(lambda t: value_and_jacobian(raw, t, data), jnp.zeros(2))

@@ -1,0 +1,52 @@
+"""How the library compiles the programs that run for milliseconds: a fit's residuals and
+Jacobian on the universal curves or a closed form, its start, its record.
+
+XLA's CPU compiler without its fusion emitters (`xla_cpu_use_fusion_emitters=False`, the
+LLVM IR emitters before them) compiles these programs about a third faster and runs them
+as fast (measured, one process each on 2 cores, benchmarks/fit_first_calls.md: a fit of
+`bingham` 7.8 -> 5.3 CPU s, `hertz_rate` 2.0 -> 1.4, `bingham_modified`'s two-group table
+12.5 -> 9.8, `compare_laws` over the seed paper's laws 51 -> 33). An integrated solve
+keeps XLA's default: it gains less (a user's law's `calibrate` 14.0 -> 11.5 CPU s), and
+with `--xla_backend_optimization_level=0` (the test suite's setting) the other rounding
+turned an over-damped Kelvin-Voigt impact (b 25x critical, e = 4e-4) from separated to
+captured. The options travel with one top-level program (`jax.jit`'s `compiler_options`,
+refused on a nested `jit`), never the process's `XLA_FLAGS`; other backends ignore an
+`xla_cpu_` option.
+"""
+
+import functools
+import threading
+
+import equinox as eqx
+
+QUICK_COMPILE = {"xla_cpu_use_fusion_emitters": False}
+
+
+@functools.cache
+def quick_options() -> dict:
+    """`QUICK_COMPILE` where this JAX's XLA takes it (tried once on a one-line program),
+    else `{}`: a version of XLA without the option compiles at its defaults, not fails."""
+    import jax
+
+    try:
+        jax.jit(lambda x: x + 1, compiler_options=QUICK_COMPILE).lower(1.0).compile()
+    except Exception:  # an unknown option: XLA's own error type varies by version
+        return {}
+    return QUICK_COMPILE
+
+
+def quick_jit(fun):
+    """`eqx.filter_jit(fun)` compiled with `quick_options()`, for a top-level program that
+    runs for milliseconds, where compiling is the wait. Made at the first call, so that
+    importing the library compiles nothing."""
+    lock, made = threading.Lock(), []
+
+    @functools.wraps(fun)
+    def call(*args, **kwargs):
+        if not made:
+            with lock:
+                if not made:
+                    made.append(eqx.filter_jit(fun, compiler_options=quick_options()))
+        return made[0](*args, **kwargs)
+
+    return call
