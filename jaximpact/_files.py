@@ -321,6 +321,7 @@ def read_csv(text: str, *, comments: bool = False):
 HEADER_UNITS = {
     "s": {"s": 1.0, "ms": 1e3, "us": 1e6, "µs": 1e6, "μs": 1e6},
     "m/s": {"m/s": 1.0, "mm/s": 1e3, "cm/s": 1e2},
+    "m": {"m": 1.0, "mm": 1e3, "cm": 1e2},
     "1": {"1": 1.0, "-": 1.0},
 }
 

@@ -186,3 +186,15 @@ def test_read_recording_keeps_a_latin_1_note_and_names_a_bad_time(tmp_path):
     assert str(error.value) == (
         f"{path}, line 3, column impact_time: '0.3_5' is not a number: write 0.35"
     )
+
+
+def test_oblique_rebounds_and_tracks_read_the_units_their_header_gives(tmp_path):
+    """`fit-oblique`'s files take the same header units: speeds in mm/s, a track's times
+    in ms and positions in mm are held in SI."""
+    from jaximpact._oblique.report import read_rebounds
+
+    plain = _saved(tmp_path / "a.csv", "v_n,v_t,e_t\n3.9,1.2,0.5\n", "utf-8")
+    headed = _saved(tmp_path / "b.csv", "v_n (mm/s),v_t [mm/s],e_t\n3900,1200,0.5\n", "utf-8")
+    assert read_rebounds(headed, None) == read_rebounds(plain, None)
+    with pytest.raises(ValueError, match=r"column 't' in 'min': give it in one of s, ms, µs"):
+        read_rebounds(_saved(tmp_path / "c.csv", "t (min),x,y,phi\n0,0,0,0\n", "utf-8"), None)

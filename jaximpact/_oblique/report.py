@@ -14,6 +14,8 @@ INCIDENCE = ("theta_deg", "v_n", "v_t", "omega")
 MEASURED = ("e_t", "omega_out")
 COLUMNS = INCIDENCE + MEASURED
 TRACK = ("t", "x", "y", "phi")
+# SI units of the columns a header may give in others (`v_n (mm/s)`, `t [ms]`, `x (mm)`)
+UNITS = dict(v_n="m/s", v_t="m/s", t="s", x="m", y="m")
 
 
 def read_track(path: Path, header, rows, g: float) -> dict:
@@ -42,10 +44,11 @@ def read_track(path: Path, header, rows, g: float) -> dict:
 
 def read_rebounds(path: Path, speed: float | None, g: float = 9.81) -> dict:
     """`{v_n, v_t, omega, e_t, omega_out, theta}` (lists; NaN where not measured) from the
-    CSV at `path`, rebounds or a video track (`read_track`, gravity `g` in m/s^2);
-    one-line `CLIError`s for what is missing or not a number."""
+    CSV at `path`, rebounds or a video track (`read_track`, gravity `g` in m/s^2), in SI
+    units or those its header gives (`UNITS`: `v_n (mm/s)`, `t [ms]`); one-line
+    `CLIError`s for what is missing or not a number."""
     hint = f"{', '.join(COLUMNS)} (rebounds) or {', '.join(TRACK)} (a track)"
-    header, rows = read_table(path, COLUMNS + TRACK, label=str(path), hint=hint)
+    header, rows = read_table(path, COLUMNS + TRACK, label=str(path), hint=hint, units=UNITS)
     if "t" in header:
         if speed is not None:
             raise ValueError(f"{path} is a video track: --speed is not used; leave it out")
