@@ -326,18 +326,24 @@ HEADER_UNITS = {
 }
 
 
+def split_unit(name: str) -> tuple[str, str | None]:
+    """`(column, unit)` of a header cell: `T (ms)` and `T [ms]` are `("T", "ms")`, `T` is
+    `("T", None)`."""
+    stripped = name.strip()
+    if not stripped.endswith((")", "]")) or "(" not in stripped and "[" not in stripped:
+        return stripped, None
+    cut = max(stripped.rfind("("), stripped.rfind("["))
+    return stripped[:cut].strip(), stripped[cut + 1 : -1].strip()
+
+
 def header_unit(name: str, units: dict, label: str) -> tuple[str, float]:
     """`(column, divisor to SI)` of a header cell `name`: a column alone (1), or a
     column with its unit in brackets, `T (ms)` or `T [ms]`, where `units` gives the
     column's SI unit (a key of `HEADER_UNITS`); a one-line `ValueError` for a unit that
     column cannot take."""
-    stripped = name.strip()
-    if not stripped.endswith((")", "]")) or "(" not in stripped and "[" not in stripped:
-        return stripped, 1.0
-    cut = max(stripped.rfind("("), stripped.rfind("["))
-    column, unit = stripped[:cut].strip(), stripped[cut + 1 : -1].strip()
-    if column not in units:
-        return stripped, 1.0  # an unknown column, which the caller names
+    column, unit = split_unit(name)
+    if unit is None or column not in units:
+        return name.strip(), 1.0  # no unit, or an unknown column, which the caller names
     accepted = HEADER_UNITS[units[column]]
     if unit not in accepted:
         raise ValueError(

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._files import NotText, as_read, cell_number, open_text
+from .._files import NotText, as_read, cell_number, open_text, split_unit
 
 TEXT_COLUMNS = ("separation",)  # columns of words, not numbers
 PARQUET_SUFFIXES = (".parquet", ".pq")
@@ -88,6 +88,13 @@ def carried_columns(columns, known, where_header: str, outputs=()) -> tuple:
     for name in columns:
         if name in known:
             continue
+        column, unit = split_unit(name)
+        if unit is not None and column in known:  # read as carried, it would be lost
+            raise ValueError(
+                f"{where_header}: column {name!r} gives {column} with a unit; a batch reads "
+                f"SI units from a column named {column} alone: rename it {column} (values "
+                "in SI units)"
+            )
         near = close_column(name, known)
         if near is not None:
             raise ValueError(

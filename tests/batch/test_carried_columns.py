@@ -7,6 +7,7 @@ Compilation: the laws and chunk sizes of test_files.py (`hertz_rate`, 250 rows i
 100) and test_custom_law_files.py (a user's law, 6 rows in chunks of 3): no new program."""
 
 import csv
+import re
 
 import jax.numpy as jnp
 import numpy as np
@@ -174,6 +175,19 @@ def test_a_missing_column_names_the_columns_carried_unread(tmp_path):
     (tmp_path / "in.csv").write_text("c,b1,mass,v0\n2e6,800,1,2.5\n")
     with pytest.raises(ValueError, match=r"no value for m: .*\(carried through unread: mass\)"):
         ji.batch_file(tmp_path / "in.csv", tmp_path / "out.csv", "hertz_rate", progress=False)
+
+
+@pytest.mark.parametrize("header", ["v0 (m/s)", "v0 [mm/s]", "c (N/m^1.5)"])
+def test_a_read_column_with_a_unit_is_refused_not_carried(tmp_path, header):
+    """`v0 (m/s)` carried unread beside --v0 would give every row the option's speed next
+    to the file's own: one line says to name the column alone, in SI units."""
+    cells = {"v0": "c,b1,m,{}\n2e6,800,1,2.5\n", "c": "{},b1,m,v0\n2e6,800,1,2.5\n"}
+    (tmp_path / "in.csv").write_text(cells[header.split()[0]].format(header))
+    name = header.split()[0]
+    with pytest.raises(ValueError, match=rf"column '{re.escape(header)}' gives {name} with a unit"):
+        ji.batch_file(
+            tmp_path / "in.csv", tmp_path / "out.csv", "hertz_rate", v0=2.5, progress=False
+        )
 
 
 def test_a_resume_checks_the_carried_columns(tmp_path):
