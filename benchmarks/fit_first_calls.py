@@ -73,6 +73,14 @@ out["converged"] = all(bool(f.converged) for f in fits)
 out["optimizer"] = sorted({f.optimizer for f in fits})
 print(json.dumps(out))
 """
+QUICK = (
+    "Since stop 42 `auto`'s program on a closed form or the curves (`hertz_rate`, `bingham`, "
+    "`maxwell`, 10 of `compare_laws`' 11 laws) compiles without XLA's CPU fusion emitters "
+    "(`jaximpact/_compiling.py`); `lbfgs` and the integrated `user law` keep XLA's defaults. "
+    "The run before (commit 1801957, load 1.7-4.6) gave `auto` first calls of 14.2 / 13.7 "
+    "(user law), 1.6 / 1.8 (hertz_rate), 8.5 / 7.5 (bingham), 6.3 / 5.1 (maxwell) and "
+    "43.9 / 46.2 (compare_laws) wall / CPU s, and second calls of 66, 5, 10, 11 and 281 ms."
+)
 CASES = ("user law", "hertz_rate", "bingham", "maxwell", "compare_laws")
 NOTE = (
     "With e alone, several of the paper's laws leave a parameter undetermined (a stiffness, "
@@ -135,6 +143,8 @@ def main():
             "4 speeds; `compare_laws`: the seed paper's 11 laws, e at 6 speeds (threads, one "
             "per core). Seconds as wall / CPU (the process's user + system time, which load "
             "affects less); the second call is new targets of the same shapes.",
+            "",
+            QUICK,
             "",
             NOTE,
             "",
