@@ -317,9 +317,10 @@ def read_csv(text: str, *, comments: bool = False):
 
 
 # the units a header may give a column in (`T (ms)`, `v0 [mm/s]`), by the column's SI unit,
-# each with how many of it make the SI unit (a divisor: 0.9 ms is 0.9 / 1000 s, rounded once)
+# each with how many of it make the SI unit (a divisor: 0.9 ms is 0.9 / 1000 s, rounded once);
+# a unit's first spelling is the one messages show, the others are its aliases
 HEADER_UNITS = {
-    "s": {"s": 1.0, "ms": 1e3, "us": 1e6, "µs": 1e6, "μs": 1e6},
+    "s": {"s": 1.0, "ms": 1e3, "µs": 1e6, "us": 1e6, "μs": 1e6},
     "m/s": {"m/s": 1.0, "mm/s": 1e3, "cm/s": 1e2},
     "m": {"m": 1.0, "mm": 1e3, "cm": 1e2},
     "1": {"1": 1.0, "-": 1.0},
@@ -346,9 +347,11 @@ def header_unit(name: str, units: dict, label: str) -> tuple[str, float]:
         return name.strip(), 1.0  # no unit, or an unknown column, which the caller names
     accepted = HEADER_UNITS[units[column]]
     if unit not in accepted:
+        first = {}  # each unit by its first spelling
+        for spelling, divisor in accepted.items():
+            first.setdefault(divisor, spelling)
         raise ValueError(
-            f"{label}: column {column!r} in {unit!r}: give it in one of "
-            f"{', '.join(a for a in accepted if a not in ('us', 'μs'))}"
+            f"{label}: column {column!r} in {unit!r}: give it in one of {', '.join(first.values())}"
         )
     return column, accepted[unit]
 

@@ -1222,8 +1222,9 @@ def _fit_on_host(law, data, m, g, target_tol, options):
         )
     theta0 = np.stack([np.asarray(to_unbounded(k, law.parameters[k])) for k in options.free])
 
+    evaluated = _evaluated_compiled[_integrates(options.impact)]
+
     def evaluate(theta):
-        evaluated = _evaluated_compiled[_integrates(options.impact)]
         r, predictions, jacobian = evaluated(law, jnp.asarray(theta), data, m, g, options)
         return np.asarray(r), np.asarray(jacobian), predictions
 
