@@ -84,7 +84,8 @@ TEMPLATES = {
 
 def _reference(np_law, params, *, m, v0, separation):
     """e, T, x_max, F_max from scipy: `m x'' = -F(x, v)` from (0, v0), ended by the first
-    zero of x (both criteria) or, under the force criterion, of F going negative."""
+    zero of x (both criteria) or, under the force criterion, of F going negative; None where
+    the contact does not end within twice the rough pass's horizon."""
 
     def rhs(t, y):
         return [y[1], -np_law(y[0], y[1], params) / m]
@@ -118,7 +119,8 @@ def _reference(np_law, params, *, m, v0, separation):
         dense_output=True,
     )
     ended = [e for k, e in enumerate(sol.t_events) if k != 1 and len(e)]
-    assert ended, "the reference never separated"
+    if not ended:  # creeps back and never reaches the surface (heavy damping): no result
+        return None
     T = min(float(e[0]) for e in ended)
     v_out = float(sol.sol(T)[1])
     t_max = float(sol.t_events[1][0])
@@ -153,6 +155,9 @@ def _check(name, params, m, v0, separation):
     law = ji.custom_law(fn, **params)
     r = ji.impact(law, m=m, v0=v0, separation=separation)
     ref = _reference(np_fn, params, m=m, v0=v0, separation=separation)
+    if ref is None:  # scipy's contact did not end in its horizon: neither may ours
+        assert r.status_name != "separated", (name, params, m, v0, float(r.e), float(r.T))
+        return
     assert r.status_name == "separated", (name, params, m, v0, r.status_name)
     assert r.path == "integrated"
     # heavy damping makes T ill-conditioned: F crosses zero with a slope ~ e, so the
