@@ -1,18 +1,19 @@
 """How the library compiles the programs that run for milliseconds: a fit's residuals and
-Jacobian on the universal curves or a closed form, its start, its record.
+Jacobian on the universal curves or a closed form, its start, its record, and
+`fit_oblique`'s one program.
 
 XLA's CPU compiler without its fusion emitters (`xla_cpu_use_fusion_emitters=False`, the
 LLVM IR emitters before them) compiles these programs about a third faster and runs them
 as fast (measured, one process each on 2 cores, benchmarks/fit_first_calls.md: a fit of
 `bingham` 7.8 -> 5.3 CPU s, `hertz_rate` 2.0 -> 1.4, `bingham_modified`'s two-group table
-12.5 -> 9.8, `compare_laws` over the seed paper's laws 51 -> 33). An integrated solve
-keeps XLA's default: it gains less (a user's law's `calibrate` 14.0 -> 11.5 CPU s), and
-its other rounding, with `--xla_backend_optimization_level=0` (the test suite's setting),
-showed restitution's start to be rounding-sensitive (an over-damped Kelvin-Voigt impact,
-b 25x critical, captured at maximum compression: `phases._TURN_NOISE` fixed it); it is
-not yet checked over the slow tests. The options travel with one top-level program
-(`jax.jit`'s `compiler_options`, refused on a nested `jit`), never the process's
-`XLA_FLAGS`; other backends ignore an `xla_cpu_` option.
+12.5 -> 9.8, `compare_laws` over the seed paper's laws 51 -> 33; `fit_oblique`'s program
+14.2 -> 9.9). Other integrated solves keep XLA's default: they gain less (a user's law's
+`calibrate` 14.0 -> 11.5 CPU s), and the other rounding, with
+`--xla_backend_optimization_level=0` (the test suite's setting), showed restitution's
+start to be rounding-sensitive (an over-damped Kelvin-Voigt impact, b 25x critical,
+captured at maximum compression: `phases._TURN_NOISE` fixed it). The options travel with
+one top-level program (`jax.jit`'s `compiler_options`, refused on a nested `jit`), never
+the process's `XLA_FLAGS`; other backends ignore an `xla_cpu_` option.
 """
 
 import functools

@@ -20,6 +20,7 @@ import optimistix as optx
 from jaxtyping import Array
 
 from .._checks import check_positive, is_traced
+from .._compiling import quick_jit
 from .._format import format_fields, format_value, jsonable
 from .._laws import AbstractLaw
 from .._solve.options import CUSTOM_RTOL, DEFAULT_RTOL
@@ -298,10 +299,11 @@ def _evaluate(problem, thetas):
     return np.stack([r for r, _ in done]), np.array([ok for _, ok in done])
 
 
-@eqx.filter_jit
+@quick_jit
 def _evaluated(problem, theta):
     """The residuals at `theta`, their Jacobian (forward mode, exact across the stick-slip
-    transitions) and the impacts: the one compiled program of a refinement."""
+    transitions) and the impacts: the one compiled program of a refinement (compiled
+    quickly, `_compiling`: it runs for milliseconds)."""
 
     def with_aux(t):
         result = problem.predict(t)

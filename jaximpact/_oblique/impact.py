@@ -28,6 +28,7 @@ from .._solve.options import CUSTOM_RTOL, DEFAULT_RTOL
 from .._solve.phases import solve_broke
 from .._solve.precision import resolvable_tolerances
 from .._status import Status
+from .._tracing import anchors
 from .dynamics import SLIP, STICK, ObliqueDynamics
 from .results import _NOT_RESULTS, ObliqueResult
 from .roots import BracketedNewton
@@ -439,22 +440,23 @@ def _segments(dyn: ObliqueDynamics, y0, options: ObliqueOptions):
         max_steps=512,
         throw=False,
     ).ys[-1]
-    zero = jnp.zeros((), jnp.int32)
-    tau0 = jnp.asarray(FIRST_TOUCH)
-    no = jnp.asarray(False)
+    # every entry of the carry starts as it leaves a segment (`_tracing`)
+    float_anchor, no = anchors(dyn, y_in)
+    zero = no.astype(jnp.int32)
+    tau0 = FIRST_TOUCH + float_anchor
     carry = (
         y_in,
         tau0,
-        mode,
-        sense,
-        compressing,
+        mode | zero,
+        sense + float_anchor,
+        compressing | no,
         no,
-        tau_max,
-        jnp.asarray(True),
+        tau_max + float_anchor,
+        ~no,
         zero - 1,
         zero,
         zero,
-        (no, -jnp.ones_like(tau0)),
+        (no, float_anchor - 1.0),
     )
     carry, _ = jax.lax.scan(
         functools.partial(_segment, setup), carry, None, length=options.max_segments

@@ -37,6 +37,7 @@ import jax
 import jax.numpy as jnp
 
 from .._status import Status
+from .._tracing import anchors
 
 GRID_STEPS = 24
 # the `ImpactResult` fields a contact on the grid gives
@@ -259,9 +260,10 @@ def grid_contact(law, m, v0, *, separation: str, steps: int = GRID_STEPS) -> dic
     force_end = separation == "force"
     h = jnp.asarray(1.0 / steps, dtype=float)
     half = steps // 2
-    zero = jnp.zeros_like(v0)
+    # the carry starts as it leaves a step, batched and with a tangent (`_tracing`)
+    anchor, false = anchors(contact)
+    zero = anchor + jnp.zeros_like(v0)
     y0 = jnp.stack([zero, zero + 1.0, zero])
-    false = jnp.asarray(False)
 
     def body(carry, k):
         y, err, least, y_mid, peak, end = carry
@@ -288,8 +290,8 @@ def grid_contact(law, m, v0, *, separation: str, steps: int = GRID_STEPS) -> dic
     rate0 = contact.force_rate(y0, True)
     init = (
         y0,
-        jnp.zeros(3),
-        jnp.asarray(jnp.inf),
+        zero + jnp.zeros(3),
+        zero + jnp.inf,
         y0,
         (y0, zero, pair, false, rate0),
         (y0, zero, pair, false, zero + 1.0),

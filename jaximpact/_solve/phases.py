@@ -9,6 +9,7 @@ import jax.numpy as jnp
 import optimistix as optx
 
 from .._status import Status
+from .._tracing import anchors
 from .results import ImpactResult
 
 # Phases of one contact, integrated one after the other by the same compiled solve.
@@ -189,7 +190,9 @@ def integrate_phases(dynamics, options, *, plan, tau_grid, hold=None):
         going_on = alive & (skip | fired) & ~at_rest & ~out_of_steps & ~failed
         return (y_end, tau_end, going_on), record
 
-    carry = (dynamics.y0(), jnp.zeros_like(tau_max), jnp.asarray(True))
+    # the carry starts as it leaves a phase, batched and with a tangent (`_tracing`)
+    zero, no = anchors(dynamics, tau_max, tau_grid)
+    carry = (dynamics.y0() + zero, zero + jnp.zeros_like(tau_max), ~no)
     if len(plan) == 1:
         _, record = phase_solve(carry, jnp.asarray(plan[0]))
         return jax.tree_util.tree_map(lambda a: a[None], record)
