@@ -55,6 +55,7 @@ import jax.numpy as jnp
 
 from .._solve.grid import _A, _B, _B_ERR, _C, E_FLOOR, GRID_ACCEPT, GRID_RTOL, _combine, _Contact
 from .._status import Status
+from .._tracing import anchors
 from .dynamics import SLIP, STICK, ObliqueDynamics
 from .impact import ObliqueInputs, ObliqueOptions, ObliqueOutcome, _first_touch, oblique_result
 
@@ -256,11 +257,12 @@ def grid_oblique(
     ob = _Oblique(contact, spring, loss, force_end)
     h = 1.0 / steps
     half = steps // 2
-    zero = jnp.zeros_like(v_n)
+    # the carry starts as it leaves a step, batched and with a tangent (`_tracing`)
+    anchor, no = anchors(contact, spring, inputs)
+    zero = anchor + jnp.zeros_like(v_n)
     y0 = jnp.stack([zero, zero + 1.0, zero, zero, v_t / v_n, R * omega / v_n])
-    big = jnp.asarray(jnp.inf, dtype=zero.dtype)
-    no = jnp.asarray(False)
-    count = jnp.zeros((), jnp.int32)
+    big = zero + jnp.inf
+    count = no.astype(jnp.int32)
     # carry: s, k (the grid step the member is in), y, mode, sense, pending event (0 none,
     # 1 switch, 2 end), where it lands, done, ok, events, switches, err, least theta_dot,
     # least force, y at s = 1/2, last event's s, iterations
@@ -273,10 +275,10 @@ def grid_oblique(
         count,
         zero,
         no,
-        jnp.asarray(True),
+        ~no,
         count,
         count,
-        jnp.zeros(6),
+        zero + jnp.zeros(6),
         big,
         big,
         y0,
@@ -291,7 +293,7 @@ def grid_oblique(
     (sw_init, end_init), (dsw_init, dend_init) = ob.conditions(
         zero, y0, mode0, sense0, jnp.asarray(True)
     )
-    init = (*init[:-3], (sw_init, dsw_init, end_init, dend_init, jnp.asarray(True)), big, big)
+    init = (*init[:-3], (sw_init, dsw_init, end_init, dend_init, ~no), big, big)
 
     def body(carry):
         (
