@@ -19,9 +19,9 @@ from jaxtyping import Array
 def anchors(*trees) -> tuple[Array, Array]:
     """`(0.0, False)` that depend on every floating-point leaf of `trees`: batched under
     `vmap` where any leaf is, with a (zero) tangent under `jvp` where any leaf has one.
-    Add the zero to a float entry of a loop's initial carry, or `|` the False into a
-    boolean (or an integer, as `astype`) one. Non-finite values are read as 0, so the zero
-    is exact."""
+    Add the zero to a float entry of a loop's initial carry (an exact 0.0 or -0.0, which
+    leave every entry that is not -0.0 as it is), or `|` the False into a boolean (or an
+    integer, as `astype`) one. Non-finite values are read as 0, so the zero is exact."""
     total = jnp.zeros(())
     for leaf in jax.tree_util.tree_leaves(trees):
         if isinstance(leaf, jax.Array) and jnp.issubdtype(leaf.dtype, jnp.floating):
