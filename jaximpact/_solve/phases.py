@@ -90,10 +90,9 @@ def _back_to_the_turn(dynamics, phase, turned, y, tau_start, tau):
     at `V = _TURN_NOISE` (it ends `_TO_SEPARATION` and `_WHOLE`): one Newton step back,
     `tau - V/(dV/dtau)`, exact to `O(_TURN_NOISE^2)` (a captured body's T within 1e-9 of the
     closed form's, where the threshold alone moved it by `_TURN_NOISE/(dV/dtau)`)."""
-    compressing = phase < _TO_SEPARATION
-    velocity, rate = jax.jvp(dynamics.velocity, (y,), (dynamics.rhs(y, compressing),))
+    velocity, rate = jax.jvp(dynamics.velocity, (y,), (dynamics.rhs(y, False),))
     back = jnp.where(rate > 0, velocity / jnp.where(rate > 0, rate, 1.0), 0.0)
-    is_turn = turned & (phase != _TO_MAX_COMPRESSION) & (phase != _TO_PEAK)
+    is_turn = turned & (phase >= _TO_SEPARATION)  # restitution's phases
     return jnp.where(is_turn, jnp.maximum(tau - back, tau_start), tau)
 
 
