@@ -4,7 +4,8 @@ its names leaves JAX's configuration alone.
 
 A compiled program is kept on disk (`$JAXIMPACT_CACHE_DIR`, default
 `$XDG_CACHE_HOME/jaximpact/jax`, else `~/.cache/jaximpact/jax`), so a second process skips
-XLA's compilation.
+XLA's compilation; a fit's programs are also kept as traced (`_stored`, in
+`jaximpact-programs/` there), so it skips their tracing too.
 """
 
 import os
@@ -25,7 +26,8 @@ def cache_dir() -> Path | None:
 
 def enable_cache(path=None, *, min_compile_time_secs: float = 0.1) -> Path | None:
     """Keep JAX's compiled programs on disk, so that a second process skips XLA's compilation
-    (JAX's persistent compilation cache): sets `jax_compilation_cache_dir`,
+    (JAX's persistent compilation cache), and a fit's programs as traced, so that it skips
+    tracing them (`jaximpact-programs/` in the same directory): sets `jax_compilation_cache_dir`,
     `jax_persistent_cache_min_compile_time_secs` and `jax_persistent_cache_min_entry_size_bytes`
     of `jax.config` for the whole process. The command line does this itself; the library
     changes nothing of JAX's configuration unless this is called.

@@ -19,7 +19,7 @@ the process's `XLA_FLAGS`; other backends ignore an `xla_cpu_` option.
 import functools
 import threading
 
-import equinox as eqx
+from ._stored import stored_jit
 
 QUICK_COMPILE = {"xla_cpu_use_fusion_emitters": False}
 
@@ -39,8 +39,9 @@ def quick_options() -> dict:
 
 def quick_jit(fun):
     """`eqx.filter_jit(fun)` compiled with `quick_options()`, for a top-level program that
-    runs for milliseconds, where compiling is the wait. Made at the first call, so that
-    importing the library compiles nothing."""
+    runs for milliseconds, where compiling is the wait; kept on disk as traced where JAX's
+    persistent cache is on (`_stored`). Made at the first call, so that importing the
+    library compiles nothing."""
     lock, made = threading.Lock(), []
 
     @functools.wraps(fun)
@@ -48,7 +49,7 @@ def quick_jit(fun):
         if not made:
             with lock:
                 if not made:
-                    made.append(eqx.filter_jit(fun, compiler_options=quick_options()))
+                    made.append(stored_jit(fun, compiler_options=quick_options()))
         return made[0](*args, **kwargs)
 
     return call

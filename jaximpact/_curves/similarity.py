@@ -111,9 +111,11 @@ def beta_for_restitution(curves: Curves, e):
     def excess(s, target):
         return jnp.log(curve_values(curves, jnp.exp(s), (0,))[0]) - target
 
+    # `excess` falls from >= 0 at `lower` to < 0 at `upper` (`log_e` clipped): `flip=True`
+    # is what optimistix would detect, without its check (a host callback) or two calls
     solution = optx.root_find(
         excess,
-        optx.Bisection(rtol=1e-14, atol=1e-14),
+        optx.Bisection(rtol=1e-14, atol=1e-14, flip=True),
         jnp.asarray(0.5 * (lower + upper)),
         args=log_e,
         options=dict(lower=lower, upper=upper),

@@ -38,6 +38,7 @@ from .._solve.options import (
     with_defaults,
 )
 from .._status import Status
+from .._stored import stored_jit
 from .._xla_log import quietly_compiled
 from .forward_jacobian import value_and_jacobian, with_forward_jacobian
 from .parameters import default_free, law_with, to_unbounded
@@ -1193,7 +1194,7 @@ def _evaluated(law, theta, data, m, g, options):
 
 
 # an integrated law's program at XLA's defaults, the others compiled quickly (`_compiling`)
-_evaluated_compiled = {True: eqx.filter_jit(_evaluated), False: quick_jit(_evaluated)}
+_evaluated_compiled = {True: stored_jit(_evaluated), False: quick_jit(_evaluated)}
 
 
 def _integrates(impact: ImpactOptions) -> bool:

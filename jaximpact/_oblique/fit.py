@@ -283,20 +283,30 @@ def _evaluate(problem, thetas):
     `_evaluated` row by row, so that a fit compiles its solves once (a batched program of
     its own, values only, compiled for 30 s more), the rows after the first in threads,
     one per core."""
-    x64 = jnp.result_type(float) == jnp.float64  # the caller's, for the threads
 
     def one(theta):
-        with jax.enable_x64(x64):
-            r, _, result = _evaluated(problem, jnp.asarray(theta))
+        r, _, result = _evaluated(problem, jnp.asarray(theta))
         return np.asarray(r), bool(np.all(np.asarray(result.status) == Status.separated))
 
-    thetas = np.asarray(thetas, dtype=float)
-    done = [one(thetas[0])]  # compiles `_evaluated` once, before the threads
-    if len(thetas) > 1:
-        workers = min(len(thetas) - 1, os.cpu_count() or 1)
-        with concurrent.futures.ThreadPoolExecutor(max_workers=workers) as pool:
-            done += list(pool.map(one, thetas[1:]))
+    done = _in_threads(one, list(np.asarray(thetas, dtype=float)))
     return np.stack([r for r, _ in done]), np.array([ok for _, ok in done])
+
+
+def _in_threads(fun, items) -> list:
+    """`[fun(x) for x in items]`, the first in this thread (it compiles what the others
+    run), the others in threads, one per core, each with the caller's float width."""
+    x64 = jnp.result_type(float) == jnp.float64
+
+    def one(item):
+        with jax.enable_x64(x64):
+            return fun(item)
+
+    done = [one(items[0])]
+    if len(items) > 1:
+        workers = min(len(items) - 1, os.cpu_count() or 1)
+        with concurrent.futures.ThreadPoolExecutor(max_workers=workers) as pool:
+            done += list(pool.map(one, items[1:]))
+    return done
 
 
 @quick_jit
@@ -585,7 +595,7 @@ def fit_oblique(
         grid_losses = np.sum(_chi2_parts(problem, points), axis=-1)
         minima = [i for i in _local_minima(grid_losses, shape) if np.any(points[i] != theta0)]
         starts += [points[i] for i in minima[: max(max_starts - 1, 0)]]
-    found = [_refine(problem, np.asarray(s), max_steps, tol) for s in starts]
+    found = _in_threads(lambda s: _refine(problem, np.asarray(s), max_steps, tol), starts)
     values = np.stack([np.asarray(v) for v, _, _, _ in found])
     finals = np.array([_final_chi2(r, result) for _, _, _, (r, _, result) in found])
     pick = int(np.argmin(finals))
