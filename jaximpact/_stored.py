@@ -423,11 +423,18 @@ def _lapack_checks() -> list:
 
 
 def _write(path: Path, data: bytes) -> None:
-    """Write `data` to `path` whole or not at all (a temporary file renamed)."""
+    """Write `data` to `path` whole or not at all (a temporary file renamed; removed if
+    the write stops, Ctrl-C included)."""
     try:
         handle, temporary = tempfile.mkstemp(dir=path.parent, suffix=".part")
+    except OSError:
+        return  # an unwritable cache is not worth failing for
+    try:
         with os.fdopen(handle, "wb") as file:
             file.write(data)
         os.replace(temporary, path)
     except OSError:
-        pass  # an unwritable cache is not worth failing for
+        pass
+    finally:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
