@@ -105,8 +105,7 @@ def _run_simulate(args):
 
 def _head(law) -> list[str]:
     """The law with its equation, and its parameters with their units."""
-    from .._fit.calibrate import law_units
-    from .._fit.report import law_title
+    from .._laws.listing import law_title, law_units
 
     units = law_units(law)
     params = ", ".join(

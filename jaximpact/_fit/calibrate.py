@@ -18,13 +18,13 @@ from .._compiling import quick_jit
 from .._curves.similarity import beta_for_restitution, curve_values
 from .._curves.store import curves_for
 from .._format import (
-    concrete_units,
     format_fields,
     format_number,
     format_value,
     jsonable,
 )
 from .._laws import AbstractLaw, damping_parameter, shape_of, stiffness_parameter
+from .._laws.listing import law_units
 from .._least_squares import LeastSquares, levenberg_marquardt
 from .._solve.impact import ImpactOptions, solve_impact
 from .._solve.options import (
@@ -437,19 +437,6 @@ def _target_text(target, unit: str) -> str:
     if not is_traced(target) and not np.any(np.isfinite(np.asarray(target))):
         return "not measured"
     return f"target {format_value(target, unit)}"
-
-
-def law_units(law) -> dict[str, str]:
-    """The units of `law`'s parameters (`{"c": "N/m^1.5", ...}`; "" for a pure number);
-    a user's own law has none to give."""
-    spec = law.spec
-    if spec is None:
-        return {}
-    try:
-        units = concrete_units(spec, law.parameters)
-    except Exception:  # an exponent that is traced: the family's own spelling (`N/m^n`)
-        units = {k: spec.units.get(k, "") for k in spec.parameters}
-    return {k: "" if u == "-" else u for k, u in units.items()}
 
 
 def _as_rows(name, value, rows, allow_missing=False):

@@ -14,24 +14,13 @@ from .._format import (
     terminal_width,
     wrap_text,
 )
-from .calibrate import goodness_text, law_units
+from .._laws.listing import law_title, law_units
+from .calibrate import goodness_text
 
 # the column of the labels of `fit_text`'s lines, and the width it wraps them to
 _LABEL, _WIDTH = 11, 100
 # the narrowest a ranking's table is wrapped to
 _RANKING_WIDTH = 120
-
-
-def law_title(name: str) -> str:
-    """`hertz_rate (eq. 14: F = c x^1.5 + b1 x^0.5 v)`: the law `name` with its equation and
-    formula (a user's law, FILE.py:NAME, by its name alone)."""
-    from .._laws import LAWS
-
-    spec = LAWS.get(name)
-    if spec is None:
-        return name
-    eq = f"eq. {spec.equation}: " if spec.equation != "-" else ""
-    return f"{name} ({eq}F = {spec.formula})"
 
 
 def fit_record(name: str, fit, order=None) -> dict:

@@ -2,18 +2,37 @@
 Parquet file of bodies (or a script's chunks), checks every row once, computes the chunks
 through `_batch` on one process or several, and joins the parts into the output (`job`:
 `plan`, `check`, `compute`, `join`); `impact_batch` takes arrays to `_batch` and chunks to
-a file. Imports `_batch`, `_laws` and the leaf helpers."""
+a file. Imports `_batch`, `_laws` and the leaf helpers.
 
-from .job import (
-    OUT_SUFFIXES as OUT_SUFFIXES,
-    BatchFile as BatchFile,
-    Job as Job,
-    batch_file as batch_file,
-    check as check,
-    check_output_file as check_output_file,
-    compute as compute,
-    join as join,
-    plan as plan,
-)
-from .parts import OUTPUTS as OUTPUTS
-from .stream import impact_batch as impact_batch
+The names load with their module on first use (PEP 562), so that reading a law from a
+file (`file_law`: `simulate`, `calibrate`, `export`) does not import the batch and diffrax."""
+
+import importlib as _importlib
+
+_NAMES = {
+    **dict.fromkeys(
+        (
+            "OUT_SUFFIXES",
+            "BatchFile",
+            "Job",
+            "batch_file",
+            "check",
+            "check_output_file",
+            "compute",
+            "join",
+            "plan",
+        ),
+        "job",
+    ),
+    "OUTPUTS": "parts",
+    "impact_batch": "stream",
+}
+__all__ = sorted(_NAMES)
+
+
+def __getattr__(name):
+    if name not in _NAMES:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(_importlib.import_module(f".{_NAMES[name]}", __name__), name)
+    globals()[name] = value  # later look-ups skip this function
+    return value

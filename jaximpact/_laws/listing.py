@@ -1,6 +1,7 @@
 """The law table as `jaximpact laws` lists it: each law's row as plain data (`law_rows`)
 and as a table fitted to a width (`laws_text`); `params_text` writes a row's parameters
-with their units and defaults (the tangential laws' listing, `_oblique.report`, too)."""
+with their units and defaults (the tangential laws' listing, `_oblique.report`, too);
+`law_title` and `law_units` name one law and its units for a report's head."""
 
 import textwrap
 
@@ -68,3 +69,28 @@ def laws_text(rows, width: int) -> list[str]:
         "Estonian Acad. Sci. Eng. 13 (2007)."
     )
     return [*textwrap.wrap(intro, width), "", *lines]
+
+
+def law_title(name: str) -> str:
+    """`hertz_rate (eq. 14: F = c x^1.5 + b1 x^0.5 v)`: the law `name` with its equation and
+    formula (a user's law, FILE.py:NAME, by its name alone)."""
+    from .table import LAWS
+
+    spec = LAWS.get(name)
+    if spec is None:
+        return name
+    eq = f"eq. {spec.equation}: " if spec.equation != "-" else ""
+    return f"{name} ({eq}F = {spec.formula})"
+
+
+def law_units(law) -> dict[str, str]:
+    """The units of `law`'s parameters (`{"c": "N/m^1.5", ...}`; "" for a pure number);
+    a user's own law has none to give."""
+    spec = law.spec
+    if spec is None:
+        return {}
+    try:
+        units = concrete_units(spec, law.parameters)
+    except Exception:  # an exponent that is traced: the family's own spelling (`N/m^n`)
+        units = {k: spec.units.get(k, "") for k in spec.parameters}
+    return {k: "" if u == "-" else u for k, u in units.items()}

@@ -1,25 +1,40 @@
 """Oblique impacts: tangential contact laws limited by Coulomb friction, a sphere's oblique
 impact on a plane with its normal law's contact and the sphere's spin, the rigid-body
-impulse theory, and fitting the tangential law to measured rebounds (issue 27)."""
+impulse theory, and fitting the tangential law to measured rebounds (issue 27).
 
-from .batch import oblique_impact_batch as oblique_impact_batch
-from .fit import ObliqueFit as ObliqueFit, fit_oblique as fit_oblique
-from .impact import (
-    ObliqueOptions as ObliqueOptions,
-    incidence as incidence,
-    oblique_impact as oblique_impact,
-    two_spheres as two_spheres,
-)
-from .results import ObliqueResult as ObliqueResult
-from .tangential import (
-    TANGENTIAL_LAW_NAMES as TANGENTIAL_LAW_NAMES,
-    TANGENTIAL_LAWS as TANGENTIAL_LAWS,
-    AbstractTangentialLaw as AbstractTangentialLaw,
-    LinearHistoryLaw as LinearHistoryLaw,
-    MindlinLaw as MindlinLaw,
-    TangentialSpec as TangentialSpec,
-    shear_modulus_star as shear_modulus_star,
-    tangential_law as tangential_law,
-)
-from .theory import rigid_oblique as rigid_oblique
-from .track import TrackRebounds as TrackRebounds, track_rebounds as track_rebounds
+The names load with their module on first use (PEP 562), so that a module that needs one
+table (`tangential`: the command line's parser, the engines' registry) does not import
+diffrax with the integrated impact and its batch."""
+
+import importlib as _importlib
+
+_NAMES = {
+    "oblique_impact_batch": "batch",
+    "ObliqueFit": "fit",
+    "fit_oblique": "fit",
+    "ObliqueOptions": "impact",
+    "incidence": "impact",
+    "oblique_impact": "impact",
+    "two_spheres": "impact",
+    "ObliqueResult": "results",
+    "TANGENTIAL_LAW_NAMES": "tangential",
+    "TANGENTIAL_LAWS": "tangential",
+    "AbstractTangentialLaw": "tangential",
+    "LinearHistoryLaw": "tangential",
+    "MindlinLaw": "tangential",
+    "TangentialSpec": "tangential",
+    "shear_modulus_star": "tangential",
+    "tangential_law": "tangential",
+    "rigid_oblique": "theory",
+    "TrackRebounds": "track",
+    "track_rebounds": "track",
+}
+__all__ = sorted(_NAMES)
+
+
+def __getattr__(name):
+    if name not in _NAMES:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(_importlib.import_module(f".{_NAMES[name]}", __name__), name)
+    globals()[name] = value  # later look-ups skip this function
+    return value

@@ -53,7 +53,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
-from .._solve.grid import _A, _B, _B_ERR, _C, E_FLOOR, GRID_ACCEPT, GRID_RTOL, _combine, _Contact
+from .._solve.grid import E_FLOOR, GRID_ACCEPT, GRID_RTOL, _combine, _Contact, _tableau
 from .._status import Status
 from .._tracing import anchors
 from .dynamics import SLIP, STICK, ObliqueDynamics
@@ -143,10 +143,11 @@ class _Oblique:
         the embedded solution, the least `theta_dot` and normal force at its stages, and
         the least value of the present mode's conditions (`watched`) at its stages inside
         the step (nodes below 1)."""
+        a, b, b_err, c = _tableau()
         k, least, low = self.rhs(s, y, mode, sense, compressing)
         ks = [k]
         dip = jnp.full_like(least, jnp.inf)
-        for row, node in zip(_A, _C, strict=True):
+        for row, node in zip(a, c, strict=True):
             z = y + h * _combine(row, ks)
             k, theta_dot, F = self.rhs(s + node * h, z, mode, sense, compressing)
             ks.append(k)
@@ -154,7 +155,7 @@ class _Oblique:
             low = jnp.minimum(low, F)
             if node < 1.0:
                 dip = jnp.minimum(dip, self.watched(z, mode, sense, compressing))
-        return y + h * _combine(_B, ks), h * _combine(_B_ERR, ks), least, low, dip
+        return y + h * _combine(b, ks), h * _combine(b_err, ks), least, low, dip
 
     def watched(self, y, mode, sense, compressing):
         """The least of the conditions that end the present mode at `y`: the switch

@@ -31,6 +31,7 @@ stuck. A member it did not serve must be recomputed by the event-terminated solv
 (`impact_batch` does so in a second batched pass); its numbers here are not results.
 """
 
+import functools
 import math
 
 import jax
@@ -60,10 +61,12 @@ _ROOT_ITERS = 8  # Newton on one step: the end to 1e-10 of the step
 _PEAK_ITERS = 6  # false position: a peak's force is second order in its place
 
 
+@functools.cache
 def _tableau():
     """The 13 stages of diffrax's `Dopri8` (Prince and Dormand's RK8(7)13M): the rows of
     `a`, the weights of the 8th-order solution and of its difference from the embedded
-    7th-order one, the nodes `c` (the 14th stage only serves diffrax's interpolation)."""
+    7th-order one, the nodes `c` (the 14th stage only serves diffrax's interpolation).
+    Read at the first trace, so that importing this module does not import diffrax."""
     import diffrax as dfx
 
     tab = dfx.Dopri8.tableau
@@ -73,9 +76,6 @@ def _tableau():
     c = tuple(float(q) for q in tab.c[:12])
     assert tab.b_sol[13] == 0 and tab.b_error[13] == 0
     return a, b, b_err, c
-
-
-_A, _B, _B_ERR, _C = _tableau()
 
 
 @jax.custom_jvp
@@ -154,13 +154,14 @@ class _Contact:
     def step(self, s, y, h, compressing):
         """One step of length `h` from `(s, y)`: the 8th-order state, the difference from
         the embedded 7th-order one, and the least `theta_dot` met at its stages."""
+        a, b, b_err, c = _tableau()
         k, least = self.rhs(s, y, compressing)
         ks = [k]
-        for row, node in zip(_A, _C, strict=True):
+        for row, node in zip(a, c, strict=True):
             k, theta_dot = self.rhs(s + node * h, y + h * _combine(row, ks), compressing)
             ks.append(k)
             least = jnp.minimum(least, theta_dot)
-        return y + h * _combine(_B, ks), h * _combine(_B_ERR, ks), least
+        return y + h * _combine(b, ks), h * _combine(b_err, ks), least
 
 
 def _false_position(g, h, g0, g1, start, iters):
