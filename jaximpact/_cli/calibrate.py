@@ -159,8 +159,6 @@ def posterior_options(args) -> dict | None:
     """The checked `--posterior` options (None without `--posterior`), before any fit:
     `posterior`'s `method`, `num_samples` and `prior` ({name: (kind, a, b)}, or None), and
     the random `seed`."""
-    from .._posterior.command import priors_from_words
-
     if args.posterior is None:
         flags = {"--prior": args.prior, "--draws": args.draws != 2000, "--seed": args.seed != 0}
         given = [flag for flag, v in flags.items() if v]
@@ -169,6 +167,8 @@ def posterior_options(args) -> dict | None:
         return None
     if args.draws < 1:
         raise CLIError(f"--draws must be at least 1, got {args.draws}")
+    from .._posterior.command import priors_from_words  # blackjax: only with --posterior
+
     prior = priors_from_words(args.prior)  # checked before any fit
     return dict(method=args.posterior, num_samples=args.draws, seed=args.seed, prior=prior or None)
 
