@@ -98,16 +98,10 @@ def _value(obj, out: list) -> None:
                 raise _NotStorable("an array in a static field")
             _value(value, out)
         out.append("]")
-    elif _is_singleton(obj):
-        out.append(f"singleton:{_from_known_module(type(obj))}")
+    elif (where := _global_name(obj)) is not None:  # equinox's `MISSING`: one a process
+        out.append(f"global:{_from_known_module(type(obj))}:{where[0]}.{where[1]}")
     else:
         raise _NotStorable(f"{type(obj)!r}")
-
-
-def _is_singleton(obj) -> bool:
-    """Whether `obj` is a module-level object of its own class's module (equinox's
-    `MISSING`): one per process, so told apart by its class alone."""
-    return _global_name(obj) is not None
 
 
 def _global_name(obj):
