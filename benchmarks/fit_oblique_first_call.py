@@ -15,22 +15,25 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from _common import load_average, machine, machine_markdown, table, write_report  # noqa: E402
+from _common import (  # noqa: E402
+    OBLIQUE_REBOUNDS,
+    load_average,
+    machine,
+    machine_markdown,
+    table,
+    write_report,
+)
 
-CHILD = """
+CHILD = (
+    """
 import json, math, sys, time
 import jax
 jax.config.update("jax_enable_x64", True)
 import numpy as np
 import jaximpact as ji
-M, R = 2.618e-4, 2.5e-3
-E = 1 / ((1 - 0.23**2) / 3.8e11 + (1 - 0.25**2) / 7.0e10)
-law = ji.law("hunt_crossley", c=4.0 / 3.0 * E * math.sqrt(R), a=0.0)
-truth = ji.tangential_law("mindlin", G_star=1.35e10, mu=0.092)
-v_n, v_t = ji.incidence(3.9, np.deg2rad([5.0, 10.0, 15.0, 20.0, 30.0, 40.0, 50.0, 60.0]))
-made = jax.vmap(lambda a, b: ji.oblique_impact(law, truth, m=M, R=R, v_n=a, v_t=b))(v_n, v_t)
-e_t = np.asarray(made.e_t) + np.random.default_rng(1).normal(0.0, 0.01, 8)
-times = []
+"""
+    + OBLIQUE_REBOUNDS
+    + """times = []
 for _ in range(2):
     start = time.perf_counter()
     fit = ji.fit_oblique(law, truth.replace(mu=0.15), m=M, R=R, v_n=v_n, v_t=v_t, e_t=e_t,
@@ -41,6 +44,7 @@ for _ in range(2):
 print(json.dumps(dict(times=times, iterations=int(fit.iterations),
                       G_star=float(fit.params["G_star"]), mu=float(fit.params["mu"]))))
 """
+)
 
 
 def main():

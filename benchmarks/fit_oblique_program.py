@@ -16,9 +16,17 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from _common import load_average, machine, machine_markdown, table, write_report  # noqa: E402
+from _common import (  # noqa: E402
+    OBLIQUE_REBOUNDS,
+    load_average,
+    machine,
+    machine_markdown,
+    table,
+    write_report,
+)
 
-CHILD = """
+CHILD = (
+    """
 import json, logging, math, re, time
 import jax
 jax.config.update("jax_enable_x64", True)
@@ -31,14 +39,9 @@ class Keep(logging.Handler):
         logged.append(record.getMessage())
 log = logging.getLogger("jax")
 log.addHandler(Keep()); log.setLevel(logging.DEBUG); log.propagate = False
-M, R = 2.618e-4, 2.5e-3
-E = 1 / ((1 - 0.23**2) / 3.8e11 + (1 - 0.25**2) / 7.0e10)
-law = ji.law("hunt_crossley", c=4.0 / 3.0 * E * math.sqrt(R), a=0.0)
-truth = ji.tangential_law("mindlin", G_star=1.35e10, mu=0.092)
-v_n, v_t = ji.incidence(3.9, np.deg2rad([5.0, 10.0, 15.0, 20.0, 30.0, 40.0, 50.0, 60.0]))
-made = jax.vmap(lambda a, b: ji.oblique_impact(law, truth, m=M, R=R, v_n=a, v_t=b))(v_n, v_t)
-e_t = np.asarray(made.e_t) + np.random.default_rng(1).normal(0.0, 0.01, 8)
-logged.clear()
+"""
+    + OBLIQUE_REBOUNDS
+    + """logged.clear()
 wall, cpu = time.perf_counter(), time.process_time()
 fit = ji.fit_oblique(law, truth.replace(mu=0.15), m=M, R=R, v_n=v_n, v_t=v_t, e_t=e_t,
                      sigma_e_t=np.full(8, 0.01), free=("G_star", "mu"), start_scan=0)
@@ -55,6 +58,7 @@ print(json.dumps(dict(wall=wall, cpu=cpu, trace=parts.get("tracing"),
                       compile=parts.get("XLA compilation of"), iterations=int(fit.iterations),
                       G_star=float(fit.params["G_star"]), mu=float(fit.params["mu"]))))
 """
+)
 
 
 def main():

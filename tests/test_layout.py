@@ -15,7 +15,7 @@ PACKAGE = Path(ji.__file__).parent
 RANK = {
     **dict.fromkeys(("_status", "_checks", "_powers", "_progress", "_cache"), 0),
     **dict.fromkeys(("_files", "_interrupt", "_choices", "_xla_log", "_least_squares"), 0),
-    **dict.fromkeys(("_tracing", "_stored"), 0),
+    **dict.fromkeys(("_tracing", "_stored", "_lazy"), 0),
     **dict.fromkeys(("_version", "_plotting", "_format", "_compiling"), 1),
     "_laws": 2,
     **dict.fromkeys(("_curves", "closed_forms"), 3),

@@ -7,7 +7,7 @@ a file. Imports `_batch`, `_laws` and the leaf helpers.
 The names load with their module on first use (PEP 562), so that reading a law from a
 file (`file_law`: `simulate`, `calibrate`, `export`) does not import the batch and diffrax."""
 
-import importlib as _importlib
+from .._lazy import lazy_names
 
 _NAMES = {
     **dict.fromkeys(
@@ -29,10 +29,4 @@ _NAMES = {
 }
 __all__ = sorted(_NAMES)
 
-
-def __getattr__(name):
-    if name not in _NAMES:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(_importlib.import_module(f".{_NAMES[name]}", __name__), name)
-    globals()[name] = value  # later look-ups skip this function
-    return value
+__getattr__ = lazy_names(__name__, _NAMES, globals())

@@ -6,7 +6,7 @@ The names load with their module on first use (PEP 562), so that a module that n
 table (`tangential`: the command line's parser, the engines' registry) does not import
 diffrax with the integrated impact and its batch."""
 
-import importlib as _importlib
+from .._lazy import lazy_names
 
 _NAMES = {
     "oblique_impact_batch": "batch",
@@ -31,10 +31,4 @@ _NAMES = {
 }
 __all__ = sorted(_NAMES)
 
-
-def __getattr__(name):
-    if name not in _NAMES:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(_importlib.import_module(f".{_NAMES[name]}", __name__), name)
-    globals()[name] = value  # later look-ups skip this function
-    return value
+__getattr__ = lazy_names(__name__, _NAMES, globals())
