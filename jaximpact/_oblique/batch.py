@@ -1,9 +1,10 @@
 """A batch of oblique impacts at batch speed: `oblique_impact_batch`, every row on the
 phase-angle grid first (`grid.py`, one batched pass with no event search), then the rows
 the grid did not serve in a second batched pass of `oblique_impact`'s event-terminated
-solve (gathered on the host, in chunks of `CHUNK` rows, the last one padded to a power
-of two, so that a few compiled shapes serve every count and no more than a chunk's
-padding is solved for nothing)."""
+solve (gathered on the host, in chunks of `CHUNK` rows, the last one padded with copies
+of its first row: one compiled shape serves every count; measured, a chunk of 2 rows of
+`linear_history` runs in 5 ms where one of 16 takes 11 ms, but each new shape compiles
+for 12 s)."""
 
 import dataclasses
 
@@ -27,8 +28,7 @@ from .impact import (
 from .results import ObliqueResult
 
 METHODS = ("auto", "integrate")
-# rows per call of the second pass: one compiled shape for every count above it, and the
-# padding of the last chunk below it
+# rows per call of the second pass, the last chunk padded to it: one compiled shape
 CHUNK = 16
 
 
@@ -66,10 +66,6 @@ def batch_options(*, separation: str, contact_point, rtol: float) -> ObliqueOpti
         rest_tol=float(rest_tol),
         lever_share=lever_share(contact_point),
     )
-
-
-def _padded(count: int) -> int:
-    return 1 << max(count - 1, 0).bit_length()
 
 
 def oblique_impact_batch(
@@ -147,7 +143,7 @@ def _second_pass(law, tangential, arrays, left, options) -> dict:
     parts = []
     for start in range(0, left.size, CHUNK):
         rows = left[start : start + CHUNK]
-        pick = np.concatenate([rows, np.full(_padded(rows.size) - rows.size, rows[0])])
+        pick = np.concatenate([rows, np.full(CHUNK - rows.size, rows[0])])
         rows_in = ObliqueInputs(*(jnp.asarray(a[pick]) for a in arrays))
         rest = _integrated(law, tangential, rows_in, options)
         parts.append(
