@@ -91,8 +91,8 @@ def oblique_impact_batch(
     together on the phase-angle grid, the transitions placed on it: `_oblique/grid.py`)
     or `"integrated"` (the rows the grid cannot serve: heavy damping, a force that pulls,
     modes that take turns, transitions closer than a grid step or a pair of them inside
-    one, a state-dependent law, a rescaled history,
-    gravity; and every row with `method="integrate"`). Concrete inputs only (not inside
+    one, a state-dependent law, a rescaled history, gravity; and every row with
+    `method="integrate"`). Concrete inputs only (not inside
     `jit` or `vmap`: it gathers the rows for its second pass on the host); for
     derivatives use `jax.vmap` of `oblique_impact`.
 

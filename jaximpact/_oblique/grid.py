@@ -239,7 +239,7 @@ def grid_oblique(
 ) -> dict:
     """One oblique contact of `inputs` (SI units; no gravity: `inputs.g` is not read) on
     the grid, with `options`' separation and lever arm, from first touch in the tangential
-    `mode` and `sense` (`impact._first_mode`'s). Returns the outgoing `e` (`v_n_out /
+    `mode` and `sense` (`impact._first_touch`'s). Returns the outgoing `e` (`v_n_out /
     v_n`), `V_t` and `W` (the centre's tangential velocity and `R omega` in units of
     `v_n`), `X` (the overlap at the end, units of `x*`), `tau` (the duration, units of
     `t*`), `t_star`, `x_star`, `switches`, `iterations` (steps of the loop), `served` and
@@ -540,7 +540,7 @@ def grid_outcome(law, tangential, m, R, v_n, v_t, omega, inertia, options: Obliq
     # (`MAX_LANDINGS`), held 29 of benchmarks/oblique_batch.py's 1,000 `mindlin` rows
     # that the grid gives within 8e-11 of the scipy oracle with its switches, and 41 rows
     # within 0.1 % of the limit were within 4.3e-11
-    mode, sense, _ = _first_touch(dyn, y0, jnp.asarray(normal.split))
+    mode, sense = _first_touch(dyn, y0, jnp.asarray(normal.split))
     inputs = ObliqueInputs(m, R, v_n, v_t, omega, inertia, 0.0)
     out = grid_oblique(law, tangential, inputs, options, mode=mode, sense=sense)
     outcome = ObliqueOutcome(

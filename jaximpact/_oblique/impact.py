@@ -66,7 +66,7 @@ def lever_share(contact_point) -> float:
 
 
 # the time (units of t*) after first touch at which the first-touch mode is decided
-# (`_first_mode`): limit and trial force grow as powers of the time there
+# (`_first_touch`): limit and trial force grow as powers of the time there
 FIRST_TOUCH = 1e-6
 # how far (in the contact's force units, m v_n^2 / x*, and their rates) a segment may end
 # beyond its tangential condition before it counts as overtaken: the forces near the end
@@ -211,15 +211,8 @@ def _land(setup: "_Setup", masks, tau, y, tau_event, args):
     return y_star + rate * shift, t_star + shift
 
 
-def _first_mode(dyn: ObliqueDynamics, y0, compressing):
-    """The tangential mode at first touch, and its sense (`_first_touch`)."""
-    mode, sense, _ = _first_touch(dyn, y0, compressing)
-    return mode, sense
-
-
 def _first_touch(dyn: ObliqueDynamics, y0, compressing):
-    """The tangential mode at first touch, its sense, and the ratio of the tested force to
-    the limit that decided it (above 1: it slides).
+    """The tangential mode at first touch and its sense.
 
     Limit and trial force both start from their values at first touch (0 for Hertz) and
     grow as powers of the time, which decide: the contact is integrated sticking over a
@@ -248,9 +241,7 @@ def _first_touch(dyn: ObliqueDynamics, y0, compressing):
     holds = dyn_.cap(stuck, compressing) >= jnp.abs(trial)
     sense = jnp.where(trial != 0, -jnp.sign(trial), jnp.sign(u0))
     slides = (u0 != 0) & ~holds
-    cap = dyn_.cap(stuck, compressing)
-    ratio = jnp.abs(trial) / jnp.where(cap > 0, cap, 1.0)
-    return jnp.where(slides, SLIP, STICK).astype(jnp.int32), sense, ratio
+    return jnp.where(slides, SLIP, STICK).astype(jnp.int32), sense
 
 
 class _Setup(NamedTuple):
@@ -422,7 +413,7 @@ def _segments(dyn: ObliqueDynamics, y0, options: ObliqueOptions):
     )
 
     compressing = jnp.asarray(normal.split)
-    mode, sense = _first_mode(dyn, y0, compressing)
+    mode, sense = _first_touch(dyn, y0, compressing)
     # the first FIRST_TOUCH t* in the chosen mode, where the mode's condition starts at 0
     # (both forces vanish at first touch): from there it is strictly positive, and a
     # change of mode within the first step of the solve cannot go unseen (a condition
@@ -655,7 +646,7 @@ def oblique_impact(
     sense of sliding) in segments, each ended by an event with a root finder where the
     spring reaches the limit or the sliding stops (so `e_t` is exact to the tolerance and
     differentiable across the transitions). At first touch the mode follows the limit of
-    the forces' ratio (`_first_mode`; Maw et al.'s `psi_1 < 1` for Mindlin's force
+    the forces' ratio (`_first_touch`; Maw et al.'s `psi_1 < 1` for Mindlin's force
     history). A contact that slides throughout gives the rigid-body impulse result exactly
     where `F_n >= 0` throughout: `v_t_out = v_t - s mu (1 + e) v_n`,
     `R omega_out = R omega + s mu (1 + e) v_n / inertia` (`rigid_oblique`).
