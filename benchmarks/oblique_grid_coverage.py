@@ -38,29 +38,20 @@ DAMPED_HEADER += ["switches not the oracle's"]
 
 
 def _grid(law, tl, options, steps, m, R, v_n, v_t, mu=None):
-    """`grid_oblique`'s dict over rows, at `steps` grid steps (a jitted vmap)."""
+    """`grid_outcome`'s dict over rows, at `steps` grid steps (a jitted vmap); `tl` a
+    tangential law, or with `mu` (one per row) its name and other parameters."""
     import jax
-    import jax.numpy as jnp
 
-    from jaximpact._oblique import grid as G, tangential_law
-    from jaximpact._oblique.impact import ObliqueDynamics, ObliqueInputs, _first_touch
+    from jaximpact._oblique import tangential_law
+    from jaximpact._oblique.grid import grid_outcome
 
     def one(a, b, f):
         spring_law = tl if f is None else tangential_law(tl[0], mu=f, **tl[1])
-        normal = law.dynamics(m=m, v0=a, g=0.0)
-        spring = spring_law.dynamics(m=m, R=R, inertia=0.4, x_star=normal.x_star, v_n=a)
-        y_n0 = normal.y0()
-        dyn = ObliqueDynamics(normal=normal, tangential=spring, size=int(y_n0.shape[0]))
-        y0 = jnp.concatenate([y_n0, jnp.stack([jnp.zeros(()), b / a, 0.0])])
-        mode, sense = _first_touch(dyn, y0, jnp.asarray(normal.split))
-        inputs = ObliqueInputs(m, R, a, b, 0.0, 0.4, 0.0)
-        return G.grid_oblique(law, spring_law, inputs, options, mode=mode, sense=sense, steps=steps)
+        return grid_outcome(law, spring_law, m, R, a, b, 0.0, 0.4, options, steps=steps)[2]
 
     if mu is None:
-        out = jax.jit(jax.vmap(lambda a, b: one(a, b, None)))(v_n, v_t)
-    else:
-        out = jax.jit(jax.vmap(one))(v_n, v_t, mu)
-    return {k: jax.numpy.asarray(v) for k, v in out.items()}
+        return jax.jit(jax.vmap(lambda a, b: one(a, b, None)))(v_n, v_t)
+    return jax.jit(jax.vmap(one))(v_n, v_t, mu)
 
 
 def undamped_rows():

@@ -527,9 +527,12 @@ def solve_oblique_grid(law, tangential, m, R, v_n, v_t, omega, inertia, options:
     return grid_outcome(law, tangential, m, R, v_n, v_t, omega, inertia, options)[:2]
 
 
-def grid_outcome(law, tangential, m, R, v_n, v_t, omega, inertia, options: ObliqueOptions):
+def grid_outcome(
+    law, tangential, m, R, v_n, v_t, omega, inertia, options: ObliqueOptions, *, steps=OBLIQUE_STEPS
+):
     """`solve_oblique_grid`'s `(ObliqueResult, served)` and `grid_oblique`'s dict (what
-    decided `served`: the tests read it)."""
+    decided `served`: the tests and benchmarks/oblique_grid_coverage.py read it), on a
+    grid of `steps` steps."""
     normal = law.dynamics(m=m, v0=v_n, g=0.0)
     spring = tangential.dynamics(m=m, R=R, inertia=inertia, x_star=normal.x_star, v_n=v_n)
     y_n0 = normal.y0()
@@ -542,7 +545,7 @@ def grid_outcome(law, tangential, m, R, v_n, v_t, omega, inertia, options: Obliq
     # within 0.1 % of the limit were within 4.3e-11
     mode, sense = _first_touch(dyn, y0, jnp.asarray(normal.split))
     inputs = ObliqueInputs(m, R, v_n, v_t, omega, inertia, 0.0)
-    out = grid_oblique(law, tangential, inputs, options, mode=mode, sense=sense)
+    out = grid_oblique(law, tangential, inputs, options, mode=mode, sense=sense, steps=steps)
     outcome = ObliqueOutcome(
         v_n_out=out["e"] * v_n,
         v_t_out=out["V_t"] * v_n,
