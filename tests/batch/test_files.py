@@ -443,7 +443,12 @@ def _finish(procs, timeout=400):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("mesh", ["global", "local"])
+@pytest.mark.parametrize(
+    "mesh",
+    # each takes 2 minutes on 2 cores: `local` (each process on its own devices, the
+    # simpler plan) is `very_slow` (run with -m very_slow)
+    ["global", pytest.param("local", marks=pytest.mark.very_slow)],
+)
 def test_two_processes_write_the_file_of_one_bit_for_bit(tmp_path, mesh):
     """Integrated (gravity on some rows) and curves rows under both criteria, 2 processes
     against 1: one program over both processes' devices (`global`, row groups a process

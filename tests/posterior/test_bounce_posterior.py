@@ -164,6 +164,8 @@ def test_cli_fit_posterior_bad_input_is_one_line(capsys, tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.very_slow  # 3 minutes of NUTS (run with -m very_slow); NUTS against an exact
+# posterior stays in the slow group (test_grid_reference.py, test_calibration.py)
 def test_nuts_agrees_with_laplace(golf_fit, golf_post):
     """Near Gaussian here: NUTS's median and 5 / 95 % quantiles within a quarter of a
     posterior standard deviation of Laplace's (Monte Carlo error of a few hundred

@@ -126,6 +126,7 @@ def test_laplace_is_the_fit_and_its_standard_errors(fit, oblique_laplace):
 
 
 @pytest.mark.slow
+@pytest.mark.very_slow  # NUTS through oblique solves: 7.6 minutes (run with -m very_slow)
 def test_nuts_agrees_with_laplace_and_holds_the_truth(oblique_laplace, oblique_nuts):
     """Near-Gaussian (in ln kt, ln mu): the medians agree within 0.25 posterior standard
     deviations (measured: within 0.05), the 90 % intervals of both hold the truth."""
@@ -141,6 +142,7 @@ def test_nuts_agrees_with_laplace_and_holds_the_truth(oblique_laplace, oblique_n
 
 
 @pytest.mark.slow
+@pytest.mark.very_slow  # NUTS through oblique solves: 7.6 minutes (run with -m very_slow)
 def test_bands_at_new_angles_hold_the_noiseless_curves(oblique_nuts):
     bands = oblique_nuts.predict(angle=NEW, max_draws=200)
     _, _, e_t, omega = rebounds(NEW)

@@ -118,8 +118,21 @@ def test_stress_full_float64(name, separation):
         assert summary["fwd_rev_max_separated"] < 1e-6
 
 
+# float32 in CI's slow group: a fractional power (the Lienard variable), a dry force and the
+# closed form; every other law's float32 sweep (about a minute each, 16 minutes in all on 2
+# cores) is `very_slow` (run with -m very_slow): float32 is a property of the solver, and
+# each law's float64 sweep above stays in the slow group
+FLOAT32_IN_CI = ("hertz_rate", "bingham", "kelvin_voigt")
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("name", STRESSED)
+@pytest.mark.parametrize(
+    "name",
+    [
+        pytest.param(name, marks=() if name in FLOAT32_IN_CI else pytest.mark.very_slow)
+        for name in STRESSED
+    ],
+)
 def test_stress_full_float32(name, tmp_path):
     """float32 (x64 off, in a subprocess): no NaN, no lost impact, e to ~1e-5."""
     out = tmp_path / "rows.json"
