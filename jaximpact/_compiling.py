@@ -14,6 +14,15 @@ start to be rounding-sensitive (an over-damped Kelvin-Voigt impact, b 25x critic
 captured at maximum compression: `phases._TURN_NOISE` fixed it). The options travel with
 one top-level program (`jax.jit`'s `compiler_options`, refused on a nested `jit`), never
 the process's `XLA_FLAGS`; other backends ignore an `xla_cpu_` option.
+
+A fit's programs on a closed form or the curves (`brief=True`: each call runs for well
+under a millisecond, a fit makes tens) also skip LLVM's optimisation passes
+(`xla_backend_optimization_level=0`, the test suite's setting): measured, a Bingham
+impact's Jacobian at 6 speeds compiles in 2.5 s instead of 3.6 and runs in 360 us
+instead of 200; a first `compare_laws` over the seed paper's laws on 2 workers took
+16.7-18.5 s instead of 20.7-22.8, with the same fits (benchmarks/compare_laws_split.md).
+`fit_oblique`'s program, which runs its grid of starts, keeps them: without, its second
+call took 23.5 s instead of 8.9 and its first no less.
 """
 
 import functools
@@ -22,26 +31,30 @@ import threading
 from ._stored import stored_jit
 
 QUICK_COMPILE = {"xla_cpu_use_fusion_emitters": False}
+# and for a program whose calls are brief: no LLVM optimisation passes
+BRIEF_COMPILE = {**QUICK_COMPILE, "xla_backend_optimization_level": 0}
 
 
 @functools.cache
-def quick_options() -> dict:
-    """`QUICK_COMPILE` where this JAX's XLA takes it (tried once on a one-line program),
-    else `{}`: a version of XLA without the option compiles at its defaults, not fails."""
+def quick_options(brief: bool = False) -> dict:
+    """`QUICK_COMPILE` (with `brief`, `BRIEF_COMPILE`) where this JAX's XLA takes it
+    (tried once on a one-line program), else `{}`: a version of XLA without the options
+    compiles at its defaults, not fails."""
     import jax
 
+    options = BRIEF_COMPILE if brief else QUICK_COMPILE
     try:
-        jax.jit(lambda x: x + 1, compiler_options=QUICK_COMPILE).lower(1.0).compile()
+        jax.jit(lambda x: x + 1, compiler_options=options).lower(1.0).compile()
     except Exception:  # an unknown option: XLA's own error type varies by version
         return {}
-    return QUICK_COMPILE
+    return options
 
 
-def quick_jit(fun):
-    """`eqx.filter_jit(fun)` compiled with `quick_options()`, for a top-level program that
-    runs for milliseconds, where compiling is the wait; kept on disk as traced where JAX's
-    persistent cache is on (`_stored`). Made at the first call, so that importing the
-    library compiles nothing."""
+def quick_jit(fun, *, brief: bool = False):
+    """`eqx.filter_jit(fun)` compiled with `quick_options(brief)`, for a top-level program
+    that runs for milliseconds (`brief`: well under one), where compiling is the wait;
+    kept on disk as traced where JAX's persistent cache is on (`_stored`). Made at the
+    first call, so that importing the library compiles nothing."""
     lock, made = threading.Lock(), []
 
     @functools.wraps(fun)
@@ -49,7 +62,7 @@ def quick_jit(fun):
         if not made:
             with lock:
                 if not made:
-                    made.append(stored_jit(fun, compiler_options=quick_options()))
+                    made.append(stored_jit(fun, compiler_options=quick_options(brief)))
         return made[0](*args, **kwargs)
 
     return call

@@ -15,6 +15,7 @@ from jaxtyping import Array
 
 from .._checks import MemberChecks, check_scale, is_traced
 from .._compiling import quick_jit
+from .._curves.gravity import WithGravity
 from .._curves.similarity import beta_for_restitution, curve_values
 from .._curves.store import curves_for
 from .._format import (
@@ -1180,23 +1181,33 @@ def _evaluated(law, theta, data, m, g, options):
     return r, predictions, jacobian
 
 
-# an integrated law's program at XLA's defaults, the others compiled quickly (`_compiling`)
-_evaluated_compiled = {True: stored_jit(_evaluated), False: quick_jit(_evaluated)}
+# an integrated law's program at XLA's defaults; the others compiled quickly, and briefly
+# where they integrate nothing (`_compiling`)
+_evaluated_compiled = {
+    "integrated": stored_jit(_evaluated),
+    "quick": quick_jit(_evaluated),
+    "brief": quick_jit(_evaluated, brief=True),
+}
 
 
-def _integrates(impact: ImpactOptions) -> bool:
-    """Whether a fit's solves are all integrated: neither a closed form nor the curves (a
-    two-group table, which integrates only the impacts that leave it, compiles quickly too:
-    `bingham_modified` 12.5 -> 9.8 CPU s, each fit 2 ms slower)."""
-    return not impact.closed_form and impact.similarity is None
+def _program(impact: ImpactOptions) -> str:
+    """Which of `_evaluated_compiled` serves a fit's solves: `"integrated"` where they are
+    all integrated, `"quick"` for a two-group table that integrates the impacts outside it
+    (compiled quickly: `bingham_modified` 12.5 -> 9.8 CPU s, each fit 2 ms slower),
+    `"brief"` for a closed form, the curves or a table alone."""
+    if not impact.closed_form and impact.similarity is None:
+        return "integrated"
+    if isinstance(impact.similarity, WithGravity) and impact.integrate_outside:
+        return "quick"
+    return "brief"
 
 
-_recorded_compiled = quick_jit(_recorded)
+_recorded_compiled = quick_jit(_recorded, brief=True)
 # the largest step of a parameter (a logarithm, or a logit for `e_nominal`) in one iteration,
 # a factor e^2 = 7.4: a longer one from a far start can saturate the logit, where the loss is
 # flat and the fit stops (Lankarani-Nikravesh from e_nominal = 0.08 went to 1)
 _MAX_STEP = 2.0
-_start_compiled = quick_jit(_start_on_curves)
+_start_compiled = quick_jit(_start_on_curves, brief=True)
 
 
 def _fit_on_host(law, data, m, g, target_tol, options):
@@ -1210,10 +1221,23 @@ def _fit_on_host(law, data, m, g, target_tol, options):
         )
     theta0 = np.stack([np.asarray(to_unbounded(k, law.parameters[k])) for k in options.free])
 
-    evaluated = _evaluated_compiled[_integrates(options.impact)]
+    # a two-group table's program first without the integration of the impacts outside
+    # it, which is compiled (about 8 s of a 10 s first fit) only when some impact is
+    table_first = isinstance(options.impact.similarity, WithGravity)
+    table_only = dataclasses.replace(
+        options, impact=dataclasses.replace(options.impact, integrate_outside=False)
+    )
 
     def evaluate(theta):
-        r, predictions, jacobian = evaluated(law, jnp.asarray(theta), data, m, g, options)
+        theta = jnp.asarray(theta)
+        if table_first:
+            r, predictions, jacobian = _evaluated_compiled["brief"](
+                law, theta, data, m, g, table_only
+            )
+            if not np.any(np.asarray(predictions[2]) == Status.failed):
+                return np.asarray(r), np.asarray(jacobian), predictions
+        evaluated = _evaluated_compiled[_program(options.impact)]
+        r, predictions, jacobian = evaluated(law, theta, data, m, g, options)
         return np.asarray(r), np.asarray(jacobian), predictions
 
     exact = _solved_by_start(law, options, v0.shape[0])

@@ -68,6 +68,13 @@ def starting_law(name: str, *, m: float, v0: float, e: float, T: float | None, *
             f"T = {T:g} s at v0 = {v0:g} m/s and m = {m:g} kg asks for a stiffness outside "
             "float64's range: check the units (s, m/s, kg)"
         ) from None
+    # with a dashpot and a dry force, each takes half the energy lost, not all of it (which
+    # started Bingham-modified at e = 0.31 at the slowest of speeds measured at e = 0.9:
+    # outside its table, so a first fit compiled the integration too)
+    share = 0.5 if "P" in spec.parameters and {"b", "b1"} & set(spec.parameters) else 1.0
+    if share < 1.0:
+        log_e = 0.5 * math.log(1.0 - share * max(1.0 - e**2, 1e-6))
+        damping *= -log_e / math.sqrt(math.pi**2 + log_e**2) / max(zeta, 1e-12)
     params = {"c": c, "n": n, "p": p}
     for key in spec.parameters:
         if key in ("b", "b1"):
@@ -79,7 +86,7 @@ def starting_law(name: str, *, m: float, v0: float, e: float, T: float | None, *
         elif key == "m_eff":  # the laws whose damping is set for a mass
             params[key] = m
         elif key == "P":
-            energy = 0.5 * m * v0**2 * max(1.0 - e**2, 1e-3)
+            energy = 0.5 * m * v0**2 * max(1.0 - e**2, 1e-3) * share
             params[key] = energy / (e * x_star) / (2.0 if _dry_both_ways(spec, v0) else 1.0)
         elif key == "e_nominal":
             params[key] = min(max(e, 0.05), 0.999)

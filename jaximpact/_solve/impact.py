@@ -197,7 +197,9 @@ def gravity_impact(dynamics, m, v0, g, options: ImpactOptions):
     """One contact from a two-group table (`_curves.gravity`: gravity, or a dry force in
     both phases) where `(beta, gamma)` (or `(beta, pi)`) lies in it, else integrated with
     `options` (a `lax.cond`; under `vmap` both run, and the integration skips the members
-    the table serves, so a batch pays for the solver only where some member is outside).
+    the table serves, so a batch pays for the solver only where some member is outside;
+    with `options.integrate_outside` False those members are NaN with the status
+    `failed`, and nothing is integrated).
     Returns the `ImpactResult` (path `"similarity"`) and the penetration at separation (m)."""
     from .phases import integrated_contact
 
@@ -219,6 +221,12 @@ def gravity_impact(dynamics, m, v0, g, options: ImpactOptions):
 
     def table(_):
         return same_types(fields), jnp.asarray(x_end, float)
+
+    if not options.integrate_outside:  # the caller integrates those members itself
+        values, x = table(None)
+        outside = {"status": Status.failed, "num_steps": 0}
+        values = {k: jnp.where(in_range, v, outside.get(k, jnp.nan)) for k, v in values.items()}
+        return ImpactResult(**values, path="similarity"), jnp.where(in_range, x, jnp.nan)
 
     def integrated(_):
         result, x = integrated_contact(dynamics, options, m=m, v0=v0, g=g, hold=in_range)

@@ -212,3 +212,47 @@ def test_shipped_file():
         assert table.tail.max() < 2e-9
         assert np.all(table.gamma_max <= gravity.GAMMA_FRACTION * table.capture + 1e-15)
     assert gravity.SHIPPED_DRY_FILE.stat().st_size < 2e6
+
+
+def _fit_programs(monkeypatch):
+    """The `integrate_outside` of each call of a host fit's program on a table path."""
+    from jaximpact._fit import calibrate as fitting
+
+    calls = []
+    for kind, program in list(fitting._evaluated_compiled.items()):
+
+        def counted(law, theta, data, m, g, options, program=program):
+            calls.append(options.impact.integrate_outside)
+            return program(law, theta, data, m, g, options)
+
+        monkeypatch.setitem(fitting._evaluated_compiled, kind, counted)
+    return calls
+
+
+def test_a_fit_inside_the_table_compiles_no_integration(monkeypatch):
+    """Every impact of a fit in the table: its one program reads the table alone (the
+    integration of the impacts outside it, 8 of a first fit's 10 s, is not compiled)."""
+    truth = ji.law("bingham_modified", c=2e6, b1=200.0, P=400.0)
+    v0 = np.array([1.0, 1.8, 2.5, 3.5])
+    e = [float(ji.impact(truth, m=1.0, v0=v).e) for v in v0]
+    calls = _fit_programs(monkeypatch)
+    start = ji.law("bingham_modified", c=2e6, b1=150.0, P=300.0)
+    fit = ji.calibrate(start, m=1.0, v0=v0, e=e, free=("b1", "P"), optimizer="lm")
+    assert calls and not any(calls)
+    assert float(fit.params["P"]) == pytest.approx(400.0, rel=1e-6)
+
+
+@pytest.mark.slow  # compiles the integration: 10 s
+def test_a_fit_from_outside_the_table_integrates_there(monkeypatch):
+    """A start that holds the slowest body (stuck: outside the table): that evaluation is
+    made again with the integration, and the fit still recovers the law."""
+    truth = ji.law("bingham_modified", c=2e6, b1=200.0, P=400.0)
+    v0 = np.array([1.0, 1.8, 2.5, 3.5])
+    e = [float(ji.impact(truth, m=1.0, v0=v).e) for v in v0]
+    start = ji.law("bingham_modified", c=2e6, b1=200.0, P=1500.0)
+    assert ji.impact(start, m=1.0, v0=1.0, throw=False).path == "integrated"
+    calls = _fit_programs(monkeypatch)
+    fit = ji.calibrate(start, m=1.0, v0=v0, e=e, free=("b1", "P"), optimizer="lm")
+    assert calls[:2] == [False, True]
+    assert float(fit.params["b1"]) == pytest.approx(200.0, rel=1e-6)
+    assert float(fit.params["P"]) == pytest.approx(400.0, rel=1e-6)
