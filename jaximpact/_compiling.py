@@ -66,3 +66,13 @@ def quick_jit(fun, *, brief: bool = False):
         return made[0](*args, **kwargs)
 
     return call
+
+
+def solve_jit(fun):
+    """`stored_jit(fun)` for a solve that runs for milliseconds when called on its own (an
+    eager `impact`, `bounce` or `oblique_impact`): such a call compiles with
+    `quick_options()`; inside a transform or a `jit` the outer program's options hold.
+    Measured on the command line, cold (benchmarks/answer_times.md): `simulate` 2.6-2.8 ->
+    1.9 s, `export lammps --wall` 7.9-8.3 -> 6.8 s, with `--tangential mindlin` 24.7-25.0
+    -> 20.7 s."""
+    return stored_jit(fun, eager_options=quick_options)

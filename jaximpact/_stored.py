@@ -258,11 +258,16 @@ def _assemble(program: _Program, arrays):
     return program.out_tree.unflatten(leaves)
 
 
-def stored_jit(fun, **jit_options):
+def stored_jit(fun, *, eager_options=None, **jit_options):
     """`eqx.filter_jit(fun, **jit_options)`, kept on disk as traced where JAX's persistent
     cache is on (this module's docstring says when). The same values, bitwise: the same
-    StableHLO, compiled with the same options."""
+    StableHLO, compiled with the same options.
+
+    `eager_options`: None, or a function of no arguments giving the compiler's options
+    (a dict, `{}` for none) of a call on its own, with no transform or `jit` around it;
+    inside one the outer program's options hold (a nested `jit` may not set them)."""
     plain = eqx.filter_jit(fun, **jit_options)
+    eager_plain = []  # made at the first call on its own
     programs: dict[str, _Program | None] = {}
     lock = threading.Lock()
     try:  # only this package's own top-level functions: their source is in the key
@@ -273,24 +278,29 @@ def stored_jit(fun, **jit_options):
 
     @functools.wraps(fun)
     def call(*args, **kwargs):
-        folder = _folder() if storable else None
-        if folder is None:
-            return plain(*args, **kwargs)
         leaves, treedef = jax.tree_util.tree_flatten((args, kwargs))
         arrays = [x for x in leaves if eqx.is_array(x)]
-        if any(isinstance(x, jax.core.Tracer) for x in arrays):
+        if any(isinstance(x, jax.core.Tracer) for x in arrays) or not _on_its_own():
             return plain(*args, **kwargs)
+        options = _eager_options(jit_options, eager_options)
+        folder = _folder() if storable else None
+        if folder is None:
+            if not eager_plain:
+                with lock:
+                    if not eager_plain:
+                        eager_plain.append(eqx.filter_jit(fun, **options))
+            return eager_plain[0](*args, **kwargs)
         try:
-            key = _key(name, jit_options, leaves, treedef)
+            key = _key(name, options, leaves, treedef)
         except _NotStorable:
             return plain(*args, **kwargs)
         program = programs.get(key)
         if program is None and key not in programs:
             with lock:
                 if key not in programs:
-                    found, program = _load(folder, key, jit_options)
+                    found, program = _load(folder, key, options)
                     if not found:
-                        program = _trace(fun, folder, key, jit_options, leaves, treedef)
+                        program = _trace(fun, folder, key, options, leaves, treedef)
                     programs[key] = program
                 program = programs[key]
         if program is None:
@@ -298,6 +308,22 @@ def stored_jit(fun, **jit_options):
         return _assemble(program, program.call(*arrays))
 
     return call
+
+
+def _on_its_own() -> bool:
+    """Whether no trace is under way around this call (JAX's own test, where this
+    version has it; else False: the outer program's options, as inside a transform)."""
+    try:
+        from jax._src.core import trace_state_clean
+    except ImportError:
+        return False
+    return bool(trace_state_clean())
+
+
+def _eager_options(jit_options: dict, eager_options) -> dict:
+    """`jit_options` with `eager_options()` as the compiler's options, where given."""
+    compiler = eager_options() if eager_options is not None else {}
+    return {**jit_options, "compiler_options": compiler} if compiler else jit_options
 
 
 def _array_text(leaf) -> str:

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import jaximpact as ji
-from jaximpact import _stored
+from jaximpact import _compiling, _stored
 
 TRACES = []
 
@@ -145,6 +145,30 @@ def test_without_the_cache_or_under_a_transform_nothing_is_stored(folder, monkey
     monkeypatch.setattr(_stored, "_folder", lambda: None)  # JAX's cache off
     stored(law, jnp.ones(2), scale=1.0, name="a")
     assert not folder.exists() or not list(folder.iterdir())
+
+
+def test_a_call_on_its_own_takes_its_options_and_under_a_jit_the_jits(folder):
+    """`eager_options` serve a call with no trace around it (its key holds them); a call
+    inside a `jit` that closes over concrete arrays passes none (JAX refuses options on a
+    nested `jit`): the same values. The library's solves take the quick options so."""
+    asked = []
+
+    def quick():
+        asked.append(1)
+        return _compiling.quick_options()
+
+    _solve_like.__module__ = "jaximpact._stored_test_fixture"
+    stored = _stored.stored_jit(_solve_like, eager_options=quick)
+    law = ji.law("hunt_crossley", c=2e6, a=0.1)
+    x = jnp.ones(2)
+    alone = stored(law, x, scale=1.0, name="a")["y"]
+    inside = jax.jit(lambda: stored(law, x, scale=1.0, name="a")["y"])()
+    assert len(asked) == 1
+    np.testing.assert_array_equal(np.asarray(alone), np.asarray(inside))
+    hertz = ji.law("hertz_rate", c=2e6, b1=800.0)
+    eager = float(ji.impact(hertz, m=1.0, v0=2.5, method="integrate").e)
+    jitted = float(jax.jit(lambda: ji.impact(hertz, m=1.0, v0=2.5, method="integrate").e)())
+    assert jitted == pytest.approx(eager, rel=1e-12)
 
 
 @pytest.mark.slow

@@ -16,6 +16,7 @@ import numpy as np
 from jaxtyping import ArrayLike
 
 from .._checks import MemberChecks, is_traced
+from .._compiling import solve_jit
 from .._laws import AbstractLaw
 from .._solve.adjoint import (
     auto_adjoint,
@@ -28,7 +29,6 @@ from .._solve.options import CUSTOM_RTOL, DEFAULT_RTOL
 from .._solve.phases import solve_broke
 from .._solve.precision import resolvable_tolerances
 from .._status import Status
-from .._stored import stored_jit
 from .._tracing import anchors
 from .dynamics import SLIP, STICK, ObliqueDynamics
 from .results import _NOT_RESULTS, ObliqueResult
@@ -471,7 +471,7 @@ def _safe_angle(t, n):
     return jnp.where(zero, 0.0, jnp.arctan2(jnp.where(zero, 1.0, t), jnp.where(zero, 1.0, n)))
 
 
-@stored_jit
+@solve_jit
 def solve_oblique(law, tangential, inputs: ObliqueInputs, options: ObliqueOptions):
     """The compiled part of `oblique_impact` (no input checks): the `ObliqueResult` of
     `inputs` (SI units)."""

@@ -24,10 +24,10 @@ import numpy as np
 from jaxtyping import Array
 
 from .._checks import MemberChecks, is_traced
+from .._compiling import solve_jit
 from .._format import format_fields, format_value, jsonable
 from .._laws import AbstractLaw
 from .._status import Status
-from .._stored import stored_jit
 from .adjoint import auto_adjoint, reverse_only, through_forward_jacobian
 from .flight import Flight
 from .impact import SEPARATIONS, ImpactOptions, gravity_impact
@@ -411,7 +411,7 @@ _PER_CONTACT = (
 )
 
 
-@stored_jit
+@solve_jit
 def _histories(result: BounceResult, ts):
     records, flight0, carry = chain(
         result.law,
@@ -462,7 +462,7 @@ def trajectory_from_records(records, flight0, carry, ts, m, g, drag):
     return height, velocity, force
 
 
-@stored_jit
+@solve_jit
 def solve_bounce(law, m, g, drag, start, t_end, min_flight, options: BounceOptions):
     records, flight0, carry = chain(law, m, g, drag, start, t_end, min_flight, None, options)
     valid = records["valid"]

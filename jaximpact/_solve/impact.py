@@ -12,11 +12,11 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._checks import MemberChecks, check_scale, is_traced
+from .._compiling import solve_jit
 from .._curves.gravity import WithGravity, gravity_fields
 from .._curves.similarity import similarity_fields
 from .._laws import AbstractLaw
 from .._status import Status
-from .._stored import stored_jit
 from .options import (
     SEPARATIONS as SEPARATIONS,
     ImpactOptions as ImpactOptions,
@@ -33,7 +33,7 @@ from .options import (
 from .results import ImpactResult
 
 
-@stored_jit
+@solve_jit
 def solve_impact(law, m, v0, g, ts, options: ImpactOptions) -> ImpactResult:
     """The compiled part of `impact`, cached per law structure and options; no input
     checks (callers inside the library that have validated their inputs use it)."""
