@@ -17,8 +17,12 @@ converged `e` and `T` under each separation criterion, naming the one nearest to
 formula really yields against the one it was asked for.
 """
 
+import concurrent.futures
+import os
 from pathlib import Path
 
+import jax
+import jax.numpy as jnp
 import numpy as np
 
 from .._files import write_text
@@ -127,25 +131,23 @@ def reproduce_paper(
     out_dir.mkdir(parents=True, exist_ok=True)
     rows, files = [], []
     tasks = len(cases) + (only is None)
+    x64 = jnp.result_type(float) == jnp.float64  # JAX's config contexts are per thread
+
+    def computed(case):
+        with jax.enable_x64(x64):
+            if case in LOOPS:
+                return _loop_row(case, with_history=figures)
+            return _bounce_row(case)
+
+    # the cases' impacts in threads, one per core (a first run is mostly compiling, which
+    # XLA does outside Python's lock); the figures drawn here, in the cases' order
+    pool = concurrent.futures.ThreadPoolExecutor(max_workers=os.cpu_count() or 1)
     with metered(progress, tasks, "paper") as bar:
-        for case in cases:
-            if case in MAPS:
-                if figures:
-                    files += plot_maps(case, out_dir)
-            elif case in LOOPS:
-                row, law, histories = _loop_row(case, with_history=figures)
-                rows.append(row)
-                if figures:
-                    suffix = f"_{case.note.split(':')[0]}" if case.figure == "3" else ""
-                    path = out_dir / f"fig{case.figure}{suffix}.png"
-                    plot_loop(row, law, histories, path)
-                    files.append(path)
-            else:
-                row, drops = _bounce_row(case)
-                rows.append(row)
-                if figures:
-                    files += plot_bounce(row, drops, out_dir)
-            bar.update(1, f"fig. {case.figure}")
+        try:
+            futures = [None if case in MAPS else pool.submit(computed, case) for case in cases]
+            _draw(cases, futures, figures, out_dir, rows, files, bar)
+        finally:  # an interrupt or a failure: the cases not started are dropped
+            pool.shutdown(wait=False, cancel_futures=True)
         if rows:
             path = out_dir / "table.md"
             write_text(path, table_markdown(rows))
@@ -156,3 +158,27 @@ def reproduce_paper(
             files.append(path)
             bar.update(1, "Hunt-Crossley variants")
     return dict(rows=rows, files=[str(f) for f in files])
+
+
+def _draw(cases, futures, figures, out_dir, rows, files, bar):
+    """Each case's figures in order (the maps computed here), its row appended to `rows`
+    and its files to `files`, as its entry of `futures` (`_loop_row`'s or `_bounce_row`'s
+    result; None for a map) comes."""
+    for case, future in zip(cases, futures, strict=True):
+        if case in MAPS:
+            if figures:
+                files += plot_maps(case, out_dir)
+        elif case in LOOPS:
+            row, law, histories = future.result()
+            rows.append(row)
+            if figures:
+                suffix = f"_{case.note.split(':')[0]}" if case.figure == "3" else ""
+                path = out_dir / f"fig{case.figure}{suffix}.png"
+                plot_loop(row, law, histories, path)
+                files.append(path)
+        else:
+            row, drops = future.result()
+            rows.append(row)
+            if figures:
+                files += plot_bounce(row, drops, out_dir)
+        bar.update(1, f"fig. {case.figure}")
