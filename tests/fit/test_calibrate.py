@@ -592,6 +592,7 @@ def test_reduced_chi_square_and_standard_errors_without_sigmas():
     chi2 = float(np.sum(np.asarray(weighted.residuals) ** 2))
     assert_rel(weighted.reduced_chi2, chi2 / 8, 1e-12, "reduced chi-square")
     assert_rel(weighted.p_value, stats.chi2.sf(chi2, 8), 1e-9, "p-value")
+    assert np.isnan(float(plain.p_value)) and np.isnan(float(plain.reduced_chi2))  # no sigmas
     text = weighted.summary()
     assert f"reduced chi-square {ji._format.format_number(chi2 / 8, 3)} with 8 degrees" in text
     assert "the sum of squared normalised residuals" in text
