@@ -20,7 +20,8 @@ under a millisecond, a fit makes tens) also skip LLVM's optimisation passes
 (`xla_backend_optimization_level=0`, the test suite's setting): measured, a Bingham
 impact's Jacobian at 6 speeds compiles in 2.5 s instead of 3.6 and runs in 360 us
 instead of 200; a first `compare_laws` over the seed paper's laws on 2 workers took
-16.7-18.5 s instead of 20.7-22.8, with the same fits (benchmarks/compare_laws_split.md).
+17.0-20.1 s instead of 21.2-23.4 (3 runs each), with the same fits
+(benchmarks/compare_laws_split.md).
 `fit_oblique`'s program, which runs its grid of starts, keeps them: without, its second
 call took 23.5 s instead of 8.9 and its first no less.
 """
@@ -72,7 +73,6 @@ def solve_jit(fun):
     """`stored_jit(fun)` for a solve that runs for milliseconds when called on its own (an
     eager `impact`, `bounce` or `oblique_impact`): such a call compiles with
     `quick_options()`; inside a transform or a `jit` the outer program's options hold.
-    Measured on the command line, cold (benchmarks/answer_times.md): `simulate` 2.6-2.8 ->
-    1.9 s, `export lammps --wall` 7.9-8.3 -> 6.8 s, with `--tangential mindlin` 24.7-25.0
-    -> 20.7 s."""
+    Measured on the command line, cold, one run each (benchmarks/answer_times.md):
+    `simulate` 2.7 -> 2.1 s, `export lammps --wall` 9.1 -> 6.2 s."""
     return stored_jit(fun, eager_options=quick_options)

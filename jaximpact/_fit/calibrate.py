@@ -1227,7 +1227,8 @@ def _fit_on_host(law, data, m, g, target_tol, options):
     theta0 = np.stack([np.asarray(to_unbounded(k, law.parameters[k])) for k in options.free])
 
     # a two-group table's program first without the integration of the impacts outside
-    # it, which is compiled (about 8 s of a 10 s first fit) only when some impact is
+    # it: that is compiled (about 8 s of a 10 s first fit) only at a point where an
+    # impact leaves the table
     table_first = isinstance(options.impact.similarity, WithGravity)
     table_only = dataclasses.replace(
         options, impact=dataclasses.replace(options.impact, integrate_outside=False)
