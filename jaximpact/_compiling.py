@@ -17,11 +17,11 @@ the process's `XLA_FLAGS`; other backends ignore an `xla_cpu_` option.
 
 A fit's programs on a closed form or the curves (`brief=True`: each call runs for well
 under a millisecond, a fit makes tens) also skip LLVM's optimisation passes
-(`xla_backend_optimization_level=0`, the test suite's setting): measured, a Bingham
-impact's Jacobian at 6 speeds compiles in 2.5 s instead of 3.6 and runs in 360 us
-instead of 200; a first `compare_laws` over the seed paper's laws on 2 workers took
-17.0-20.1 s instead of 21.2-23.4 (3 runs each), with the same fits
-(benchmarks/compare_laws_split.md).
+(`xla_backend_optimization_level=0`, the test suite's setting): measured (scratch), a
+Bingham impact's Jacobian at 6 speeds compiles in 2.5 s instead of 3.6 and runs in 360
+us instead of 200, and a first `compare_laws` over the seed paper's laws on 2 workers
+took 17.0-20.1 s instead of 21.2-23.4 (3 runs each), with the same fits;
+benchmarks/compare_laws_split.md has it with the two-group table's change: 30.1 -> 17.6 s.
 `fit_oblique`'s program, which runs its grid of starts, keeps them: without, its second
 call took 23.5 s instead of 8.9 and its first no less.
 """

@@ -310,14 +310,16 @@ def stored_jit(fun, *, eager_options=None, **jit_options):
     return call
 
 
+try:  # JAX's own test that no trace is under way (private: absent from some version)
+    from jax._src.core import trace_state_clean as _trace_state_clean
+except ImportError:
+    _trace_state_clean = None
+
+
 def _on_its_own() -> bool:
     """Whether no trace is under way around this call (JAX's own test, where this
     version has it; else False: the outer program's options, as inside a transform)."""
-    try:
-        from jax._src.core import trace_state_clean
-    except ImportError:
-        return False
-    return bool(trace_state_clean())
+    return _trace_state_clean is not None and bool(_trace_state_clean())
 
 
 def _eager_options(jit_options: dict, eager_options) -> dict:

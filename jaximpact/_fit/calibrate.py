@@ -1230,9 +1230,10 @@ def _fit_on_host(law, data, m, g, target_tol, options):
     # it: that is compiled (about 8 s of a 10 s first fit) only at a point where an
     # impact leaves the table
     table_first = isinstance(options.impact.similarity, WithGravity)
-    table_only = dataclasses.replace(
-        options, impact=dataclasses.replace(options.impact, integrate_outside=False)
-    )
+    if table_first:
+        table_only = dataclasses.replace(
+            options, impact=dataclasses.replace(options.impact, integrate_outside=False)
+        )
 
     def evaluate(theta):
         theta = jnp.asarray(theta)

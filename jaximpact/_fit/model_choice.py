@@ -72,9 +72,9 @@ def starting_law(name: str, *, m: float, v0: float, e: float, T: float | None, *
     # started Bingham-modified at e = 0.31 at the slowest of speeds measured at e = 0.9:
     # outside its table, so a first fit compiled the integration too)
     share = 0.5 if "P" in spec.parameters and {"b", "b1"} & set(spec.parameters) else 1.0
-    if share < 1.0:
-        log_e = 0.5 * math.log(1.0 - share * max(1.0 - e**2, 1e-6))
-        damping *= -log_e / math.sqrt(math.pi**2 + log_e**2) / max(zeta, 1e-12)
+    if share < 1.0:  # the damping ratio of the e that loses `share` of the energy
+        log_half = 0.5 * math.log(1.0 - share * max(1.0 - e**2, 1e-6))
+        damping *= -log_half / math.sqrt(math.pi**2 + log_half**2) / max(zeta, 1e-12)
     params = {"c": c, "n": n, "p": p}
     for key in spec.parameters:
         if key in ("b", "b1"):
