@@ -1,9 +1,12 @@
 """The exports as recorded: `Export.to_dict()` of every engine, normal law and tangential law
 that the export tests of tests/engines build, against `recorded_exports.json` (written at
-the code before the engines became tables of sub-models, issue 36). Floats to 1e-9
-relative, strings, names and keys exactly: a refactoring of `_engines/` changes none of them.
-(Here they agree to 1e-12; 1e-9 leaves room for another machine's XLA, whose CPU code
-rounds a solve's last digits differently, as it moved the gravity table's end at stop 38.)
+the code before the engines became tables of sub-models, issue 36). Floats to 1e-7
+relative, numbers inside strings (an engine's command line) the same, names, keys and the
+rest of each string exactly: a refactoring of `_engines/` changes none of them. Many values
+come from an adaptive solve or a root find (an engine's realised e and spin, JKR's w), so
+their last digits follow XLA's rounding: compiling a lone oblique solve with the quick
+options (d89f065) moved them by up to 3e-9, as another machine's XLA moved the gravity
+table's end at stop 38. 1e-7 is far above that and far below any change of an export.
 
 Record again (only where an export is meant to change, and say why in the commit):
 
@@ -17,6 +20,7 @@ import json
 import math
 import os
 import pathlib
+import re
 import warnings
 
 import pytest
@@ -24,7 +28,8 @@ import pytest
 import jaximpact as ji
 
 RECORD = pathlib.Path(__file__).with_name("recorded_exports.json")
-REL = 1e-9
+REL = 1e-7
+NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
 
 # the scenes of the export tests (test_export*.py, test_*_tangential.py, test_real_*.py)
 SMALL = dict(m=0.004, v0=1.0, radius=0.005)  # WALL_M, WALL_R
@@ -298,6 +303,10 @@ def _plain(value):
     return value if math.isfinite(value) else repr(value)
 
 
+def _close(got, want):
+    return got == want or abs(got - want) <= REL * max(abs(got), abs(want))
+
+
 def _compare(got, want, where=""):
     """A list of the places where `got` differs from `want` (floats to `REL`)."""
     if isinstance(want, dict):
@@ -310,12 +319,19 @@ def _compare(got, want, where=""):
         if not isinstance(got, list) or len(got) != len(want):
             return [f"{where}: {got!r} != {want!r}"]
         return [
-            d for i, (a, b) in enumerate(zip(got, want)) for d in _compare(a, b, f"{where}[{i}]")
+            d
+            for i, (a, b) in enumerate(zip(got, want, strict=True))
+            for d in _compare(a, b, f"{where}[{i}]")
         ]
     if isinstance(want, float) and isinstance(got, float) and not isinstance(want, bool):
-        if got == want or abs(got - want) <= REL * max(abs(got), abs(want)):
-            return []
-        return [f"{where}: {got!r} != {want!r}"]
+        return [] if _close(got, want) else [f"{where}: {got!r} != {want!r}"]
+    if isinstance(want, str) and isinstance(got, str):
+        same_words = NUMBER.split(got) == NUMBER.split(want)
+        numbers = NUMBER.findall(got), NUMBER.findall(want)
+        same_numbers = len(numbers[0]) == len(numbers[1]) and all(
+            _close(float(a), float(b)) for a, b in zip(*numbers, strict=True)
+        )
+        return [] if same_words and same_numbers else [f"{where}: {got!r} != {want!r}"]
     return [] if (type(got) is type(want) and got == want) else [f"{where}: {got!r} != {want!r}"]
 
 
