@@ -24,7 +24,6 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
-import optimistix as optx
 from jax.scipy.special import gammaln
 
 from .._checks import is_traced
@@ -36,7 +35,7 @@ from .closed_forms_linear import (
     maxwell_gravity_impact,
     maxwell_impact,
 )
-from .oscillator import _arctan_ratio, _cos_continued, _sin_ratio
+from .oscillator import _arctan_ratio, _cos_continued, _newton_root, _sin_ratio
 
 
 def kelvin_voigt(c, b, m, v0, separation="force", *, rest_tol=1e-7):
@@ -93,15 +92,14 @@ def _rest_time(s, r, rest_tol, beta, tau_start):
     slow, fast = -s + q, -s - q
     start = jnp.maximum(jnp.log(rest_tol) / slow, tau_start)
 
-    def excess(tau, _):
+    def excess(tau, args):
+        slow, fast, beta, rest_tol = args
         x = (jnp.exp(slow * tau) - jnp.exp(fast * tau)) / (slow - fast)
         v = (slow * jnp.exp(slow * tau) - fast * jnp.exp(fast * tau)) / (slow - fast)
         return jnp.log(jnp.abs(v) + jnp.abs(x + beta * v)) - jnp.log(rest_tol)
 
-    solution = optx.root_find(
-        excess, optx.Newton(rtol=1e-13, atol=1e-13), start, max_steps=64, throw=False
-    )
-    return jnp.where(jnp.isfinite(solution.value), solution.value, start)
+    tau, _ = _newton_root(excess, (slow, fast, beta, rest_tol), start)
+    return jnp.where(jnp.isfinite(tau), tau, start)
 
 
 def maxwell(c, b, m, v0):

@@ -23,7 +23,6 @@ from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
-import optimistix as optx
 from jaxtyping import Array
 
 from .._status import Status
@@ -37,6 +36,25 @@ from .oscillator import (
     _sin_ratio,
     _state,
 )
+
+
+def _creep_modes(mu, tau):
+    """`(Phi, V)` at `tau` of `maxwell_creep`'s over-damped Maxwell contact (`mu >= 2`)."""
+    s = 0.5 * mu
+    q2 = s**2 - 1.0
+    near = q2 < 1e-4  # within 1e-2 of critical damping in q: the sinh form, no cancellation
+    q = jnp.sqrt(jnp.where(near, 1.0, q2))
+    fast = -s - q
+    slow = 1.0 / fast  # l1 l2 = 1, without the cancellation of -s + q
+    gap = slow - fast
+    r_near = -jnp.where(near, q2, 0.0)
+    e1, e2 = jnp.exp(slow * tau), jnp.exp(fast * tau)
+    phi_far, v_far = (e1 - e2) / gap, (slow * e2 - fast * e1) / gap
+    decay = jnp.exp(-s * tau)
+    sin_r = _sin_ratio(r_near, tau)
+    phi_near = decay * sin_r
+    v_near = decay * (_cos_continued(r_near, tau) + s * sin_r)
+    return jnp.where(near, phi_near, phi_far), jnp.where(near, v_near, v_far)
 
 
 def maxwell_creep(mu, rest_tol):
@@ -53,37 +71,23 @@ def maxwell_creep(mu, rest_tol):
     damping the modes are written `exp(-mu tau/2) sinh(q tau)/q` (series in `q`)."""
     s = 0.5 * mu
     q2 = s**2 - 1.0
-    near = q2 < 1e-4  # within 1e-2 of critical damping in q: the sinh form, no cancellation
-    q = jnp.sqrt(jnp.where(near, 1.0, q2))
-    fast = -s - q
-    slow = 1.0 / fast  # l1 l2 = 1, without the cancellation of -s + q
-    gap = slow - fast
-    r_near = -jnp.where(near, q2, 0.0)
-
-    def modes(tau):
-        e1, e2 = jnp.exp(slow * tau), jnp.exp(fast * tau)
-        phi_far, v_far = (e1 - e2) / gap, (slow * e2 - fast * e1) / gap
-        decay = jnp.exp(-s * tau)
-        sin_r = _sin_ratio(r_near, tau)
-        phi_near = decay * sin_r
-        v_near = decay * (_cos_continued(r_near, tau) + s * sin_r)
-        return jnp.where(near, phi_near, phi_far), jnp.where(near, v_near, v_far)
-
+    near = q2 < 1e-4
+    fast = -s - jnp.sqrt(jnp.where(near, 1.0, q2))
+    slow, gap = 1.0 / fast, 1.0 / fast - fast
     start = jnp.where(near, -jnp.log(rest_tol), jnp.log(rest_tol * gap / (1.0 - fast)) / slow)
     start = jnp.maximum(start, 1.0)
 
-    def excess(tau, _):
-        phi, v = modes(tau)
+    def excess(tau, args):
+        mu, rest_tol = args
+        phi, v = _creep_modes(mu, tau)
         return jnp.log(phi + v) - jnp.log(rest_tol)
 
-    solution = optx.root_find(
-        excess, optx.Newton(rtol=1e-13, atol=1e-13), start, max_steps=64, throw=False
-    )
-    tau_rest = jnp.where(jnp.isfinite(solution.value), solution.value, start)
-    phi, v = modes(tau_rest)
+    tau_rest, _ = _newton_root(excess, (mu, rest_tol), start)
+    tau_rest = jnp.where(jnp.isfinite(tau_rest), tau_rest, start)
+    phi, v = _creep_modes(mu, tau_rest)
     # Phi' = 0 where tanh(q tau) = q/s
     tau_peak = _arctan_ratio(-q2 / s**2) / s
-    return tau_rest, phi + mu * (1.0 - v), tau_peak, modes(tau_peak)[0]
+    return tau_rest, phi + mu * (1.0 - v), tau_peak, _creep_modes(mu, tau_peak)[0]
 
 
 def _placeholder(value):

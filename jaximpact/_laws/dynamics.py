@@ -203,7 +203,7 @@ class MaxwellDynamics(AbstractDynamics):
     def creeping(self, rest_tol):
         """Over-damped (`mu >= 2`) and no gravity: `V'' + mu V' + V = 0` keeps `V > 0`, the
         body sinks in for ever while the force relaxes (`closed_forms.maxwell_creep`)."""
-        from .closed_forms import maxwell_creep  # optimistix, only for Maxwell
+        from .closed_forms import maxwell_creep  # only for Maxwell
 
         captured = (self.mu >= 2.0) & (self.gamma == 0)
         # a harmless over-damped value elsewhere, so no NaN reaches a discarded gradient;

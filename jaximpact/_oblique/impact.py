@@ -28,11 +28,11 @@ from .._solve.impact import check_custom_law
 from .._solve.options import CUSTOM_RTOL, DEFAULT_RTOL
 from .._solve.phases import solve_broke
 from .._solve.precision import resolvable_tolerances
+from .._solve.roots import BracketedNewton
 from .._status import Status
 from .._tracing import anchors
 from .dynamics import SLIP, STICK, ObliqueDynamics
 from .results import _NOT_RESULTS, ObliqueResult
-from .roots import BracketedNewton
 from .tangential import AbstractTangentialLaw
 
 SEPARATIONS = ("force", "penetration")

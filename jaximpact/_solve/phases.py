@@ -6,11 +6,11 @@ optimistix take about half a second to import)."""
 import diffrax as dfx
 import jax
 import jax.numpy as jnp
-import optimistix as optx
 
 from .._status import Status
 from .._tracing import anchors
 from .results import ImpactResult
+from .roots import BracketedNewton
 
 # Phases of one contact, integrated one after the other by the same compiled solve.
 _TO_PEAK = 0  # compression, until the first force peak or maximum compression
@@ -123,7 +123,7 @@ def integrate_phases(dynamics, options, *, plan, tau_grid, hold=None):
     conditions = _event_conditions(dynamics, separation, plan, rest_tol)
     event = dfx.Event(
         conditions,
-        root_finder=optx.Newton(rtol=1e-13, atol=1e-13),
+        root_finder=BracketedNewton(rtol=1e-13, atol=1e-13),
         direction=(False,) * len(conditions),
     )
     controller = dfx.PIDController(rtol=rtol, atol=atol)

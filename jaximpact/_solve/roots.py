@@ -1,18 +1,25 @@
 """A root finder for diffrax's events that keeps its bracket: Newton's method, falling
 back to bisection wherever a Newton step would leave the interval that holds the root.
+Every integrated impact ends its events with it, head-on (`phases.py`) and oblique
+(`_oblique/impact.py`).
 
 diffrax finds an event's time with an optimistix root finder on the step's interpolant,
-over the step `[lower, upper]` in which the condition changed sign. Plain Newton (what
-`impact` uses) is clipped to that step, and a condition that grows like a square root
-from the start of contact (the stick-slip conditions of a Hertz contact:
-`K u - 1.5 mu X^0.5 V`, K small) sends it from the step's end past `lower` to `t = 0`,
-where the derivative vanishes: the root find failed and the solve with it (a linear spring
-of 5e6 N/m on Kharaz's sphere at 5 degrees). Bisection alone cannot serve: diffrax hands
-the root finder every condition of the event at once (a tuple, all zero but the one that
-fired), and optimistix's `Bisection` takes a scalar only. Here the conditions are summed
-to that scalar, and each iterate is Newton's where it stays inside the bracket, the
-bracket's midpoint otherwise; the derivative of the event time comes from optimistix's
-implicit function theorem as before.
+over the step `[lower, upper]` in which the condition changed sign. Two things rule out
+optimistix's own finders:
+
+- `optx.Newton` is clipped to that step, and a condition that grows like a square root
+  from the start of contact (the stick-slip conditions of a Hertz contact:
+  `K u - 1.5 mu X^0.5 V`, K small) sends it from the step's end past `lower` to `t = 0`,
+  where the derivative vanishes: the root find failed and the solve with it (a linear
+  spring of 5e6 N/m on Kharaz's sphere at 5 degrees). It also solves its scalar Newton step
+  through a lineax operator and QR, which cost a user's law's first `impact` about 2 s of
+  its 6 s of tracing and compiling (benchmarks/first_calls.md).
+- `optx.Bisection` takes a scalar only, and diffrax hands the root finder every condition
+  of the event at once (a tuple, all zero but the one that fired).
+
+Here the conditions are summed to that scalar, and each iterate is Newton's where it stays
+inside the bracket, the bracket's midpoint otherwise; the derivative of the event time
+comes from optimistix's implicit function theorem as before.
 """
 
 from collections.abc import Callable
