@@ -72,8 +72,12 @@ class BracketedNewton(optx.AbstractRootFinder):
         upper = jnp.where(same_as_lower, state.upper, y)
         usable = jnp.isfinite(slope) & (slope != 0)
         newton = y - value / jnp.where(usable, slope, 1.0)
-        inside = (
-            usable & (newton > jnp.minimum(lower, upper)) & (newton < jnp.maximum(lower, upper))
+        # `y` is now an end of the bracket: a converged Newton step lands on it (or within
+        # the tolerance of it), which is the root, not a step out of the bracket
+        converged = jnp.abs(newton - y) < self.atol + self.rtol * jnp.abs(y)
+        inside = usable & (
+            converged
+            | ((newton > jnp.minimum(lower, upper)) & (newton < jnp.maximum(lower, upper)))
         )
         new_y = jnp.where(inside, newton, 0.5 * (lower + upper))
         new_y = jnp.where(value == 0, y, new_y)
