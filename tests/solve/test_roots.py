@@ -54,6 +54,33 @@ def test_a_root_that_grows_like_a_square_root_is_found_inside_the_bracket(start)
     assert float(jax.grad(_root)(a, start)) == pytest.approx(0.6, rel=1e-9)
 
 
+def test_a_converged_step_on_a_noisy_function_ends_the_search():
+    """A condition evaluated on diffrax's interpolant carries rounding noise. After each
+    step the iterate is an end of the bracket, so a converged Newton step that the noise
+    puts on it or just past it must be taken as converged. Sent to the bracket's midpoint
+    instead (before 7f93ee6): up to 28 steps and a root 2.5e-13 off; a `vmap`
+    of a user's law's impacts ran 10-30 % slower."""
+
+    def steps_and_root(r):
+        def noisy(t, r):
+            return jnp.expm1(t - r) + 3e-15 * jnp.sin(1e11 * t), jnp.zeros_like(t)
+
+        solution = optx.root_find(
+            noisy,
+            BracketedNewton(rtol=1e-13, atol=1e-13),
+            jnp.asarray(2.0),
+            r,
+            options=dict(lower=0.0, upper=2.0),
+            throw=False,
+        )
+        return solution.stats["num_steps"], solution.value
+
+    roots = jnp.linspace(0.2, 1.8, 400)
+    steps, found = jax.vmap(steps_and_root)(roots)
+    assert int(steps.max()) <= 10
+    assert float(jnp.max(jnp.abs(found - roots))) <= 1e-14
+
+
 def test_an_integrated_impact_holds_no_linear_solve():
     """Its events end with `BracketedNewton`: `optx.Newton`, used before, solved each
     Newton step through a lineax operator and QR (about 2 s of a user's law's first
