@@ -146,3 +146,21 @@ def assert_one_line_error(status, out, err, expected_status=2, contains=""):
     lines = err.splitlines()
     assert len(lines) == 1 and lines[0].startswith("jaximpact: error: "), err
     assert contains in lines[0], lines[0]
+
+
+def primitive_names(fn, *args) -> list:
+    """The primitive names of `fn`'s jaxpr in order, the bodies of calls, loops and
+    branches included."""
+    names = []
+
+    def walk(jaxpr):
+        for eqn in jaxpr.eqns:
+            names.append(eqn.primitive.name)
+            for value in eqn.params.values():
+                for inner in value if isinstance(value, list | tuple) else [value]:
+                    inner = getattr(inner, "jaxpr", inner)
+                    if hasattr(inner, "eqns"):
+                        walk(inner)
+
+    walk(jax.make_jaxpr(fn)(*args).jaxpr)
+    return names

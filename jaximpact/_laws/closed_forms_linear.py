@@ -38,14 +38,21 @@ from .oscillator import (
 )
 
 
-def _creep_modes(mu, tau):
-    """`(Phi, V)` at `tau` of `maxwell_creep`'s over-damped Maxwell contact (`mu >= 2`)."""
+def _creep_rates(mu):
+    """`(s, q2, near, fast, slow)` of `maxwell_creep`'s modes: `s = mu/2`, `q2 = s^2 - 1`,
+    `near` within 1e-2 of critical damping in `q` (the sinh form, no cancellation), and
+    the rates `l2 = -s - q`, `l1 = 1/l2` (`l1 l2 = 1`, without the cancellation of
+    `-s + q`)."""
     s = 0.5 * mu
     q2 = s**2 - 1.0
-    near = q2 < 1e-4  # within 1e-2 of critical damping in q: the sinh form, no cancellation
-    q = jnp.sqrt(jnp.where(near, 1.0, q2))
-    fast = -s - q
-    slow = 1.0 / fast  # l1 l2 = 1, without the cancellation of -s + q
+    near = q2 < 1e-4
+    fast = -s - jnp.sqrt(jnp.where(near, 1.0, q2))
+    return s, q2, near, fast, 1.0 / fast
+
+
+def _creep_modes(mu, tau):
+    """`(Phi, V)` at `tau` of `maxwell_creep`'s over-damped Maxwell contact (`mu >= 2`)."""
+    s, q2, near, fast, slow = _creep_rates(mu)
     gap = slow - fast
     r_near = -jnp.where(near, q2, 0.0)
     e1, e2 = jnp.exp(slow * tau), jnp.exp(fast * tau)
@@ -69,11 +76,8 @@ def maxwell_creep(mu, rest_tol):
     Newton on its logarithm, differentiated implicitly) and the force peak `Phi' = 0`.
     Call it with `mu >= 2` only (callers substitute a safe value elsewhere); near critical
     damping the modes are written `exp(-mu tau/2) sinh(q tau)/q` (series in `q`)."""
-    s = 0.5 * mu
-    q2 = s**2 - 1.0
-    near = q2 < 1e-4
-    fast = -s - jnp.sqrt(jnp.where(near, 1.0, q2))
-    slow, gap = 1.0 / fast, 1.0 / fast - fast
+    s, q2, near, fast, slow = _creep_rates(mu)
+    gap = slow - fast
     start = jnp.where(near, -jnp.log(rest_tol), jnp.log(rest_tol * gap / (1.0 - fast)) / slow)
     start = jnp.maximum(start, 1.0)
 

@@ -74,7 +74,7 @@ class BracketedNewton(optx.AbstractRootFinder):
         newton = y - value / jnp.where(usable, slope, 1.0)
         # `y` is now an end of the bracket: a converged Newton step lands on it (or within
         # the tolerance of it), which is the root, not a step out of the bracket
-        converged = jnp.abs(newton - y) < self.atol + self.rtol * jnp.abs(y)
+        converged = jnp.abs(newton - y) < self._scale(y)
         inside = usable & (
             converged
             | ((newton > jnp.minimum(lower, upper)) & (newton < jnp.maximum(lower, upper)))
@@ -83,8 +83,11 @@ class BracketedNewton(optx.AbstractRootFinder):
         new_y = jnp.where(value == 0, y, new_y)
         return new_y, _State(lower, upper, state.negative_at_lower, new_y - y, value), aux
 
+    def _scale(self, y):
+        return self.atol + self.rtol * jnp.abs(y)
+
     def terminate(self, fn, y, args, options, state: _State, tags):
-        scale = self.atol + self.rtol * jnp.abs(y)
+        scale = self._scale(y)
         done = (
             (jnp.abs(state.diff) < scale)
             | (jnp.abs(state.upper - state.lower) < scale)

@@ -6,7 +6,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from helpers import assert_finite
+from helpers import assert_finite, primitive_names
 
 import jaximpact as ji
 from jaximpact._laws.fast_powers import fast_powers
@@ -17,22 +17,6 @@ TINY = float(np.finfo(float).tiny)
 # the exponents laws use: within 4e-16 of pow (values and derivatives); others within 4 ulps
 COMMON = (0.5, 1.5, 2.5, 2.0)
 OTHERS = (3.5, 1.0, 3.0, 8.0, -0.5, -1.5, -2.0)
-
-
-def _primitives(fn, *args):
-    """The primitive names of `fn`'s jaxpr, the bodies of calls included."""
-    names = []
-
-    def walk(jaxpr):
-        for eqn in jaxpr.eqns:
-            names.append(eqn.primitive.name)
-            for value in eqn.params.values():
-                inner = getattr(value, "jaxpr", value)
-                if hasattr(inner, "eqns"):
-                    walk(inner)
-
-    walk(jax.make_jaxpr(fn)(*args).jaxpr)
-    return names
 
 
 def _max_rel(actual, expected):
@@ -56,7 +40,7 @@ def test_half_power_is_pow_to_a_few_ulps(p):
     expected_value, expected_slope = _on_grid(lambda x: x**p)
     assert _max_rel(value, expected_value) <= tol
     assert _max_rel(slope, expected_slope) <= tol
-    assert "pow" not in _primitives(lambda x: half_power(x, int(2 * p)), 1.0)
+    assert "pow" not in primitive_names(lambda x: half_power(x, int(2 * p)), 1.0)
 
 
 @pytest.mark.parametrize("p", [0.5, 1.5, 2.5])
@@ -65,7 +49,7 @@ def test_a_static_half_power_is_guarded_as_before(p):
     zero with zero gradient and Hessian at and below the surface, finite elsewhere."""
     xs = jnp.array([-1.0, -1e-300, 0.0, 1e-300, TINY, 1e-8, 0.3, 4.0])
     for fn in (lambda x: safe_pow(x, p), lambda x: contact_pow(x, p)):
-        assert "pow" not in _primitives(fn, 1.0)
+        assert "pow" not in primitive_names(fn, 1.0)
         value = jax.vmap(fn)(xs)
         slope = jax.vmap(jax.grad(fn))(xs)
         curvature = jax.vmap(jax.hessian(fn))(xs)
@@ -78,21 +62,21 @@ def test_a_static_half_power_is_guarded_as_before(p):
 
 
 def test_a_traced_or_general_exponent_stays_pow():
-    assert "pow" in _primitives(lambda x, n: contact_pow(x, n), 1.0, 1.5)  # Hunt-Crossley's n
+    assert "pow" in primitive_names(lambda x, n: contact_pow(x, n), 1.0, 1.5)  # Hunt-Crossley's n
     for p in (0.25, 1.3, 17.5):
-        assert "pow" in _primitives(lambda x: contact_pow(x, p), 1.0)
-    assert "pow" in _primitives(lambda x: safe_pow(x, jnp.asarray(1.5)), 1.0)
+        assert "pow" in primitive_names(lambda x: contact_pow(x, p), 1.0)
+    assert "pow" in primitive_names(lambda x: safe_pow(x, jnp.asarray(1.5)), 1.0)
 
 
 def test_the_table_laws_with_half_powers_need_no_pow():
     law = ji.law("hertz_rate", c=2e6, b1=800.0)
-    assert "pow" not in _primitives(lambda x, v: law.force(x, v), 1e-3, 1.0)
+    assert "pow" not in primitive_names(lambda x, v: law.force(x, v), 1e-3, 1.0)
     dynamics = law.dynamics(m=1.0, v0=2.5, g=0.0)
     y = jnp.array([0.3, 0.5])
-    assert "pow" not in _primitives(lambda y: dynamics.rhs(y, True), y)
-    assert "pow" not in _primitives(lambda y: dynamics.force_gap(y, True), y)
+    assert "pow" not in primitive_names(lambda y: dynamics.rhs(y, True), y)
+    assert "pow" not in primitive_names(lambda y: dynamics.force_gap(y, True), y)
     traced = ji.law("hunt_crossley", c=2e6, a=0.1, n=1.5)  # n a parameter: pow, as before
-    assert "pow" in _primitives(lambda x, v: traced.force(x, v), 1e-3, 1.0)
+    assert "pow" in primitive_names(lambda x, v: traced.force(x, v), 1e-3, 1.0)
 
 
 # ---------------------------------------------------------------- a user's law, rewritten
@@ -110,7 +94,7 @@ USER_POWERS = {
 def test_a_users_power_is_rewritten_and_agrees_with_pow(name):
     fn = USER_POWERS[name]
     fast = fast_powers(fn)
-    assert "pow" not in _primitives(fast, 1.0)
+    assert "pow" not in primitive_names(fast, 1.0)
     value, slope = _on_grid(fast)
     expected_value, expected_slope = _on_grid(fn)
     assert _max_rel(value, expected_value) <= 4e-16
@@ -143,7 +127,7 @@ def test_what_is_not_a_constant_half_power_is_left_as_written():
     def law(x, v, p):
         return jnp.power(x, p["n"]) + x**0.25 + x**2 + jnp.sqrt(x) + jax.lax.rsqrt(x) * v
 
-    names = _primitives(fast_powers(law), 0.3, 1.0, {"n": jnp.asarray(1.5)})
+    names = primitive_names(fast_powers(law), 0.3, 1.0, {"n": jnp.asarray(1.5)})
     assert names.count("pow") == 2  # the traced n and the general 0.25
     assert names.count("integer_pow") == 1 and "sqrt" in names and "rsqrt" in names
     x, v, p = 0.3, 1.0, {"n": jnp.asarray(1.5)}
@@ -163,7 +147,7 @@ def test_powers_inside_a_users_jitted_helper_and_a_clamp_are_rewritten():
         return jnp.maximum(hertz(x, p["c"]) + p["b1"] * power(x, 0.5) * v, 0.0)
 
     fast = fast_powers(law)
-    assert "pow" not in _primitives(fast, 0.3, 1.0, PARAMS)
+    assert "pow" not in primitive_names(fast, 0.3, 1.0, PARAMS)
     for x, v in [(1e-3, 1.0), (1e-3, -3.0)]:
         np.testing.assert_allclose(fast(x, v, PARAMS), law(x, v, PARAMS), rtol=1e-15)
 
@@ -180,8 +164,8 @@ def test_a_custom_law_evaluates_no_pow_and_no_nan_at_the_surface():
     force and its gradients are finite at x = tiny, 0 and below, and 0 outside."""
     law = ji.custom_law(_hertz_rate, c=2e6, b1=800.0)
     clamped = ji.custom_law(lambda x, v, p: jnp.maximum(_hertz_rate(x, v, p), 0.0), c=2e6, b1=800.0)
-    assert "pow" not in _primitives(lambda x, v: law.force(x, v), 1e-3, 1.0)
-    assert "pow" not in _primitives(lambda x, v: clamped.edge_force(x, v), 1e-3, 1.0)
+    assert "pow" not in primitive_names(lambda x, v: law.force(x, v), 1e-3, 1.0)
+    assert "pow" not in primitive_names(lambda x, v: clamped.edge_force(x, v), 1e-3, 1.0)
     xs = jnp.array([-1e-3, -1e-300, 0.0, TINY, 1e-300, 1e-12, 1e-3])
     vs = jnp.full_like(xs, 1.5)
 

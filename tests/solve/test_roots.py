@@ -6,29 +6,12 @@ import jax
 import jax.numpy as jnp
 import optimistix as optx
 import pytest
+from helpers import primitive_names
 
 import jaximpact as ji
 from jaximpact._solve.roots import BracketedNewton
 
 LINEAR_SOLVES = {"geqrf", "lu", "linear_solve", "householder_product", "triangular_solve"}
-
-
-def _primitive_names(fn, *args):
-    """Every primitive name in `fn`'s jaxpr, the bodies of calls, loops and branches
-    included."""
-    names = set()
-
-    def walk(jaxpr):
-        for eqn in jaxpr.eqns:
-            names.add(eqn.primitive.name)
-            for value in eqn.params.values():
-                for inner in value if isinstance(value, list | tuple) else [value]:
-                    inner = getattr(inner, "jaxpr", inner)
-                    if hasattr(inner, "eqns"):
-                        walk(inner)
-
-    walk(jax.make_jaxpr(fn)(*args).jaxpr)
-    return names
 
 
 def _root(a, start):
@@ -86,6 +69,6 @@ def test_an_integrated_impact_holds_no_linear_solve():
     Newton step through a lineax operator and QR (about 2 s of a user's law's first
     `impact`). Reverse mode keeps the one solve of optimistix's implicit derivative."""
     law = ji.custom_law(lambda x, v, p: p["c"] * x**1.5 + p["b"] * jnp.sqrt(x) * v, c=2e6, b=800.0)
-    names = _primitive_names(lambda v0: ji.impact(law, m=1.0, v0=v0).e, 2.5)
+    names = set(primitive_names(lambda v0: ji.impact(law, m=1.0, v0=v0).e, 2.5))
     assert "while" in names  # diffrax's loop: the walk reached the solve
     assert not names & LINEAR_SOLVES
