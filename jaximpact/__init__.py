@@ -105,7 +105,10 @@ _PUBLIC.update(
 )
 # uncertainty: posteriors of fits, their bands, the next measurement (issue 37)
 _PUBLIC.update(
-    dict.fromkeys(("posterior", "Posterior", "next_measurement", "NextMeasurement"), "_posterior")
+    posterior="_posterior.posterior",
+    Posterior="_posterior.result",
+    next_measurement="_posterior.next_measurement",
+    NextMeasurement="_posterior.next_measurement",
 )
 _SUBMODULES = ("closed_forms",)
 

@@ -178,8 +178,8 @@ def sample_posterior(fit, sampling):
     record with its draws thinned (`_posterior.command.thinned_record`)."""
     import jax
 
-    from .._posterior import posterior
     from .._posterior.command import thinned_record
+    from .._posterior.posterior import posterior
 
     with metered(heartbeat_meter(), 1, f"posterior ({sampling['method']})") as bar:
         options = {k: v for k, v in sampling.items() if k != "seed"}

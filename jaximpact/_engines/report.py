@@ -234,7 +234,7 @@ def posterior_band(
     """`(x, origin, notes)`: the export `x` with the engine's band over the draws of
     `posterior` (`Posterior.to_dict`'s record, in the file `path`), each exported with
     `options`, and the words for its origin; or `x` and a note why there is no band."""
-    from .._posterior import Posterior
+    from .._posterior.result import Posterior
     from .export import with_band
 
     origin = " at the posterior medians"

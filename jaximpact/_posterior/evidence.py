@@ -5,13 +5,15 @@ default, is that function's ranking unchanged)."""
 
 import dataclasses
 import math
+import typing
 import warnings
 
 from .._fit import model_choice
 from .._format import format_fields, format_value, jsonable
 from .._progress import AbstractMeter, metered
-from .posterior import posterior
-from .result import Posterior
+
+if typing.TYPE_CHECKING:  # imported by the evidence ranking alone (blackjax, scipy)
+    from .result import Posterior
 
 BY = ("aic", "evidence")
 
@@ -28,7 +30,7 @@ class EvidenceRanking(model_choice.Ranking):
     log_evidence: float = math.nan
     bayes_factor: float = math.nan
     aic_rank: int = 0
-    posterior: Posterior | None = None
+    posterior: "Posterior | None" = None
 
     @property
     def log_bayes_factor(self) -> float:
@@ -125,6 +127,8 @@ def compare_laws(
         if prior is not None:
             raise ValueError("prior= is for by='evidence' (the AIC ranking has no priors)")
         return model_choice.compare_laws(progress=progress, **options)
+    from .posterior import posterior
+
     prior = {} if prior is None else prior
     if not isinstance(prior, dict):
         raise TypeError(

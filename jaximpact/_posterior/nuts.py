@@ -10,6 +10,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .._compiling import quick_jit
+
 
 class Chains(eqx.Module):
     """The draws `z`, shape `(chains, num_samples, d)`, and per draw whether the
@@ -61,13 +63,7 @@ def diagnostics(chains: Chains, names) -> dict:
     `chains`, `draws_per_chain` and mean `tree_steps`."""
     z = jnp.asarray(chains.z)
     n_chains, n_draws, _ = z.shape
-    # blackjax broadcasts by rank promotion, which a strict caller's config would refuse
-    with jax.numpy_rank_promotion("allow"):
-        if n_chains > 1:
-            r_hat = blackjax.diagnostics.rhat(z, chain_axis=0, sample_axis=1)
-        else:
-            r_hat = np.full(z.shape[-1], np.nan)
-        ess = blackjax.diagnostics.ess_bulk(z, chain_axis=0, sample_axis=1)
+    r_hat, ess = _r_hat_and_ess(z)
     # blackjax gives a 0-d array for one parameter: one value per parameter, always
     r_hat, ess = (np.asarray(a).reshape(z.shape[-1]) for a in (r_hat, ess))
     return {
@@ -80,6 +76,22 @@ def diagnostics(chains: Chains, names) -> dict:
         "draws_per_chain": int(n_draws),
         "tree_steps": float(np.mean(np.asarray(chains.steps))),
     }
+
+
+@quick_jit
+def _r_hat_and_ess(z):
+    """blackjax's split r-hat (NaN with one chain) and bulk effective sample size of the
+    draws `z` `(chains, draws, d)`, in one compiled program: run op by op, their FFTs and
+    ranks compiled some hundred small programs, 8 s of a first call against 1.6 s
+    (measured, 4 x 400 draws; the values agree to 3e-12)."""
+    # blackjax broadcasts by rank promotion, which a strict caller's config would refuse
+    with jax.numpy_rank_promotion("allow"):
+        if z.shape[0] > 1:
+            r_hat = blackjax.diagnostics.rhat(z, chain_axis=0, sample_axis=1)
+        else:
+            r_hat = jnp.full(z.shape[-1], jnp.nan)
+        ess = blackjax.diagnostics.ess_bulk(z, chain_axis=0, sample_axis=1)
+    return r_hat, ess
 
 
 # a warning below these: r-hat above, effective sample size below, any divergence

@@ -14,7 +14,7 @@ import pytest
 from helpers import run_cli
 
 import jaximpact as ji
-from jaximpact._posterior import PosteriorWarning
+from jaximpact._posterior.posterior import PosteriorWarning
 from jaximpact._solve.bounce import bounce
 
 GOLF_M = 0.0415  # kg

@@ -4,6 +4,8 @@ and of a viscoelastic ball (Kuwabara-Kono, `hertz_rate`), sigmas given, the gene
 ranks first. The default `by` is the AIC ranking of `_fit.model_choice`, unchanged."""
 
 import math
+import subprocess
+import sys
 
 import jax
 import numpy as np
@@ -72,6 +74,19 @@ def test_the_default_is_the_aic_ranking():
         ji.compare_laws(**data, laws=("hertz_rate",), by="bic")
     with pytest.raises(ValueError, match="prior= is for by='evidence'"):
         ji.compare_laws(**data, laws=("hertz_rate",), prior={"hertz_rate": {}})
+
+
+def test_the_aic_ranking_loads_no_sampler():
+    """`jaximpact.compare_laws` (by AIC) imports neither blackjax nor the posterior's
+    modules: they cost 0.8 s of its first call, and only `by="evidence"` uses them."""
+    code = (
+        "import sys, jaximpact as ji; ji.compare_laws; "
+        "print(sorted(m for m in sys.modules if m.startswith(('blackjax', "
+        "'jaximpact._posterior.posterior', 'jaximpact._posterior.nuts'))))"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "[]"
 
 
 @pytest.mark.slow

@@ -19,7 +19,7 @@ import pytest
 
 import jaximpact as ji
 from jaximpact._oblique.fit import ObliqueFit
-from jaximpact._posterior import PosteriorWarning
+from jaximpact._posterior.posterior import PosteriorWarning
 
 E, NU, RHO, R = 380e9, 0.23, 4000.0, 2.5e-3
 M = RHO * 4.0 / 3.0 * np.pi * R**3
