@@ -1,10 +1,13 @@
 """Test configuration: float64 everywhere, and `tests/` importable (`reference`, `helpers`).
 
-- XLA compiles without LLVM's optimisation passes (`--xla_backend_optimization_level=0`,
-  unless `XLA_FLAGS` is already set): compiling, not running, is what the suite spends its
-  time on (about a third less wall time measured). Results agree with the optimised build
-  to rounding (LLVM's contraction of multiply-adds differs), so a test that compares two
-  processes bit for bit gives both the same flags (test_batch.py).
+- XLA compiles without LLVM's optimisation passes (`--xla_backend_optimization_level=0`)
+  and without its CPU fusion emitters (`--xla_cpu_use_fusion_emitters=false`, the LLVM IR
+  emitters before them, as `_compiling.QUICK_COMPILE` compiles the library's brief
+  programs), unless `XLA_FLAGS` is already set: compiling, not running, is what the suite
+  spends its time on (about a third less wall time measured for the first flag; the second
+  took a stress sweep's first call from 48-50 to 38-43 s, 2026-11-29). Results agree with
+  the optimised build to rounding (LLVM's contraction of multiply-adds differs), so a test
+  that compares two processes bit for bit gives both the same flags (test_batch.py).
 - Strict about shapes: implicit rank promotion raises (`jax_numpy_rank_promotion`), so a
   broadcast that was not meant fails here. Dtype promotion stays standard: strict promotion
   fails inside optax's L-BFGS, whose counters mix int32 and int64 under float64.
@@ -26,7 +29,8 @@
 import os
 import sys
 
-os.environ.setdefault("XLA_FLAGS", "--xla_backend_optimization_level=0")
+SUITE_XLA_FLAGS = "--xla_backend_optimization_level=0 --xla_cpu_use_fusion_emitters=false"
+os.environ.setdefault("XLA_FLAGS", SUITE_XLA_FLAGS)
 os.environ.setdefault("JAXIMPACT_PROGRESS", "off")
 
 import jax  # noqa: E402

@@ -56,8 +56,9 @@ def _start_sharded(tmp_path, exact):
     code = _CHILD.format(tests=here, root=os.path.dirname(here), exact=exact, path=path)
     # XLA's default optimisation (not conftest's level 0, under which the arithmetic of a
     # block depends on its shape), four host devices; the one-device run in the same child
-    flags = os.environ.get("XLA_FLAGS", "").replace("--xla_backend_optimization_level=0", "")
-    env = dict(os.environ, XLA_FLAGS=f"{flags} --xla_force_host_platform_device_count=4".strip())
+    suite = ("--xla_backend_optimization_level=", "--xla_cpu_use_fusion_emitters=")
+    flags = [f for f in os.environ.get("XLA_FLAGS", "").split() if not f.startswith(suite)]
+    env = dict(os.environ, XLA_FLAGS=" ".join([*flags, "--xla_force_host_platform_device_count=4"]))
     env.pop("JAX_PLATFORMS", None)
     process = subprocess.Popen(
         [sys.executable, "-c", code], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE
