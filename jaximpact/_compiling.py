@@ -34,16 +34,23 @@ from ._stored import stored_jit
 QUICK_COMPILE = {"xla_cpu_use_fusion_emitters": False}
 # and for a program whose calls are brief: no LLVM optimisation passes
 BRIEF_COMPILE = {**QUICK_COMPILE, "xla_backend_optimization_level": 0}
+# and for one that runs for seconds (`fit_oblique`'s, over its grid of starts): XLA's own
+# default level (3) stated, so that `XLA_FLAGS` lowering it for every program (the test
+# suite's level 0) does not slow it: under that flag a Chung & Ooi fit took 71 / 58 s (first
+# and second call) against 37 / 15 s, and now takes 38 / 17 s with the same digits
+OPTIMISED_COMPILE = {**QUICK_COMPILE, "xla_backend_optimization_level": 3}
 
 
 @functools.cache
-def quick_options(brief: bool = False) -> dict:
-    """`QUICK_COMPILE` (with `brief`, `BRIEF_COMPILE`) where this JAX's XLA takes it
-    (tried once on a one-line program), else `{}`: a version of XLA without the options
-    compiles at its defaults, not fails."""
+def quick_options(brief: bool = False, optimised: bool = False) -> dict:
+    """`QUICK_COMPILE` (with `brief`, `BRIEF_COMPILE`; with `optimised`,
+    `OPTIMISED_COMPILE`) where this JAX's XLA takes it (tried once on a one-line program),
+    else `{}`: a version of XLA without the options compiles at its defaults, not fails."""
     import jax
 
-    options = BRIEF_COMPILE if brief else QUICK_COMPILE
+    if brief and optimised:
+        raise ValueError("a program is compiled brief or optimised, not both")
+    options = BRIEF_COMPILE if brief else OPTIMISED_COMPILE if optimised else QUICK_COMPILE
     try:
         jax.jit(lambda x: x + 1, compiler_options=options).lower(1.0).compile()
     except Exception:  # an unknown option: XLA's own error type varies by version
@@ -51,9 +58,10 @@ def quick_options(brief: bool = False) -> dict:
     return options
 
 
-def quick_jit(fun, *, brief: bool = False):
-    """`eqx.filter_jit(fun)` compiled with `quick_options(brief)`, for a top-level program
-    that runs for milliseconds (`brief`: well under one), where compiling is the wait;
+def quick_jit(fun, *, brief: bool = False, optimised: bool = False):
+    """`eqx.filter_jit(fun)` compiled with `quick_options(brief, optimised)`, for a
+    top-level program that runs for milliseconds (`brief`: well under one; `optimised`: a
+    program called for seconds), where compiling is the wait;
     kept on disk as traced where JAX's persistent cache is on (`_stored`). Made at the
     first call, so that importing the library compiles nothing."""
     lock, made = threading.Lock(), []
@@ -63,7 +71,7 @@ def quick_jit(fun, *, brief: bool = False):
         if not made:
             with lock:
                 if not made:
-                    made.append(stored_jit(fun, compiler_options=quick_options(brief)))
+                    made.append(stored_jit(fun, compiler_options=quick_options(brief, optimised)))
         return made[0](*args, **kwargs)
 
     return call

@@ -2,6 +2,7 @@
 
 import jax.numpy as jnp
 import numpy as np
+import pytest
 
 from jaximpact import _compiling
 
@@ -22,3 +23,16 @@ def test_an_option_this_xla_does_not_know_falls_back_to_its_defaults(monkeypatch
         monkeypatch.undo()
         _compiling.quick_options.cache_clear()
     assert _compiling.quick_options() == {"xla_cpu_use_fusion_emitters": False}
+
+
+def test_an_optimised_program_states_xla_s_default_level():
+    """`optimised=True` (`fit_oblique`'s program, which runs for seconds) compiles at XLA's
+    default level 3 stated, whatever `XLA_FLAGS` sets for the process (the suite's level 0,
+    under which a Chung & Ooi fit ran 2-4x slower); a program is not brief and optimised."""
+    assert _compiling.quick_options(optimised=True) == {
+        "xla_cpu_use_fusion_emitters": False,
+        "xla_backend_optimization_level": 3,
+    }
+    assert _compiling.quick_jit(lambda x: 2 * x, optimised=True)(jnp.asarray(1.5)) == 3.0
+    with pytest.raises(ValueError, match="brief or optimised"):
+        _compiling.quick_options(brief=True, optimised=True)

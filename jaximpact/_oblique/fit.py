@@ -7,6 +7,7 @@ probing the loss. One compiled program (`_evaluated`: residuals, Jacobian, impac
 the grid, the optimiser (by a host callback from its loop) and the probes."""
 
 import concurrent.futures
+import functools
 import itertools
 import os
 import warnings
@@ -309,11 +310,11 @@ def _in_threads(fun, items) -> list:
     return done
 
 
-@quick_jit
+@functools.partial(quick_jit, optimised=True)
 def _evaluated(problem, theta):
     """The residuals at `theta`, their Jacobian (forward mode, exact across the stick-slip
     transitions) and the impacts: the one compiled program of a refinement (compiled
-    quickly, `_compiling`: it runs for milliseconds)."""
+    quickly, `_compiling`: each call runs for milliseconds, a fit makes hundreds)."""
 
     def with_aux(t):
         result = problem.predict(t)
