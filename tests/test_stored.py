@@ -165,9 +165,11 @@ def test_a_call_on_its_own_takes_its_options_and_under_a_jit_the_jits(folder):
     inside = jax.jit(lambda: stored(law, x, scale=1.0, name="a")["y"])()
     assert len(asked) == 1
     np.testing.assert_array_equal(np.asarray(alone), np.asarray(inside))
+    # the library's solve (`solve_jit`), here on the universal curve (a cheap compile; the
+    # integrated path under jit and eagerly: tests/solve/test_solve_options.py, slow)
     hertz = ji.law("hertz_rate", c=2e6, b1=800.0)
-    eager = float(ji.impact(hertz, m=1.0, v0=2.5, method="integrate").e)
-    jitted = float(jax.jit(lambda: ji.impact(hertz, m=1.0, v0=2.5, method="integrate").e)())
+    eager = float(ji.impact(hertz, m=1.0, v0=2.5).e)
+    jitted = float(jax.jit(lambda: ji.impact(hertz, m=1.0, v0=2.5).e)())
     assert jitted == pytest.approx(eager, rel=1e-12)
 
 
