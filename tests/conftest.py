@@ -83,6 +83,8 @@ SLOW_BY_COST = (
     "tests/posterior/test_engine_band.py::test_the_band_is_the_draws_exported_one_by_one",
     "tests/posterior/test_engine_band.py::test_the_band_holds_the_posterior_of_the_law",
     "tests/batch/test_custom_law_files.py::test_batch_file_takes_a_users_law",
+    # two users' laws' first compiles (8 s); a plain law's fast test compares with the table
+    "tests/laws/test_custom_laws.py::test_users_laws_match_scipy_under_the_force_criterion",
     # a bounce fit and its Laplace posterior, one module fixture: about 50 CPU s
     *(
         f"tests/posterior/test_bounce_posterior.py::{name}"
