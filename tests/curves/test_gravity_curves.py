@@ -227,30 +227,37 @@ def test_shipped_file():
 
 @pytest.mark.slow
 def test_build_is_reproducible():
-    """Rebuilding a shape gives the shipped table: the same pieces where both tables hold,
-    and the same outputs to 1e-9 there (`gamma Q`, the relative change of each output).
+    """Rebuilding a shape gives the shipped table: the same first break, and the same outputs
+    to 1e-9 wherever both tables hold (`gamma Q`, the relative change of each output), each
+    read off its own pieces.
 
-    Each piece's gamma range, and so where the table ends, comes from a capture search whose
-    solves count running out of a short budget as captured; that decision moves with XLA's
-    compiler flags (the suite sets its own) and with the last bits of the force: measured up
-    to 2x on one piece's range (0.0045 against 0.0091), and for this shape the table ended
-    after 12, 13 or 15 pieces (beta 3.1, 3.8, 5.8) by the flags and by whether `x^1.5` was
-    `pow` or `x sqrt(x)`. So the ranges are compared as lower bounds, the breaks where both
-    tables have them, and each table must reach beta = 3 (past the pieces that never moved)."""
+    Where a piece is split, its gamma range, and so where the table ends, come from a capture
+    search whose solves count running out of a short budget as captured; that decision moves
+    with XLA's compiler flags (the suite sets its own) and with the last bits of the force:
+    measured up to 2x on one piece's range (0.0045 against 0.0091), and for this shape the
+    table ended after 12, 13 or 15 pieces (beta 3.1, 3.8, 5.8) by the flags and by whether
+    `x^1.5` was `pow` or `x sqrt(x)`; without XLA's CPU fusion emitters one piece more is
+    split (at ln beta = -8.16, measured 2026-11-29). So the pieces are not
+    compared one by one: the ranges as lower bounds, the outputs at 64 points of the range
+    both tables cover, and each table must reach beta = 3."""
     key = curve_key(1.5, 0.5, "force")
     built = gravity.build_gravity(key, progress=False)
     shipped = gravity.table_for(key)
-    both = min(len(built.breaks), len(shipped.breaks))
-    np.testing.assert_array_equal(built.breaks[:both], shipped.breaks[:both])
+    assert built.breaks[0] == shipped.breaks[0]
     assert built.beta_max > 3.0 and shipped.beta_max > 3.0
     assert np.all(built.gamma_max > 0) and np.all(shipped.gamma_max > 0)
     rng = np.random.default_rng(7)
-    k = rng.integers(0, both - 1, 64)
-    s = shipped.breaks[k] + rng.uniform(0, 1, 64) * np.diff(shipped.breaks)[k]
-    gamma = np.minimum(built.gamma_max[k], shipped.gamma_max[k]) * rng.uniform(0, 1, 64)
+    s = rng.uniform(shipped.breaks[0], min(built.breaks[-1], shipped.breaks[-1]), 64)
+
+    def gamma_max(table):  # of the piece that holds each s
+        piece = np.searchsorted(table.breaks, s, side="right") - 1
+        return table.gamma_max[np.clip(piece, 0, len(table.gamma_max) - 1)]
+
+    gamma = np.minimum(gamma_max(built), gamma_max(shipped)) * rng.uniform(0, 1, 64)
     outputs = tuple(range(built.coefficients.shape[-1]))
     for beta, g in zip(np.exp(s), gamma, strict=True):
-        _, q_built = gravity.gravity_correction(built, beta, g, outputs)
-        _, q_shipped = gravity.gravity_correction(shipped, beta, g, outputs)
+        held_built, q_built = gravity.gravity_correction(built, beta, g, outputs)
+        held_shipped, q_shipped = gravity.gravity_correction(shipped, beta, g, outputs)
+        assert bool(held_built) and bool(held_shipped)
         # what a user sees: f = f(beta, 0) exp(gamma Q), so gamma dQ is f's relative change
         np.testing.assert_allclose(g * np.asarray(q_built), g * np.asarray(q_shipped), atol=1e-9)
