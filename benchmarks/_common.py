@@ -123,3 +123,23 @@ def write_report(path: str, text: str) -> None:
     with open(path, "w") as handle:
         handle.write(text)
     print(text)
+
+
+def fresh_process(code: str, *args: str) -> dict:
+    """The JSON that `python -c code *args` prints last, run in a fresh process with an empty
+    persistent cache of its own (a first call's time); its stderr tail on failure."""
+    import json
+    import sys
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="jaximpact-fresh-") as cache:
+        done = subprocess.run(
+            [sys.executable, "-c", code, *args],
+            capture_output=True,
+            text=True,
+            check=False,
+            env=dict(os.environ, JAXIMPACT_CACHE_DIR=cache, TF_CPP_MIN_LOG_LEVEL="3"),
+        )
+    if done.returncode != 0:
+        raise RuntimeError(done.stderr[-2000:])
+    return json.loads(done.stdout.strip().splitlines()[-1])

@@ -8,15 +8,12 @@ fits one after another, so each law's share is its own) and two (threads, the de
 Run: python benchmarks/compare_laws_split.py (writes benchmarks/compare_laws_split.md).
 """
 
-import json
 import os
-import subprocess
 import sys
-import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from _common import load_average, machine, machine_markdown, table, write_report  # noqa: E402
+from _common import fresh_process, load_average, machine, machine_markdown, table, write_report  # noqa: E402
 
 CHILD = r"""
 import collections, json, sys, time, warnings
@@ -48,15 +45,7 @@ EVENTS = ("jaxpr_trace_duration", "jaxpr_to_mlir_module_duration", "backend_comp
 
 
 def child(workers: int) -> dict:
-    with tempfile.TemporaryDirectory(prefix="jaximpact-compare-") as cache:
-        done = subprocess.run(
-            [sys.executable, "-c", CHILD, str(workers)],
-            capture_output=True,
-            text=True,
-            check=True,
-            env=dict(os.environ, JAXIMPACT_CACHE_DIR=cache, TF_CPP_MIN_LOG_LEVEL="3"),
-        )
-    return json.loads(done.stdout.strip().splitlines()[-1])
+    return fresh_process(CHILD, str(workers))
 
 
 def main():

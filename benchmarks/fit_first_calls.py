@@ -11,16 +11,13 @@ how far apart their answers are (the largest relative difference of the fitted p
 Run: python benchmarks/fit_first_calls.py [CASE ...] (writes benchmarks/fit_first_calls.md).
 """
 
-import json
 import os
-import subprocess
 import sys
-import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from _common import load_average, machine, machine_markdown, table, write_report  # noqa: E402
+from _common import fresh_process, load_average, machine, machine_markdown, table, write_report  # noqa: E402
 
 CHILD = r"""
 import json, sys, time, warnings
@@ -91,17 +88,7 @@ NOTE = (
 
 
 def child(case, optimizer):
-    with tempfile.TemporaryDirectory(prefix="jaximpact-fit-first-") as cache:
-        done = subprocess.run(
-            [sys.executable, "-c", CHILD, case, optimizer],
-            capture_output=True,
-            text=True,
-            check=False,
-            env=dict(os.environ, JAXIMPACT_CACHE_DIR=cache, TF_CPP_MIN_LOG_LEVEL="3"),
-        )
-    if done.returncode != 0:
-        raise RuntimeError(done.stderr[-2000:])
-    return json.loads(done.stdout.strip().splitlines()[-1])
+    return fresh_process(CHILD, case, optimizer)
 
 
 def largest_difference(a: dict, b: dict) -> float:

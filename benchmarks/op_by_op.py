@@ -12,16 +12,13 @@ of each, alternated.
 Run: python benchmarks/op_by_op.py (writes benchmarks/op_by_op.md).
 """
 
-import json
 import os
 import statistics
-import subprocess
 import sys
-import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from _common import load_average, machine, machine_markdown, table, write_report  # noqa: E402
+from _common import fresh_process, load_average, machine, machine_markdown, table, write_report  # noqa: E402
 
 CHILD = r"""
 import json, sys, time
@@ -61,15 +58,7 @@ REPEATS = 3
 
 
 def child(which: str) -> dict:
-    with tempfile.TemporaryDirectory(prefix="jaximpact-op-by-op-") as cache:
-        done = subprocess.run(
-            [sys.executable, "-c", CHILD, which],
-            capture_output=True,
-            text=True,
-            check=True,
-            env=dict(os.environ, JAXIMPACT_CACHE_DIR=cache, TF_CPP_MIN_LOG_LEVEL="3"),
-        )
-    return json.loads(done.stdout.strip().splitlines()[-1])
+    return fresh_process(CHILD, which)
 
 
 def main():
