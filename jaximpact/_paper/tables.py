@@ -2,10 +2,9 @@
 `hunt_crossley_variants.md`, with the notes that explain the differences.
 """
 
-import functools
-
 import numpy as np
 
+from .._compiling import quick_jit
 from .cases import COLUMNS, CRITERIA, HC_NOMINAL, SCHEMES
 
 
@@ -198,14 +197,6 @@ def _integrated_restitutions_of(a, speed):
     return jax.vmap(one)(a)
 
 
-@functools.cache
-def _integrated_restitutions_compiled():
-    """`_integrated_restitutions_of`, compiled quickly (nine impacts run for a
-    millisecond): at XLA's defaults its compile took 8.6 s of a first `jaximpact paper`."""
-    from .._compiling import quick_jit
-
-    return quick_jit(_integrated_restitutions_of, brief=True)
-
-
-def _integrated_restitutions(a, speed):
-    return _integrated_restitutions_compiled()(a, speed)
+# compiled quickly (nine impacts run for a millisecond): at XLA's defaults its compile took
+# 8.6 s of a first `jaximpact paper`
+_integrated_restitutions = quick_jit(_integrated_restitutions_of, brief=True)
