@@ -37,7 +37,7 @@ BRIEF_COMPILE = {**QUICK_COMPILE, "xla_backend_optimization_level": 0}
 # and for one that runs for seconds (`fit_oblique`'s, over its grid of starts): XLA's own
 # default level (3) stated, so that `XLA_FLAGS` lowering it for every program (the test
 # suite's level 0) does not slow it: under that flag a Chung & Ooi fit took 71 / 58 s (first
-# and second call) against 37 / 15 s, and now takes 38 / 17 s with the same digits
+# and second call) against 37 / 15 s without it, and now takes 33 / 14 s with the same digits
 OPTIMISED_COMPILE = {**QUICK_COMPILE, "xla_backend_optimization_level": 3}
 
 
