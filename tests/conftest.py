@@ -4,11 +4,13 @@
   unless `XLA_FLAGS` is already set): compiling, not running, is what the suite spends its
   time on (about a third less wall time measured). Results agree with the optimised build
   to rounding (LLVM's contraction of multiply-adds differs), so a test that compares two
-  processes bit for bit gives both the same flags (test_batch.py). Without XLA's CPU
-  fusion emitters too (`--xla_cpu_use_fusion_emitters=false`, as the library's quick
-  programs compile) a stress sweep's first call took 38-43 s instead of 48-50 and the
-  fast suite about 15 s less (2026-11-29), but the gravity table's rebuild split another
-  piece (test_gravity_curves.py): not taken until every slow group has run with it.
+  processes bit for bit gives both the same flags (test_batch.py).
+- The fast suite (a run whose mark expression leaves the slow tests out, as the default
+  `addopts` does) also compiles without XLA's CPU fusion emitters
+  (`--xla_cpu_use_fusion_emitters=false`, as the library's quick programs compile; see
+  `FAST_SUITE_FLAG`). The slow group keeps them: the gravity table's rebuild split one more
+  piece under the flag (test_gravity_curves.py), and its rounding-sensitive sweeps were
+  checked against the default build.
 - Strict about shapes: implicit rank promotion raises (`jax_numpy_rank_promotion`), so a
   broadcast that was not meant fails here. Dtype promotion stays standard: strict promotion
   fails inside optax's L-BFGS, whose counters mix int32 and int64 under float64.
@@ -30,6 +32,8 @@
 import os
 import sys
 
+# the suite's own compiler flags, only where the user set none (a worker inherits them)
+_OWN_FLAGS = "XLA_FLAGS" not in os.environ
 os.environ.setdefault("XLA_FLAGS", "--xla_backend_optimization_level=0")
 os.environ.setdefault("JAXIMPACT_PROGRESS", "off")
 
@@ -117,6 +121,36 @@ SLOW_BY_COST = (
         )
     ),
 )
+
+
+# measured on 2 cores, empty cache, alternated runs of the same tree: see the README's Tests
+FAST_SUITE_FLAG = "--xla_cpu_use_fusion_emitters=false"
+
+
+def pytest_configure(config):
+    """The fast suite's extra compiler flag (module docstring), set before JAX starts its
+    backend: the controller's environment is what xdist's workers start with."""
+    if (
+        _OWN_FLAGS
+        and _selects_no_slow_test(config)
+        and FAST_SUITE_FLAG not in os.environ["XLA_FLAGS"]
+    ):
+        os.environ["XLA_FLAGS"] += " " + FAST_SUITE_FLAG
+
+
+def _selects_no_slow_test(config) -> bool:
+    """Whether the run's mark expression (`-m`, or `addopts`' default) leaves out every test
+    marked `slow` or `engines` (any combination of them with `very_slow`)."""
+    from _pytest.mark.expression import Expression
+
+    expression = config.getoption("markexpr") or ""
+    if not expression.strip():
+        return False
+    compiled = Expression.compile(expression)
+    kinds = ({"slow"}, {"slow", "very_slow"}, {"engines"}, {"slow", "engines"})
+    return not any(
+        compiled.evaluate(lambda name, _marks=marks, **_: name in _marks) for marks in kinds
+    )
 
 
 @pytest.hookimpl(tryfirst=True)
