@@ -1,6 +1,7 @@
 """Fitting a law's parameters to measured restitution and contact duration."""
 
 import dataclasses
+import functools
 import warnings
 from typing import NamedTuple
 
@@ -41,7 +42,7 @@ from .._solve.options import (
 from .._status import Status
 from .._stored import stored_jit
 from .._xla_log import quietly_compiled
-from .forward_jacobian import value_and_jacobian, with_forward_jacobian
+from .forward_jacobian import rows_value_and_jacobian, value_and_jacobian, with_forward_jacobian
 from .parameters import default_free, law_with, to_unbounded
 from .restitution_tables import restitution_table
 
@@ -671,22 +672,28 @@ def _residuals(law, free, options: ImpactOptions, *, m, g, has_e, has_T):
     hence the explicit `ForwardMode` adjoint."""
 
     def residuals(theta, data):
-        v0, e, T, s_e, s_T = data
         fitted = law_with(law, free, theta)
-        result = jax.vmap(lambda v: solve_impact(fitted, m, v, g, None, options))(v0)
-        parts = []
+        result = jax.vmap(lambda v: solve_impact(fitted, m, v, g, None, options))(data[0])
         predictions = (result.e, result.T, result.status)
         if options.peaks:
             predictions += (result.x_max, result.F_max)
-        if has_e:
-            parts.append((result.e - e) / s_e)
-        if has_T:
-            known = jnp.isfinite(T)
-            T_safe = jnp.where(known, T, 1.0)
-            parts.append(jnp.where(known, (result.T - T_safe) / s_T, 0.0))
-        return jnp.concatenate(parts), predictions
+        return _weighted(result.e, result.T, data, has_e=has_e, has_T=has_T), predictions
 
     return residuals
+
+
+def _weighted(e, T, data, *, has_e, has_T):
+    """The residuals `(e - e_measured) / sigma_e` and `(T - T_measured) / sigma_T` (0 where
+    no `T` was measured), concatenated: what a fit's least squares takes."""
+    _, e_measured, T_measured, s_e, s_T = data
+    parts = []
+    if has_e:
+        parts.append((e - e_measured) / s_e)
+    if has_T:
+        known = jnp.isfinite(T_measured)
+        T_safe = jnp.where(known, T_measured, 1.0)
+        parts.append(jnp.where(known, (T - T_safe) / s_T, 0.0))
+    return jnp.concatenate(parts)
 
 
 def _run_lbfgs(loss, theta0, data, optimizer, max_iter, gtol):
@@ -1179,11 +1186,21 @@ def _recorded(law, solved, data, m, g, target_tol, options, *, exact, optimizer)
 def _evaluated(law, theta, data, m, g, options):
     """`(r, (e, T, status, x_max, F_max), J)` at `theta`: the one compiled program of a fit
     driven from Python (the residuals with the peaks and their forward-mode Jacobian)."""
-    targets = dict(m=m, g=g, has_e=options.has_e, has_T=options.has_T)
     with_peaks = dataclasses.replace(options.impact, peaks=True)
-    raw = _residuals(law, options.free, with_peaks, **targets)
-    (r, predictions), jacobian = value_and_jacobian(raw, theta, data)
-    return r, predictions, jacobian
+
+    def per_impact(theta, v0):
+        result = solve_impact(law_with(law, options.free, theta), m, v0, g, None, with_peaks)
+        return (result.e, result.T, result.x_max, result.F_max), result.status
+
+    ((e, T, x_max, F_max), status), (de, dT, _, _) = rows_value_and_jacobian(
+        per_impact, theta, data[0]
+    )
+    weighted = functools.partial(_weighted, data=data, has_e=options.has_e, has_T=options.has_T)
+    # the residuals are linear in (e, T): their Jacobian is theirs applied to (de, dT)
+    jacobian = jax.vmap(
+        lambda de_k, dT_k: jax.jvp(weighted, (e, T), (de_k, dT_k))[1], in_axes=-1, out_axes=-1
+    )(de, dT)
+    return weighted(e, T), (e, T, status, x_max, F_max), jacobian
 
 
 # an integrated law's program at XLA's defaults; the others compiled quickly, and briefly

@@ -52,3 +52,30 @@ def value_and_jacobian(residuals, theta, data):
 
     jacobian, value = jax.jacfwd(with_aux, has_aux=True)(theta)
     return value, jnp.atleast_2d(jacobian)
+
+
+def rows_value_and_jacobian(per_row, theta, rows):
+    """`((out, aux), J)` of `per_row(theta, row) -> (out, aux)` for every row of `rows`
+    (arrays along their first axis), `J` holding `d out / d theta` on a last axis: one
+    `vmap` over the (row, direction) pairs of a `jax.jvp`.
+
+    `jax.jacfwd` of a `vmap` over the rows batches the solve twice, once per transformation,
+    and JAX's batching of diffrax's nested loops is most of a fit's tracing: batched once,
+    a user's law's Jacobian program of 4 impacts traced in 2.8 s instead of 5.2 s (its
+    solves run in the same time: the pairs' repeated primals are members of one batch).
+    `out`: a tuple of float arrays; `aux` is not differentiated.
+    """
+    n = theta.shape[0]
+    count = jax.tree.leaves(rows)[0].shape[0]
+    repeated = jax.tree.map(lambda a: jnp.repeat(a, n, axis=0), rows)
+    directions = jnp.tile(jnp.eye(n, dtype=theta.dtype), (count, 1))
+
+    def pair(row, direction):
+        return jax.jvp(lambda t: per_row(t, row), (theta,), (direction,), has_aux=True)
+
+    out, d_out, aux = jax.vmap(pair)(repeated, directions)
+    first = jax.tree.map(lambda a: a[::n], (out, aux))  # every direction's primal is the same
+    jacobian = jax.tree.map(
+        lambda a: jnp.moveaxis(jnp.reshape(a, (count, n, *a.shape[1:])), 1, -1), d_out
+    )
+    return first, jacobian
