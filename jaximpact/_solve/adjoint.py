@@ -99,7 +99,11 @@ def _forward_jacobian_rule(primals, tangents, *, fn):
         out = fn(*jtu.tree_unflatten(treedef, new))
         return eqx.filter(out, eqx.is_inexact_array), out
 
-    jacobian, out = jax.jacfwd(at, has_aux=True)(theta)
+    if theta.shape == (1,):  # one scalar input: one jvp, no batch over the directions
+        _, column, out = jax.jvp(at, (theta,), (jnp.ones_like(theta),), has_aux=True)
+        jacobian = jax.tree.map(lambda c: c[..., None], column)
+    else:
+        jacobian, out = jax.jacfwd(at, has_aux=True)(theta)
     return out, jax.tree.map(lambda j: j @ d_theta, jacobian)
 
 
