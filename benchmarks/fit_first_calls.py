@@ -74,9 +74,11 @@ QUICK = (
     "Since stop 42 `auto`'s program on a closed form or the curves (`hertz_rate`, `bingham`, "
     "`maxwell`, 10 of `compare_laws`' 11 laws) compiles without XLA's CPU fusion emitters "
     "(`jaximpact/_compiling.py`); `lbfgs` and the integrated `user law` keep XLA's defaults. "
-    "The run before (commit 1801957, load 1.7-4.6) gave `auto` first calls of 14.2 / 13.7 "
-    "(user law), 1.6 / 1.8 (hertz_rate), 8.5 / 7.5 (bingham), 6.3 / 5.1 (maxwell) and "
-    "43.9 / 46.2 (compare_laws) wall / CPU s, and second calls of 66, 5, 10, 11 and 281 ms."
+    "Since stop 50 `auto`'s Jacobian batches the solve once, over (impact, direction) pairs "
+    "of a `jax.jvp` (`_fit/forward_jacobian.rows_value_and_jacobian`), not `jax.jacfwd` of "
+    "the batch of impacts: the run before (commit e67b1a1, load 1.5-2.6) gave `auto` first "
+    "calls of 12.0 / 13.9 (user law), 1.0 / 1.3 (hertz_rate), 4.0 / 4.9 (bingham), "
+    "3.0 / 3.5 (maxwell) and 37.9 / 33.8 (compare_laws) wall / CPU s."
 )
 CASES = ("user law", "hertz_rate", "bingham", "maxwell", "compare_laws")
 NOTE = (
