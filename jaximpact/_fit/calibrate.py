@@ -440,9 +440,16 @@ def reproduces_text(fit) -> str:
 
 
 def _target_text(target, unit: str) -> str:
-    """`target 7.8 ms`, or `not measured` where no row has one (NaN)."""
-    if not is_traced(target) and not np.any(np.isfinite(np.asarray(target))):
+    """`target 7.8 ms`, `not measured` where no row has one (NaN), and a short list with the
+    rows that have none named so: `target [8 ms, not measured, 7.2 ms]`."""
+    if is_traced(target):
+        return f"target {format_value(target, unit)}"
+    values = np.asarray(target)
+    if not np.any(np.isfinite(values)):
         return "not measured"
+    if values.ndim == 1 and values.size <= 4 and not np.all(np.isfinite(values)):
+        shown = (format_value(x, unit) if np.isfinite(x) else "not measured" for x in values)
+        return f"target [{', '.join(shown)}]"
     return f"target {format_value(target, unit)}"
 
 

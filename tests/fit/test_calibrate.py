@@ -205,6 +205,14 @@ def test_rows_without_T():
     assert_rel(as_array.params["c"], fit.params["c"], 1e-12, "NaN rows as None rows")
 
 
+def test_a_row_without_T_reads_not_measured():
+    """The fit's text names a row without a measured T, where it once read `nan s`."""
+    text = _calibrate._target_text
+    assert text(np.array([8e-3, np.nan, 7.2e-3]), "s") == "target [8 ms, not measured, 7.2 ms]"
+    assert text(np.array([8e-3, 7.2e-3]), "s") == "target [8 ms, 7.2 ms]"
+    assert text(np.array([np.nan, np.nan]), "s") == "not measured"
+
+
 @pytest.mark.slow
 def test_e_alone():
     """Without any T only the damping is fitted (e of law 14 fixes b1 / c^0.6 alone)."""
