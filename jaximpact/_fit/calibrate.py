@@ -678,15 +678,26 @@ def _residuals(law, free, options: ImpactOptions, *, m, g, has_e, has_T):
     or integrated; differentiated in forward mode only (through `with_forward_jacobian`),
     hence the explicit `ForwardMode` adjoint."""
 
+    predict = _predictions(law, free, options, m=m, g=g)
+
     def residuals(theta, data):
-        fitted = law_with(law, free, theta)
-        result = jax.vmap(lambda v: solve_impact(fitted, m, v, g, None, options))(data[0])
-        predictions = (result.e, result.T, result.status)
-        if options.peaks:
-            predictions += (result.x_max, result.F_max)
-        return _weighted(result.e, result.T, data, has_e=has_e, has_T=has_T), predictions
+        fields, status = jax.vmap(lambda v: predict(theta, v))(data[0])
+        e, T = fields[0], fields[1]
+        return _weighted(e, T, data, has_e=has_e, has_T=has_T), (e, T, status, *fields[2:])
 
     return residuals
+
+
+def _predictions(law, free, options: ImpactOptions, *, m, g):
+    """`(theta, v0) -> ((e, T) and with `options.peaks` (x_max, F_max), status)`: one
+    impact of `law` with its `free` parameters at `theta`, solved as `options` say."""
+
+    def predict(theta, v0):
+        result = solve_impact(law_with(law, free, theta), m, v0, g, None, options)
+        peaks = (result.x_max, result.F_max) if options.peaks else ()
+        return (result.e, result.T, *peaks), result.status
+
+    return predict
 
 
 def _weighted(e, T, data, *, has_e, has_T):
@@ -1194,13 +1205,9 @@ def _evaluated(law, theta, data, m, g, options):
     """`(r, (e, T, status, x_max, F_max), J)` at `theta`: the one compiled program of a fit
     driven from Python (the residuals with the peaks and their forward-mode Jacobian)."""
     with_peaks = dataclasses.replace(options.impact, peaks=True)
-
-    def per_impact(theta, v0):
-        result = solve_impact(law_with(law, options.free, theta), m, v0, g, None, with_peaks)
-        return (result.e, result.T, result.x_max, result.F_max), result.status
-
+    predict = _predictions(law, options.free, with_peaks, m=m, g=g)
     ((e, T, x_max, F_max), status), (de, dT, _, _) = rows_value_and_jacobian(
-        per_impact, theta, data[0]
+        predict, theta, data[0]
     )
     weighted = functools.partial(_weighted, data=data, has_e=options.has_e, has_T=options.has_T)
     # the residuals are linear in (e, T): their Jacobian is theirs applied to (de, dT)
